@@ -1,0 +1,9 @@
+"""Command-line interface: ``wovenimpact COMMAND``. One module per command."""
+
+from wovenimpact.cli import calibrate, element_test  # noqa: F401  (register commands)
+from wovenimpact.cli.app import app
+
+
+def main() -> None:
+    """Entry point of the ``wovenimpact`` script."""
+    app()

@@ -1,0 +1,51 @@
+"""The typer application shared by the command modules, and output helpers."""
+
+from __future__ import annotations
+
+import json
+import math
+from collections.abc import Mapping
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+app = typer.Typer(
+    name="wovenimpact",
+    help="Explicit dynamics of impacts on dry woven fabric and metal.",
+    no_args_is_help=True,
+    add_completion=False,
+    pretty_exceptions_enable=False,
+)
+calibrate_app = typer.Typer(help="Calibrate model parameters from measurements.", no_args_is_help=True)
+app.add_typer(calibrate_app, name="calibrate")
+
+console = Console()
+err_console = Console(stderr=True)
+
+
+def _jsonable(v):
+    if isinstance(v, float) and not math.isfinite(v):
+        return None
+    if hasattr(v, "item"):
+        return v.item()
+    return v
+
+
+def emit(result: Mapping, as_json: bool, title: str) -> None:
+    """Print ``result`` as one JSON object on stdout, or as a table for a person."""
+    if as_json:
+        typer.echo(json.dumps({k: _jsonable(v) for k, v in result.items()}))
+        return
+    table = Table(title=title)
+    table.add_column("quantity")
+    table.add_column("value", justify="right")
+    for k, v in result.items():
+        table.add_row(k, f"{v:.6g}" if isinstance(v, float) else str(v))
+    console.print(table)
+
+
+def fail(message: str, code: int = 2) -> None:
+    """Print an input error for a person and exit with ``code``."""
+    err_console.print(f"[bold red]error:[/] {message}")
+    raise typer.Exit(code)

@@ -1,0 +1,67 @@
+"""Index layout of the crossover-model parameter vector and state vector.
+
+Kept apart from the kernels so the Python side (materials/fabric.py, outputs,
+tests) can name entries without importing compiled code. Plain integer
+constants: Numba treats module-level ints as compile-time constants.
+
+Parameter vector ``p`` (float64, length ``N_PARAM``), SI units. Index 0/1 of a
+pair is warp/fill.
+"""
+
+# --- parameters -------------------------------------------------------------
+P_E = 0  # E_i, yarn axial modulus (Pa); P_E + 1 for fill
+P_AREA = 2  # A_i, yarn cross-section area (m²)
+P_ELL0 = 4  # ℓ_i0, in-plane half-length of a family-i yarn between crossings (m)
+P_H0 = 6  # h_i0, crimp amplitude (m)
+P_TU = 8  # T_ui, ultimate yarn tension (N)
+P_WIDTH = 10  # b_i, yarn width (m)
+P_LT0 = 12  # L_i0 = √(ℓ_i0² + h_i0²), initial half-truss length (m) — derived
+P_COMP_A = 14  # a, compaction law F = b δ / (a − δ) (m)
+P_COMP_B = 15  # b (N)
+P_G1 = 16  # trellis shear modulus before locking (Pa)
+P_G2 = 17  # trellis shear modulus after full compaction (Pa)
+P_GAMMA1 = 18  # γ1, true shear angle where parallel yarns touch (rad) — derived
+P_GAMMA2 = 19  # γ2, true shear angle of full compaction (rad) — derived
+P_BETA1 = 20  # β1 of the thesis shear variant, eq. (6.32) (rad) — derived
+P_BETA2 = 21  # β2 of the thesis shear variant, eq. (6.33) (rad) — derived
+P_THICK = 22  # t, shell (fabric) thickness (m), default 2 (h_w0 + h_f0)
+P_SOFT = 23  # Δε_s, softening strain of progressive failure (—)
+P_HOMOG = 24  # homogenisation option: HOMOG_VIRIAL or HOMOG_THESIS
+P_SHEAR = 25  # shear option: SHEAR_TRUE or SHEAR_THESIS
+P_FRAME = 26  # frame option: FRAME_FIBRE or FRAME_GREEN_NAGHDI
+P_FAILURE = 27  # failure option: FAILURE_INSTANT or FAILURE_PROGRESSIVE
+P_AREAL_MASS = 28  # μ, areal mass (kg/m²) — derived or measured
+N_PARAM = 29
+
+HOMOG_VIRIAL = 0
+HOMOG_THESIS = 1
+SHEAR_TRUE = 0
+SHEAR_THESIS = 1
+FRAME_FIBRE = 0
+FRAME_GREEN_NAGHDI = 1
+FAILURE_INSTANT = 0
+FAILURE_PROGRESSIVE = 1
+
+# --- state (history variables and outputs of one material point) -------------
+S_H = 0  # H_i, current crimp height of family i (m); S_H + 1 for fill
+S_DAMAGE = 2  # d_i ∈ [0, 1], yarn damage (1 = broken)
+S_LAMBDA = 4  # λ_i, stretch of family i (accumulated in the Green–Naghdi option)
+S_GAMMA = 6  # γ, trellis shear angle (rad)
+S_TAU = 7  # τ, trellis shear stress (Pa)
+S_TENSION = 8  # T_i, yarn tension (N)
+S_ALIVE = 10  # 1.0 while at least one family is intact, 0.0 once eroded
+S_ENERGY = 11  # stored energy per unit reference area (J/m²): yarns + compaction + shear
+S_SHEAR_ENERGY = 12  # shear part of S_ENERGY (J/m²)
+S_ITER = 13  # iterations of the last height solve
+N_STATE = 14
+
+# --- status codes returned per point -----------------------------------------
+STATUS_OK = 0
+STATUS_NOT_CONVERGED = 1  # height solve exceeded its iteration budget
+STATUS_BAD_KINEMATICS = 2  # stretch ≤ 0, yarns parallel or inverted, or non-finite input
+
+STATUS_TEXT = {
+    STATUS_OK: "ok",
+    STATUS_NOT_CONVERGED: "crimp-height solve did not converge",
+    STATUS_BAD_KINEMATICS: "inadmissible deformation (stretch ≤ 0, yarns parallel, or NaN)",
+}

@@ -1,0 +1,184 @@
+"""Python side of the yarn-crossover fabric model: parameters and point updates.
+
+The physics lives in :mod:`wovenimpact.kernels.fabric` (Numba). This module
+holds the SI parameter set (:class:`FabricParameters`), packs it into the flat
+parameter vector the kernels read (layout in :mod:`wovenimpact.kernels.fabric_layout`),
+and offers :func:`initial_state` and :func:`update_points`, which run the kernel
+on one point or a million and raise :class:`MaterialPointError` naming the
+point and its state if any point fails. docs/theory.md §1.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+
+from wovenimpact.kernels import fabric_layout as L
+
+
+@dataclass(frozen=True)
+class YarnFamily:
+    """One yarn family (warp or fill), SI units.
+
+    Attributes:
+        half_length: ℓ_i0 = 1/(2 n_j), in-plane half-length between crossings (m).
+        crimp: c_i, yarn length / fabric length − 1.
+        h0: crimp amplitude from eq. (5.5) (m).
+        area: A_i, yarn cross-section (m²).
+        modulus: E_i, yarn axial modulus (Pa).
+        ultimate_tension: T_ui (N).
+        width: b_i, yarn width (m).
+        thickness: t_i, yarn thickness (m).
+    """
+
+    half_length: float
+    crimp: float
+    h0: float
+    area: float
+    modulus: float
+    ultimate_tension: float
+    width: float
+    thickness: float
+
+    @property
+    def truss_length(self) -> float:
+        """L_i0 = √(ℓ_i0² + h_i0²), initial half-truss length (eq. 6.18)."""
+        return math.hypot(self.half_length, self.h0)
+
+
+@dataclass(frozen=True)
+class FabricOptions:
+    """Model variants (MODEL.md §1.4–1.7; docs/theory.md §1.8)."""
+
+    homogenisation: Literal["virial", "thesis"] = "virial"
+    shear: Literal["true", "thesis"] = "true"
+    frame: Literal["fibre", "green-naghdi"] = "fibre"
+    failure: Literal["instant", "progressive"] = "instant"
+    softening_strain: float = 0.0  # Δε_s (—), used with failure = "progressive"
+
+
+@dataclass(frozen=True)
+class FabricParameters:
+    """Complete, validated parameter set of the crossover model (SI).
+
+    Attributes:
+        warp, fill: the two yarn families.
+        compaction_a: a of F = b δ / (a − δ) (m), eq. (5.8).
+        compaction_b: b (N).
+        shear_g1, shear_g2: trellis shear moduli before locking / at full compaction (Pa).
+        shear_c_max: compaction ratio C_max at full locking (—).
+        fibre_density: ρ_y (kg/m³).
+        areal_density: measured areal mass (kg/m²); None = from yarn volume (§1.8).
+        thickness: shell thickness (m); None = 2 (h_w0 + h_f0) (= 4 h0, Table 5-1).
+        options: model variants.
+    """
+
+    warp: YarnFamily
+    fill: YarnFamily
+    compaction_a: float
+    compaction_b: float
+    shear_g1: float
+    shear_g2: float
+    shear_c_max: float
+    fibre_density: float
+    areal_density: float | None = None
+    thickness: float | None = None
+    options: FabricOptions = field(default_factory=FabricOptions)
+
+    # --- derived quantities ---------------------------------------------------
+    @property
+    def shell_thickness(self) -> float:
+        """Shell thickness t (m): given, or 2 (h_w0 + h_f0) = 4 h0 for a balanced weave."""
+        if self.thickness is not None:
+            return self.thickness
+        return 2.0 * (self.warp.h0 + self.fill.h0)
+
+    @property
+    def areal_mass(self) -> float:
+        """μ (kg/m²): measured, or ρ_y [A_w (1+c_w)/(2ℓ_f0) + A_f (1+c_f)/(2ℓ_w0)] (§1.8)."""
+        if self.areal_density is not None:
+            return self.areal_density
+        w, f = self.warp, self.fill
+        return self.fibre_density * (
+            w.area * (1.0 + w.crimp) / (2.0 * f.half_length)
+            + f.area * (1.0 + f.crimp) / (2.0 * w.half_length)
+        )
+
+    @property
+    def locking_angles(self) -> tuple[float, float]:
+        """(γ1, γ2) in rad of the true-angle trellis law (§1.6, eq. 3.13–3.14).
+
+        Parallel warp yarns are 2ℓ_f0 apart along the fill; they touch when
+        2ℓ_f0 sin θ = b_w, and are fully compacted when 2ℓ_f0 sin θ = C_max b_w
+        (same for the fill). The family that locks first sets γ1 and γ2. A yarn
+        as wide as its pitch (zero gap, the reference fabric) gives γ1 = 0.
+        """
+        ratios = (
+            self.warp.width / (2.0 * self.fill.half_length),
+            self.fill.width / (2.0 * self.warp.half_length),
+        )
+        r = max(ratios)
+        gamma1 = 0.5 * math.pi - math.asin(min(r, 1.0))
+        gamma2 = 0.5 * math.pi - math.asin(min(self.shear_c_max * r, 1.0))
+        return gamma1, gamma2
+
+    @property
+    def thesis_locking_angles(self) -> tuple[float, float]:
+        """(β1, β2) in rad of the thesis shear variant, eq. (6.32)–(6.33).
+
+        sin β1 = mean_i(b_i / ℓ_i0), sin β2 = mean_i(C_max b_i / ℓ_i0). For the
+        reference fabric these sines are 2.0 and 1.3: no such angle exists, so
+        the thesis's locking never engages and G = G1 throughout. We represent
+        an unreachable angle by π/2 (β = asin(H/ℓ) ≤ π/2 always) and say so in
+        :meth:`warnings`.
+        """
+        s1 = 0.5 * (self.warp.width / self.warp.half_length + self.fill.width / self.fill.half_length)
+        s2 = self.shear_c_max * s1
+        beta = lambda s: math.asin(s) if s <= 1.0 else 0.5 * math.pi  # noqa: E731
+        return beta(s1), beta(s2)
+
+    def warnings(self) -> list[str]:
+        """Model caveats worth showing a user of these parameters."""
+        out = []
+        if self.options.shear == "thesis":
+            s1 = 0.5 * (
+                self.warp.width / self.warp.half_length + self.fill.width / self.fill.half_length
+            )
+            if s1 >= 1.0:
+                out.append(
+                    f"shear = 'thesis': sin β1 = b/ℓ0 = {s1:.3f} ≥ 1 (eq. 6.32), so the thesis's "
+                    "locking angles do not exist and G = G1 at every shear angle"
+                )
+        return out
+
+    def to_array(self) -> np.ndarray:
+        """Pack into the flat parameter vector read by the kernels."""
+        p = np.zeros(L.N_PARAM)
+        for i, y in enumerate((self.warp, self.fill)):
+            p[L.P_E + i] = y.modulus
+            p[L.P_AREA + i] = y.area
+            p[L.P_ELL0 + i] = y.half_length
+            p[L.P_H0 + i] = y.h0
+            p[L.P_TU + i] = y.ultimate_tension
+            p[L.P_WIDTH + i] = y.width
+            p[L.P_LT0 + i] = y.truss_length
+        p[L.P_COMP_A] = self.compaction_a
+        p[L.P_COMP_B] = self.compaction_b
+        p[L.P_G1] = self.shear_g1
+        p[L.P_G2] = self.shear_g2
+        p[L.P_GAMMA1], p[L.P_GAMMA2] = self.locking_angles
+        p[L.P_BETA1], p[L.P_BETA2] = self.thesis_locking_angles
+        p[L.P_THICK] = self.shell_thickness
+        o = self.options
+        p[L.P_SOFT] = o.softening_strain
+        p[L.P_HOMOG] = {"virial": L.HOMOG_VIRIAL, "thesis": L.HOMOG_THESIS}[o.homogenisation]
+        p[L.P_SHEAR] = {"true": L.SHEAR_TRUE, "thesis": L.SHEAR_THESIS}[o.shear]
+        p[L.P_FRAME] = {"fibre": L.FRAME_FIBRE, "green-naghdi": L.FRAME_GREEN_NAGHDI}[o.frame]
+        p[L.P_FAILURE] = {"instant": L.FAILURE_INSTANT, "progressive": L.FAILURE_PROGRESSIVE}[
+            o.failure
+        ]
+        p[L.P_AREAL_MASS] = self.areal_mass
+        return p

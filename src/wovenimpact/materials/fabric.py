@@ -182,3 +182,65 @@ class FabricParameters:
         ]
         p[L.P_AREAL_MASS] = self.areal_mass
         return p
+
+
+# --- running the kernel on points ------------------------------------------------
+def initial_state(params: FabricParameters, n_points: int = 1) -> np.ndarray:
+    """States of ``n_points`` undeformed points: H_i = h_i0, λ_i = 1, intact, alive."""
+    s = np.zeros((n_points, L.N_STATE))
+    s[:, L.S_H] = params.warp.h0
+    s[:, L.S_H + 1] = params.fill.h0
+    s[:, L.S_LAMBDA] = 1.0
+    s[:, L.S_LAMBDA + 1] = 1.0
+    s[:, L.S_ALIVE] = 1.0
+    return s
+
+
+@dataclass
+class PointUpdate:
+    """Result of :func:`update_points` (arrays over points)."""
+
+    state: np.ndarray  # (n, N_STATE)
+    resultant: np.ndarray  # (n, 3): N_xx, N_yy, N_xy (N/m)
+    stiffness: np.ndarray  # (n,): tangent stiffness bound (N/m)
+
+
+def update_points(
+    p: np.ndarray, f_old: np.ndarray, f_new: np.ndarray, state: np.ndarray
+) -> PointUpdate:
+    """Advance material points from F_old to F_new; raise on any failed point.
+
+    Args:
+        p: parameter vector (:meth:`FabricParameters.to_array`).
+        f_old, f_new: (n, 2, 2) or (2, 2) deformation gradients (reference yarn
+            frame → current frame).
+        state: (n, N_STATE) or (N_STATE,) states at the start of the step.
+
+    Raises:
+        MaterialPointError: naming the first failed point, why, and its input.
+    """
+    from wovenimpact.errors import MaterialPointError
+    from wovenimpact.kernels.fabric import fabric_update_for_points
+
+    f_old = np.ascontiguousarray(np.asarray(f_old, dtype=np.float64).reshape(-1, 2, 2))
+    f_new = np.ascontiguousarray(np.asarray(f_new, dtype=np.float64).reshape(-1, 2, 2))
+    state_in = np.ascontiguousarray(np.asarray(state, dtype=np.float64).reshape(-1, L.N_STATE))
+    n = f_new.shape[0]
+    if f_old.shape[0] != n or state_in.shape[0] != n:
+        raise ValueError(
+            f"point counts differ: f_old {f_old.shape[0]}, f_new {n}, state {state_in.shape[0]}"
+        )
+    state_out = np.empty_like(state_in)
+    res = np.empty((n, 3))
+    stiff = np.empty(n)
+    status = np.empty(n, dtype=np.int32)
+    fabric_update_for_points(p, f_old, f_new, state_in, state_out, res, stiff, status)
+    bad = np.flatnonzero(status != L.STATUS_OK)
+    if bad.size:
+        i = int(bad[0])
+        raise MaterialPointError(
+            f"fabric point {i} of {n} ({bad.size} failed): {L.STATUS_TEXT[int(status[i])]}; "
+            f"F_old = {f_old[i].tolist()}, F_new = {f_new[i].tolist()}, "
+            f"state = {state_in[i].tolist()}"
+        )
+    return PointUpdate(state=state_out, resultant=res, stiffness=stiff)

@@ -1,0 +1,89 @@
+"""Figures of a single-element test, in the manner of thesis Figs. 6-10 to 6-15."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from wovenimpact.calibration.single_element import SHEAR_TESTS, ElementTestResult  # noqa: E402
+
+
+def _save(fig, path: Path) -> Path:
+    fig.tight_layout()
+    tmp = path.with_name(path.stem + ".tmp" + path.suffix)
+    fig.savefig(tmp, dpi=120)
+    plt.close(fig)
+    tmp.replace(path)
+    return path
+
+
+def plot_element_test(result: ElementTestResult, out_dir: Path) -> list[Path]:
+    """Write the PNG figures of one test into ``out_dir``; return their paths."""
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    h = result.history
+    shear = result.test in SHEAR_TESTS
+    if shear:
+        x, xlabel = h["shear_angle_deg"], "shear angle γ (°)"
+    else:
+        x, xlabel = h["displacement_m"] * 1e3, "edge displacement (mm)"
+    title = f"{result.test} — " + ", ".join(f"{k} {v}" for k, v in result.options.items())
+    paths = []
+
+    fig, ax = plt.subplots(figsize=(6, 4))  # Figs. 6-10, 6-13: yarn tensions
+    ax.plot(x, h["tension_w_N"], label="warp T_w")
+    ax.plot(x, h["tension_f_N"], "--", label="fill T_f")
+    if result.failure_displacement_m is not None and not shear:
+        ax.axvline(result.failure_displacement_m * 1e3, color="grey", lw=0.8, ls=":")
+    ax.set(xlabel=xlabel, ylabel="yarn tension (N)", title=title)
+    ax.legend()
+    ax.grid(alpha=0.3)
+    paths.append(_save(fig, out_dir / "tensions.png"))
+
+    fig, ax = plt.subplots(figsize=(6, 4))  # Figs. 6-12, 6-14: crimp heights
+    ax.plot(x, h["height_w_m"] * 1e3, label="warp H_w")
+    ax.plot(x, h["height_f_m"] * 1e3, "--", label="fill H_f")
+    ax.set(xlabel=xlabel, ylabel="crimp height (mm)", title=title)
+    ax.legend()
+    ax.grid(alpha=0.3)
+    paths.append(_save(fig, out_dir / "heights.png"))
+
+    fig, ax = plt.subplots(figsize=(6, 4))  # stress resultants
+    for name, style in (("N_xx_N_per_m", "-"), ("N_yy_N_per_m", "--"), ("N_xy_N_per_m", ":")):
+        ax.plot(x, h[name] / 1e3, style, label=name.split("_N")[0])
+    ax.set(xlabel=xlabel, ylabel="membrane resultant (kN/m)", title=title)
+    ax.legend()
+    ax.grid(alpha=0.3)
+    paths.append(_save(fig, out_dir / "resultants.png"))
+
+    fig, ax = plt.subplots(figsize=(6, 4))  # energy balance
+    ax.plot(x, h["external_work_J_per_m2"], label="external work W")
+    ax.plot(x, h["stored_energy_J_per_m2"], "--", label="stored energy U")
+    ax.set(
+        xlabel=xlabel,
+        ylabel="energy per reference area (J/m²)",
+        title=f"energy error before failure {result.energy_error_fraction:.2e}",
+    )
+    ax.legend()
+    ax.grid(alpha=0.3)
+    paths.append(_save(fig, out_dir / "energy.png"))
+
+    if shear:  # Fig. 6-15: shear stress and secant modulus against the shear angle
+        gam = np.radians(h["shear_angle_deg"])
+        with np.errstate(invalid="ignore", divide="ignore"):
+            g_sec = np.where(np.abs(gam) > 0, h["shear_stress_Pa"] / gam, np.nan)
+        fig, ax = plt.subplots(figsize=(6, 4))
+        ax.plot(h["shear_angle_deg"], g_sec / 1e9, label="secant modulus τ/γ")
+        ax.set(xlabel=xlabel, ylabel="shear modulus (GPa)", title=title)
+        ax2 = ax.twinx()
+        ax2.plot(h["shear_angle_deg"], h["shear_stress_Pa"] / 1e6, "r--", label="τ")
+        ax2.set_ylabel("shear stress τ (MPa)")
+        ax.grid(alpha=0.3)
+        fig.legend(loc="upper left")
+        paths.append(_save(fig, out_dir / "shear.png"))
+    return paths

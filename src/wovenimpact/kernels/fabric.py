@@ -1,0 +1,466 @@
+"""Yarn-crossover model of a dry plain-weave fabric: one material-point update.
+
+docs/theory.md §1 states the model; thesis ch. 3.5–3.6 and 6.2 are its source,
+MODEL.md §1 the corrections. Per point, given the in-plane deformation gradient
+F (2×2, mapping the reference yarn frame — warp along x, fill along y — to the
+current corotational frame), the kernel
+
+1. finds the stretches λ_i and yarn directions e_i (fibre frame, §1.7) or
+   accumulates them incrementally (Green–Naghdi option, eq. 6.13–6.16);
+2. solves the crossover for the crimp heights H_w, H_f (eq. 6.19–6.25) with a
+   bracketed Newton iteration on one unknown (theory §1.3);
+3. applies yarn failure (eq. 6.29, or progressive softening) and erosion;
+4. returns the membrane stress resultant N (force per unit current length,
+   virial homogenisation §1.5 or the thesis's eq. 6.38), the trellis shear
+   resultant (§1.6), the stored energy per unit reference area and an upper
+   bound of the membrane tangent stiffness for the stable time step.
+
+Everything is a pure function of flat arrays; ``fabric_update_point`` handles
+one point and ``fabric_update_for_points`` loops over many in parallel (each
+point independent, so results are bitwise identical for any thread count).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import prange
+
+from wovenimpact.jit import kernel, loop_kernel
+from wovenimpact.kernels.fabric_layout import (
+    FAILURE_PROGRESSIVE,
+    FRAME_GREEN_NAGHDI,
+    HOMOG_THESIS,
+    N_STATE,
+    P_AREA,
+    P_BETA1,
+    P_BETA2,
+    P_COMP_A,
+    P_COMP_B,
+    P_E,
+    P_ELL0,
+    P_FAILURE,
+    P_FRAME,
+    P_G1,
+    P_G2,
+    P_GAMMA1,
+    P_GAMMA2,
+    P_H0,
+    P_HOMOG,
+    P_LT0,
+    P_SHEAR,
+    P_SOFT,
+    P_THICK,
+    P_TU,
+    S_ALIVE,
+    S_DAMAGE,
+    S_ENERGY,
+    S_GAMMA,
+    S_H,
+    S_ITER,
+    S_LAMBDA,
+    S_SHEAR_ENERGY,
+    S_TAU,
+    S_TENSION,
+    SHEAR_THESIS,
+    STATUS_BAD_KINEMATICS,
+    STATUS_NOT_CONVERGED,
+    STATUS_OK,
+)
+
+MAX_ITER = 100  # bisection alone halves [0, 2h0] to round-off in < 60 steps
+REL_TOL = 1e-12  # equilibrium |F_w − F_f| ≤ REL_TOL (F_w + F_f)
+RESOLUTION = 4.0 * 2.220446049250313e-16  # smallest useful height step, relative to S
+
+
+# --- constitutive pieces -------------------------------------------------------
+@kernel
+def yarn_vertical_force(k, ell, ell_truss0, h):
+    """Vertical force of one yarn on the crossing, F = 2 T H / L (eq. 6.21–6.22).
+
+    Args:
+        k: (1 − d) E A / L0, axial stiffness of the half truss (N/m).
+        ell: ℓ, current in-plane half-length (m).
+        ell_truss0: L0 = √(ℓ0² + h0²) (m).
+        h: H, crimp height (m); the formula is odd in H.
+
+    Returns:
+        (F, dF/dH, T): force (N), its derivative (N/m), tension
+        T = k ⟨L − L0⟩ (eq. 6.20; yarns carry no compression).
+    """
+    length = math.sqrt(ell * ell + h * h)
+    if length <= ell_truss0 or k == 0.0:
+        return 0.0, 0.0, 0.0
+    tension = k * (length - ell_truss0)
+    force = 2.0 * tension * h / length
+    dforce = 2.0 * k * (1.0 - ell_truss0 * ell * ell / (length * length * length))
+    return force, dforce, tension
+
+
+@kernel
+def compaction_closure(force, a, b):
+    """Overclosure δ(F) = a F / (b + F), inverse of F = b δ / (a − δ) (eq. 5.8), and dδ/dF."""
+    if force <= 0.0:
+        return 0.0, a / b
+    denom = b + force
+    return a * force / denom, a * b / (denom * denom)
+
+
+@kernel
+def compaction_energy(delta, a, b):
+    """∫₀^δ F dδ = b (−a ln(1 − δ/a) − δ) (J), energy of the compaction spring."""
+    if delta <= 0.0:
+        return 0.0
+    return b * (-a * math.log1p(-delta / a) - delta)
+
+
+@kernel
+def slack_height(ell, ell_truss0):
+    """Largest H at which a yarn of half-length ℓ is slack: √(L0² − ℓ²), 0 if taut when straight."""
+    if ell >= ell_truss0:
+        return 0.0
+    return math.sqrt(ell_truss0 * ell_truss0 - ell * ell)
+
+
+@kernel
+def solve_crimp_heights(k_w, k_f, ell_w, ell_f, lt0_w, lt0_f, s_total, a, b, h_w_prev):
+    """Crimp heights of two intact yarns in contact (eq. 6.21–6.25; theory §1.3).
+
+    Unknown H_w; compatibility gives H_f(H_w) = S − δ(F_w(H_w)) − H_w and the
+    equilibrium residual g(H_w) = F_w(H_w) − F_f(H_f(H_w)) is non-decreasing.
+    With the slack heights Hs_i, either Hs_w + Hs_f ≥ S (both yarns can be
+    slack while touching: g ≡ 0 on an interval, we keep the previous height
+    projected onto it) or the root is unique in [Hs_w, S − Hs_f], where
+    g(Hs_w) < 0 < g(S − Hs_f). Newton steps are kept inside the shrinking
+    bracket; a step that leaves it is replaced by bisection.
+
+    Returns:
+        (H_w, H_f, F_c, iterations, converged)
+    """
+    hs_w = slack_height(ell_w, lt0_w)
+    hs_f = slack_height(ell_f, lt0_f)
+    if hs_w + hs_f >= s_total:
+        lo = max(0.0, s_total - hs_f)
+        hi = min(s_total, hs_w)
+        h_w = min(max(h_w_prev, lo), hi)
+        return h_w, s_total - h_w, 0.0, 0, True
+    lo = hs_w
+    hi = s_total - hs_f
+    x = min(max(h_w_prev, lo), hi)
+    if x == lo or x == hi:
+        x = 0.5 * (lo + hi)
+    for it in range(1, MAX_ITER + 1):
+        f_w, df_w, t_w = yarn_vertical_force(k_w, ell_w, lt0_w, x)
+        delta, ddelta = compaction_closure(f_w, a, b)
+        h_f = s_total - delta - x
+        f_f, df_f, t_f = yarn_vertical_force(k_f, ell_f, lt0_f, h_f)
+        g = f_w - f_f
+        if abs(g) <= REL_TOL * (f_w + f_f) and f_w > 0.0:
+            return x, h_f, 0.5 * (f_w + f_f), it, True
+        if g < 0.0:
+            lo = x
+        else:
+            hi = x
+        slope = df_w + df_f * (1.0 + ddelta * df_w)
+        x_new = x - g / slope if slope > 0.0 else lo - 1.0
+        if not (lo < x_new < hi):
+            x_new = 0.5 * (lo + hi)
+        # H_f = S − δ − H_w is resolved only to ~eps·S: a step below that
+        # cannot reduce the residual any further, the root is pinned.
+        if abs(x_new - x) <= RESOLUTION * s_total:
+            return x, h_f, 0.5 * (f_w + f_f), it, True
+        x = x_new
+    return x, s_total - x, 0.0, MAX_ITER, False
+
+
+@kernel
+def shear_modulus_true(gamma_abs, g1, g2, gamma1, gamma2):
+    """Secant modulus G(|γ|) of the trellis law (eq. 3.16 on the true angle; theory §1.6).
+
+    Returns (G, dτ/dγ, e) with τ = G γ and e(|γ|) = ∫₀^|γ| τ dγ (J/m³).
+    """
+    if gamma_abs <= gamma1:
+        return g1, g1, 0.5 * g1 * gamma_abs * gamma_abs
+    e1 = 0.5 * g1 * gamma1 * gamma1
+    if gamma2 > gamma1:
+        m = (g2 - g1) / (gamma2 - gamma1)
+        if gamma_abs <= gamma2:
+            g = g1 + m * (gamma_abs - gamma1)
+            e = (
+                e1
+                + 0.5 * g1 * (gamma_abs**2 - gamma1**2)
+                + m * ((gamma_abs**3 - gamma1**3) / 3.0 - 0.5 * gamma1 * (gamma_abs**2 - gamma1**2))
+            )
+            return g, g + m * gamma_abs, e
+        e2 = (
+            e1
+            + 0.5 * g1 * (gamma2**2 - gamma1**2)
+            + m * ((gamma2**3 - gamma1**3) / 3.0 - 0.5 * gamma1 * (gamma2**2 - gamma1**2))
+        )
+    else:
+        e2 = e1
+    return g2, g2, e2 + 0.5 * g2 * (gamma_abs**2 - gamma2**2)
+
+
+@kernel
+def shear_modulus_thesis(sin_beta, g1, g2, beta1, beta2):
+    """G(β) of the thesis's VUMAT, eq. (6.35)–(6.36): β from the crimp heights."""
+    beta = math.asin(min(sin_beta, 1.0))
+    if beta <= beta1:
+        return g1
+    if beta >= beta2:
+        return g2
+    return g1 + (g2 - g1) * (beta - beta1) / (beta2 - beta1)
+
+
+@kernel
+def softening_damage(strain, d_old, e_a, t_u, soft):
+    """Damage after progressive failure (theory §1.4): tension falls linearly to 0 over Δε_s.
+
+    Envelope T_env(ε) = T_u (1 − (ε − ε_u)/Δε_s) for ε ≥ ε_u = T_u/(E A);
+    d = max(d_old, 1 − T_env/(E A ε)) when (1 − d_old) E A ε exceeds it.
+    """
+    eps_u = t_u / e_a
+    if strain < eps_u:
+        return d_old
+    if strain >= eps_u + soft:
+        return 1.0
+    t_env = t_u * (1.0 - (strain - eps_u) / soft)
+    if (1.0 - d_old) * e_a * strain <= t_env:
+        return d_old
+    return max(d_old, 1.0 - t_env / (e_a * strain))
+
+
+# --- one material point --------------------------------------------------------
+@kernel
+def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
+    """Update one crossover material point from F_old to F_new.
+
+    Args:
+        p: (N_PARAM,) parameters (layout in fabric_layout).
+        f_old, f_new: (2, 2) deformation gradients at the start and end of the step.
+        s_in: (N_STATE,) state at the start of the step.
+        s_out: (N_STATE,) state at the end (written; may not alias s_in).
+        n_out: (3,) membrane resultant (N_xx, N_yy, N_xy) in N/m (written).
+
+    Returns:
+        (status, stiffness): a STATUS_* code and an upper bound of the membrane
+        tangent stiffness dN/dε (N/m) for the stable time step (theory §1.8).
+    """
+    for j in range(N_STATE):
+        s_out[j] = s_in[j]
+    n_out[0] = 0.0
+    n_out[1] = 0.0
+    n_out[2] = 0.0
+    thick = p[P_THICK]
+
+    # 1. kinematics: current yarn directions and angle (eq. 6.5, fibre frame)
+    gwx, gwy = f_new[0, 0], f_new[1, 0]
+    gfx, gfy = f_new[0, 1], f_new[1, 1]
+    lam_w = math.sqrt(gwx * gwx + gwy * gwy)
+    lam_f = math.sqrt(gfx * gfx + gfy * gfy)
+    if not (lam_w > 0.0 and lam_f > 0.0):  # also catches NaN
+        return STATUS_BAD_KINEMATICS, 0.0
+    ewx, ewy = gwx / lam_w, gwy / lam_w
+    efx, efy = gfx / lam_f, gfy / lam_f
+    cos_t = ewx * efx + ewy * efy
+    sin_t = ewx * efy - ewy * efx
+    if not (sin_t > 0.0) or not math.isfinite(cos_t):
+        return STATUS_BAD_KINEMATICS, 0.0
+    gamma = 0.5 * math.pi - math.atan2(sin_t, cos_t)
+
+    if p[P_FRAME] == FRAME_GREEN_NAGHDI:
+        # Incremental stretches (eq. 6.13–6.16) from the midpoint strain increment
+        # Δε = sym(ΔF F_mid⁻¹), and the shear increment of eq. (6.34).
+        a11 = 0.5 * (f_old[0, 0] + f_new[0, 0])
+        a12 = 0.5 * (f_old[0, 1] + f_new[0, 1])
+        a21 = 0.5 * (f_old[1, 0] + f_new[1, 0])
+        a22 = 0.5 * (f_old[1, 1] + f_new[1, 1])
+        det = a11 * a22 - a12 * a21
+        if not (det > 0.0):
+            return STATUS_BAD_KINEMATICS, 0.0
+        i11, i12, i21, i22 = a22 / det, -a12 / det, -a21 / det, a11 / det
+        d11 = f_new[0, 0] - f_old[0, 0]
+        d12 = f_new[0, 1] - f_old[0, 1]
+        d21 = f_new[1, 0] - f_old[1, 0]
+        d22 = f_new[1, 1] - f_old[1, 1]
+        l11 = d11 * i11 + d12 * i21
+        l12 = d11 * i12 + d12 * i22
+        l21 = d21 * i11 + d22 * i21
+        l22 = d21 * i12 + d22 * i22
+        e11, e22, e12 = l11, l22, 0.5 * (l12 + l21)
+        de_w = ewx * ewx * e11 + 2.0 * ewx * ewy * e12 + ewy * ewy * e22
+        de_f = efx * efx * e11 + 2.0 * efx * efy * e12 + efy * efy * e22
+        if not (1.0 + 2.0 * de_w > 0.0 and 1.0 + 2.0 * de_f > 0.0):
+            return STATUS_BAD_KINEMATICS, 0.0
+        lam_w = s_in[S_LAMBDA] * math.sqrt(1.0 + 2.0 * de_w)
+        lam_f = s_in[S_LAMBDA + 1] * math.sqrt(1.0 + 2.0 * de_f)
+        # e_w · Δε · (e_w turned +90°) + (e_f turned −90°) · Δε · e_f
+        nwx, nwy = -ewy, ewx
+        mfx, mfy = efy, -efx
+        dgam = (ewx * nwx * e11 + (ewx * nwy + ewy * nwx) * e12 + ewy * nwy * e22) + (
+            mfx * efx * e11 + (mfx * efy + mfy * efx) * e12 + mfy * efy * e22
+        )
+        gamma = s_in[S_GAMMA] + dgam
+    dgamma = gamma - s_in[S_GAMMA]
+    s_out[S_LAMBDA] = lam_w
+    s_out[S_LAMBDA + 1] = lam_f
+    s_out[S_GAMMA] = gamma
+
+    ell_w = lam_w * p[P_ELL0]
+    ell_f = lam_f * p[P_ELL0 + 1]
+    lt0_w = p[P_LT0]
+    lt0_f = p[P_LT0 + 1]
+    s_total = p[P_H0] + p[P_H0 + 1]
+    a = p[P_COMP_A]
+    b = p[P_COMP_B]
+    ea_w = p[P_E] * p[P_AREA]
+    ea_f = p[P_E + 1] * p[P_AREA + 1]
+
+    if s_in[S_ALIVE] == 0.0:
+        s_out[S_TENSION] = 0.0
+        s_out[S_TENSION + 1] = 0.0
+        s_out[S_TAU] = 0.0
+        s_out[S_ENERGY] = 0.0
+        s_out[S_SHEAR_ENERGY] = 0.0
+        return STATUS_OK, 0.0
+
+    # 2–3. crossover solve, failure check, and one re-solve if a yarn failed
+    d_w = s_in[S_DAMAGE]
+    d_f = s_in[S_DAMAGE + 1]
+    h_w = s_in[S_H]
+    h_f = s_in[S_H + 1]
+    f_c = 0.0
+    t_w = 0.0
+    t_f = 0.0
+    iters = 0
+    for attempt in range(2):
+        k_w = (1.0 - d_w) * ea_w / lt0_w
+        k_f = (1.0 - d_f) * ea_f / lt0_f
+        if d_w < 1.0 and d_f < 1.0:
+            h_w, h_f, f_c, it, ok = solve_crimp_heights(
+                k_w, k_f, ell_w, ell_f, lt0_w, lt0_f, s_total, a, b, s_in[S_H]
+            )
+            iters += it
+            if not ok:
+                s_out[S_ITER] = iters
+                return STATUS_NOT_CONVERGED, 0.0
+        elif d_w < 1.0:  # fill broken: the warp loses its support and decrimps
+            h_w = min(s_in[S_H], slack_height(ell_w, lt0_w))
+            f_c = 0.0
+        elif d_f < 1.0:  # warp broken
+            h_f = min(s_in[S_H + 1], slack_height(ell_f, lt0_f))
+            f_c = 0.0
+        l_w = math.sqrt(ell_w * ell_w + h_w * h_w)
+        l_f = math.sqrt(ell_f * ell_f + h_f * h_f)
+        t_w = k_w * max(l_w - lt0_w, 0.0)
+        t_f = k_f * max(l_f - lt0_f, 0.0)
+        if attempt == 1:
+            break
+        d_w_new = d_w
+        d_f_new = d_f
+        if p[P_FAILURE] == FAILURE_PROGRESSIVE:
+            if d_w < 1.0:
+                d_w_new = softening_damage((l_w - lt0_w) / lt0_w, d_w, ea_w, p[P_TU], p[P_SOFT])
+            if d_f < 1.0:
+                d_f_new = softening_damage(
+                    (l_f - lt0_f) / lt0_f, d_f, ea_f, p[P_TU + 1], p[P_SOFT]
+                )
+        else:  # eq. (6.29): a yarn breaks for good when T ≥ T_u
+            if d_w < 1.0 and t_w >= p[P_TU]:
+                d_w_new = 1.0
+            if d_f < 1.0 and t_f >= p[P_TU + 1]:
+                d_f_new = 1.0
+        if d_w_new == d_w and d_f_new == d_f:
+            break
+        d_w = d_w_new
+        d_f = d_f_new
+
+    s_out[S_H] = h_w
+    s_out[S_H + 1] = h_f
+    s_out[S_DAMAGE] = d_w
+    s_out[S_DAMAGE + 1] = d_f
+    s_out[S_TENSION] = t_w
+    s_out[S_TENSION + 1] = t_f
+    s_out[S_ITER] = iters
+    if d_w >= 1.0 and d_f >= 1.0:  # eroded (theory §1.4)
+        s_out[S_ALIVE] = 0.0
+        s_out[S_TENSION] = 0.0
+        s_out[S_TENSION + 1] = 0.0
+        s_out[S_TAU] = 0.0
+        s_out[S_ENERGY] = 0.0
+        s_out[S_SHEAR_ENERGY] = 0.0
+        return STATUS_OK, 0.0
+
+    # 4a. yarn membrane resultant (theory §1.5)
+    l_w = math.sqrt(ell_w * ell_w + h_w * h_w)
+    l_f = math.sqrt(ell_f * ell_f + h_f * h_f)
+    if p[P_HOMOG] == HOMOG_THESIS:  # eq. (6.30), (6.38): σ = ½ Σ T_i/A_i e_i⊗e_i, × t
+        c_w = 0.5 * thick * t_w / p[P_AREA]
+        c_f = 0.5 * thick * t_f / p[P_AREA + 1]
+        stiff = 0.5 * thick * max((1.0 - d_w) * p[P_E], (1.0 - d_f) * p[P_E + 1])
+    else:  # virial: N = Σ 2 T_i ℓ_i cosψ_i e_i⊗e_i / A_cell
+        a_cell = 4.0 * ell_w * ell_f * sin_t
+        c_w = 2.0 * t_w * ell_w * (ell_w / l_w) / a_cell
+        c_f = 2.0 * t_f * ell_f * (ell_f / l_f) / a_cell
+        stiff = max(
+            (1.0 - d_w) * ea_w / (2.0 * p[P_ELL0 + 1]), (1.0 - d_f) * ea_f / (2.0 * p[P_ELL0])
+        )
+    n_out[0] = c_w * ewx * ewx + c_f * efx * efx
+    n_out[1] = c_w * ewy * ewy + c_f * efy * efy
+    n_out[2] = c_w * ewx * ewy + c_f * efx * efy
+
+    # 4b. trellis shear (theory §1.6): τ(γ), applied through its work conjugate
+    area0 = 4.0 * p[P_ELL0] * p[P_ELL0 + 1]
+    jac = lam_w * lam_f * sin_t
+    if p[P_SHEAR] == SHEAR_THESIS:  # eq. (6.35)–(6.37): G(β), τ integrated incrementally
+        sin_beta = 0.5 * (h_w / ell_w + h_f / ell_f)
+        g = shear_modulus_thesis(sin_beta, p[P_G1], p[P_G2], p[P_BETA1], p[P_BETA2])
+        tau = s_in[S_TAU] + g * dgamma
+        g_tan = g
+        e_shear = s_in[S_SHEAR_ENERGY] + thick * 0.5 * (s_in[S_TAU] + tau) * dgamma
+    else:
+        g, g_tan, e_dens = shear_modulus_true(
+            abs(gamma), p[P_G1], p[P_G2], p[P_GAMMA1], p[P_GAMMA2]
+        )
+        tau = g * gamma
+        e_shear = thick * e_dens
+    s_out[S_TAU] = tau
+    s_out[S_SHEAR_ENERGY] = e_shear
+    cs = thick * tau / (jac * sin_t)
+    n_out[0] += cs * (2.0 * ewx * efx - cos_t * (ewx * ewx + efx * efx))
+    n_out[1] += cs * (2.0 * ewy * efy - cos_t * (ewy * ewy + efy * efy))
+    n_out[2] += cs * (ewx * efy + ewy * efx - cos_t * (ewx * ewy + efx * efy))
+    stiff += thick * g_tan
+
+    # 5. stored energy per unit reference area: two half trusses per family,
+    #    the compaction spring and the shear energy
+    k_w = (1.0 - d_w) * ea_w / lt0_w
+    k_f = (1.0 - d_f) * ea_f / lt0_f
+    u_yarn = k_w * max(l_w - lt0_w, 0.0) ** 2 + k_f * max(l_f - lt0_f, 0.0) ** 2
+    delta = s_total - h_w - h_f if f_c > 0.0 else 0.0
+    s_out[S_ENERGY] = (u_yarn + compaction_energy(delta, a, b)) / area0 + e_shear
+    return STATUS_OK, stiff
+
+
+# --- many points ----------------------------------------------------------------
+@loop_kernel
+def fabric_update_for_points(p, f_old, f_new, state_in, state_out, n_out, stiff_out, status_out):
+    """Run :func:`fabric_update_point` on every point (independent, ``prange``).
+
+    Args:
+        p: (N_PARAM,) parameters shared by all points.
+        f_old, f_new: (n, 2, 2) deformation gradients.
+        state_in: (n, N_STATE) states at the start of the step.
+        state_out: (n, N_STATE) states at the end (written).
+        n_out: (n, 3) membrane resultants (written).
+        stiff_out: (n,) tangent stiffness bounds (written).
+        status_out: (n,) int32 status codes (written).
+    """
+    for i in prange(f_new.shape[0]):
+        status, stiff = fabric_update_point(
+            p, f_old[i], f_new[i], state_in[i], state_out[i], n_out[i]
+        )
+        status_out[i] = status
+        stiff_out[i] = stiff

@@ -54,12 +54,12 @@ def crimp_amplitude(half_length: float, crimp: float) -> float:
         raise ValueError(f"crimp = {crimp} is not valid: it must be ≥ 0 (0.0421 for 4.21 %)")
     if crimp == 0.0:
         return 0.0
-    # c(h) grows like (π h / 2ℓ)²/4 for small h and like 2h/ℓ for large h, so
-    # h = ℓ (2 + c) bounds the root from above.
-    hi = half_length * (2.0 + crimp)
-    return brentq(
-        lambda h: crimp_of_amplitude(h, half_length) - crimp, 0.0, hi, xtol=1e-16, rtol=1e-14
+    # Solve for r = h/ℓ (scale-free): c(r) grows like (π r / 2)²/4 for small r and
+    # like 2r for large r, so r = 2 + c bounds the root from above.
+    r = brentq(
+        lambda x: crimp_of_amplitude(x, 1.0) - crimp, 0.0, 2.0 + crimp, xtol=1e-15, rtol=8.9e-16
     )
+    return half_length * r
 
 
 @dataclass(frozen=True)

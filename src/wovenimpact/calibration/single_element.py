@@ -331,3 +331,36 @@ def read_history_csv(path: Path) -> dict[str, np.ndarray]:
         names = next(r)
         data = np.array([[float(x) for x in row] for row in r])
     return {n: data[:, j] for j, n in enumerate(names)}
+
+
+@dataclass
+class PathResult:
+    """States along an arbitrary deformation path (see :func:`drive_path`)."""
+
+    work: np.ndarray  # (n,) external work per unit reference area (J/m²)
+    energy: np.ndarray  # (n,) stored energy per unit reference area (J/m²)
+    states: np.ndarray  # (n, N_STATE)
+    resultants: np.ndarray  # (n, 3) N_xx, N_yy, N_xy (N/m)
+
+
+def drive_path(params: FabricParameters, path: np.ndarray) -> PathResult:
+    """Drive one point along ``path`` (n, 2, 2), path[0] the start; trapezoidal work.
+
+    The building block of load–unload cycle checks: for a conservative
+    (hyperelastic) option set, ``work − energy`` is the quadrature error only.
+    """
+    p = params.to_array()
+    n = path.shape[0]
+    states = np.empty((n, L.N_STATE))
+    res = np.empty((n, 3))
+    work = np.zeros(n)
+    upd = update_points(p, path[0], path[0], initial_state(params)[0])
+    states[0], res[0] = upd.state[0], upd.resultant[0]
+    p_prev = _piola(path[0], res[0])
+    for k in range(1, n):
+        upd = update_points(p, path[k - 1], path[k], states[k - 1])
+        states[k], res[k] = upd.state[0], upd.resultant[0]
+        p_new = _piola(path[k], res[k])
+        work[k] = work[k - 1] + 0.5 * float(np.sum((p_prev + p_new) * (path[k] - path[k - 1])))
+        p_prev = p_new
+    return PathResult(work=work, energy=states[:, L.S_ENERGY].copy(), states=states, resultants=res)

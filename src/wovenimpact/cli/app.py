@@ -8,6 +8,7 @@ from collections.abc import Mapping
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 
 app = typer.Typer(
@@ -47,5 +48,5 @@ def emit(result: Mapping, as_json: bool, title: str) -> None:
 
 def fail(message: str, code: int = 2) -> None:
     """Print an input error for a person and exit with ``code``."""
-    err_console.print(f"[bold red]error:[/] {message}")
+    err_console.print(f"[bold red]error:[/] {escape(message)}", soft_wrap=True)
     raise typer.Exit(code)

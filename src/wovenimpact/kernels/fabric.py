@@ -71,28 +71,40 @@ from wovenimpact.kernels.fabric_layout import (
 
 MAX_ITER = 100  # bisection alone halves [0, 2h0] to round-off in < 60 steps
 REL_TOL = 1e-12  # equilibrium |F_w − F_f| ≤ REL_TOL (F_w + F_f)
-RESOLUTION = 4.0 * 2.220446049250313e-16  # smallest useful height step, relative to S
+RESOLUTION = 2.0 * 2.220446049250313e-16  # smallest useful step, relative to the unknown
 
 
 # --- constitutive pieces -------------------------------------------------------
 @kernel
-def yarn_vertical_force(k, ell, ell_truss0, h):
+def yarn_extension(ell, ell0, h, h0, ell_truss0):
+    """L − L0 of a half truss, L = √(ℓ² + H²), L0 = √(ℓ0² + h0²) (eq. 6.19, 6.28).
+
+    Evaluated as [(ℓ − ℓ0)(ℓ + ℓ0) + (H − h0)(H + h0)] / (L + L0): near the
+    slack point L ≈ L0 the plain difference of two square roots loses all but
+    a few digits, and those digits are the yarn tension.
+    """
+    length = math.sqrt(ell * ell + h * h)
+    return ((ell - ell0) * (ell + ell0) + (h - h0) * (h + h0)) / (length + ell_truss0), length
+
+
+@kernel
+def yarn_vertical_force(k, ell, ell0, h, h0, ell_truss0):
     """Vertical force of one yarn on the crossing, F = 2 T H / L (eq. 6.21–6.22).
 
     Args:
         k: (1 − d) E A / L0, axial stiffness of the half truss (N/m).
-        ell: ℓ, current in-plane half-length (m).
+        ell, ell0: ℓ, current and ℓ0, initial in-plane half-length (m).
+        h, h0: H, crimp height (the formula is odd in H) and h0, its initial value (m).
         ell_truss0: L0 = √(ℓ0² + h0²) (m).
-        h: H, crimp height (m); the formula is odd in H.
 
     Returns:
         (F, dF/dH, T): force (N), its derivative (N/m), tension
         T = k ⟨L − L0⟩ (eq. 6.20; yarns carry no compression).
     """
-    length = math.sqrt(ell * ell + h * h)
-    if length <= ell_truss0 or k == 0.0:
+    ext, length = yarn_extension(ell, ell0, h, h0, ell_truss0)
+    if ext <= 0.0 or k == 0.0:
         return 0.0, 0.0, 0.0
-    tension = k * (length - ell_truss0)
+    tension = k * ext
     force = 2.0 * tension * h / length
     dforce = 2.0 * k * (1.0 - ell_truss0 * ell * ell / (length * length * length))
     return force, dforce, tension
@@ -116,62 +128,78 @@ def compaction_energy(delta, a, b):
 
 
 @kernel
-def slack_height(ell, ell_truss0):
-    """Largest H at which a yarn of half-length ℓ is slack: √(L0² − ℓ²), 0 if taut when straight."""
-    if ell >= ell_truss0:
+def slack_height(ell, ell0, h0):
+    """Largest H at which a yarn of half-length ℓ is slack, √(L0² − ℓ²) = √(h0² − (ℓ − ℓ0)(ℓ + ℓ0)),
+    or 0 if it is taut even when straight."""
+    q = h0 * h0 - (ell - ell0) * (ell + ell0)
+    if q <= 0.0:
         return 0.0
-    return math.sqrt(ell_truss0 * ell_truss0 - ell * ell)
+    return math.sqrt(q)
 
 
 @kernel
-def solve_crimp_heights(k_w, k_f, ell_w, ell_f, lt0_w, lt0_f, s_total, a, b, h_w_prev):
+def solve_crimp_heights(k_a, ell_a, ell0_a, h0_a, lt0_a, k_b, ell_b, ell0_b, h0_b, lt0_b, a, b, h_a_prev):
     """Crimp heights of two intact yarns in contact (eq. 6.21–6.25; theory §1.3).
 
-    Unknown H_w; compatibility gives H_f(H_w) = S − δ(F_w(H_w)) − H_w and the
-    equilibrium residual g(H_w) = F_w(H_w) − F_f(H_f(H_w)) is non-decreasing.
-    With the slack heights Hs_i, either Hs_w + Hs_f ≥ S (both yarns can be
-    slack while touching: g ≡ 0 on an interval, we keep the previous height
-    projected onto it) or the root is unique in [Hs_w, S − Hs_f], where
-    g(Hs_w) < 0 < g(S − Hs_f). Newton steps are kept inside the shrinking
-    bracket; a step that leaves it is replaced by bisection.
+    Yarn "a" carries the unknown H_a; compatibility gives
+    H_b(H_a) = S − δ(F_a(H_a)) − H_a (S = h0_a + h0_b), and the equilibrium
+    residual g(H_a) = F_a(H_a) − F_b(H_b(H_a)) is non-decreasing. With the
+    slack heights Hs_i, either Hs_a + Hs_b ≥ S (both yarns can be slack while
+    touching: g ≡ 0 on an interval, we keep the previous height projected onto
+    it) or the root is unique in [Hs_a, S − Hs_b], where g(Hs_a) < 0 ≤ g(S − Hs_b).
+    Newton steps are kept inside the shrinking bracket; a step that leaves it
+    is replaced by bisection. The caller gives the role "a" to the yarn with
+    the smaller height: g can be steep (stiff yarns, soft compaction), and the
+    attainable residual is |g'| times the spacing of floating-point numbers
+    near H_a, which is finest for the smaller height.
 
     Returns:
-        (H_w, H_f, F_c, iterations, converged)
+        (H_a, H_b, F_c, |F_a − F_b|, iterations, converged)
     """
-    hs_w = slack_height(ell_w, lt0_w)
-    hs_f = slack_height(ell_f, lt0_f)
-    if hs_w + hs_f >= s_total:
-        lo = max(0.0, s_total - hs_f)
-        hi = min(s_total, hs_w)
-        h_w = min(max(h_w_prev, lo), hi)
-        return h_w, s_total - h_w, 0.0, 0, True
-    lo = hs_w
-    hi = s_total - hs_f
-    x = min(max(h_w_prev, lo), hi)
+    s_total = h0_a + h0_b
+    hs_a = slack_height(ell_a, ell0_a, h0_a)
+    hs_b = slack_height(ell_b, ell0_b, h0_b)
+    if hs_a + hs_b >= s_total:
+        lo = max(0.0, s_total - hs_b)
+        hi = min(s_total, hs_a)
+        h_a = min(max(h_a_prev, lo), hi)
+        return h_a, s_total - h_a, 0.0, 0.0, 0, True
+    lo = hs_a
+    hi = s_total - hs_b
+    x = min(max(h_a_prev, lo), hi)
     if x == lo or x == hi:
         x = 0.5 * (lo + hi)
     for it in range(1, MAX_ITER + 1):
-        f_w, df_w, t_w = yarn_vertical_force(k_w, ell_w, lt0_w, x)
-        delta, ddelta = compaction_closure(f_w, a, b)
-        h_f = s_total - delta - x
-        f_f, df_f, t_f = yarn_vertical_force(k_f, ell_f, lt0_f, h_f)
-        g = f_w - f_f
-        if abs(g) <= REL_TOL * (f_w + f_f) and f_w > 0.0:
-            return x, h_f, 0.5 * (f_w + f_f), it, True
+        f_a, df_a, t_a = yarn_vertical_force(k_a, ell_a, ell0_a, x, h0_a, lt0_a)
+        delta, ddelta = compaction_closure(f_a, a, b)
+        h_b = s_total - delta - x
+        f_b, df_b, t_b = yarn_vertical_force(k_b, ell_b, ell0_b, h_b, h0_b, lt0_b)
+        g = f_a - f_b
+        if abs(g) <= REL_TOL * (f_a + f_b) and f_a > 0.0:
+            return x, h_b, 0.5 * (f_a + f_b), abs(g), it, True
         if g < 0.0:
             lo = x
         else:
             hi = x
-        slope = df_w + df_f * (1.0 + ddelta * df_w)
+        if hi - lo <= 2.0 * RESOLUTION * x:  # bracket collapsed to a few ulps
+            return x, h_b, 0.5 * (f_a + f_b), abs(g), it, True
+        slope = df_a + df_b * (1.0 + ddelta * df_a)
         x_new = x - g / slope if slope > 0.0 else lo - 1.0
-        if not (lo < x_new < hi):
+        newton = lo < x_new < hi
+        if not newton:
             x_new = 0.5 * (lo + hi)
-        # H_f = S − δ − H_w is resolved only to ~eps·S: a step below that
-        # cannot reduce the residual any further, the root is pinned.
-        if abs(x_new - x) <= RESOLUTION * s_total:
-            return x, h_f, 0.5 * (f_w + f_f), it, True
+        # a Newton step of a couple of ulps of H_a cannot reduce the residual
+        # any further: the root is pinned to the resolution of the unknown
+        if newton and abs(x_new - x) <= RESOLUTION * x:
+            # keep the better of the last iterate and the Newton proposal
+            f_a2 = yarn_vertical_force(k_a, ell_a, ell0_a, x_new, h0_a, lt0_a)[0]
+            h_b2 = s_total - compaction_closure(f_a2, a, b)[0] - x_new
+            f_b2 = yarn_vertical_force(k_b, ell_b, ell0_b, h_b2, h0_b, lt0_b)[0]
+            if abs(f_a2 - f_b2) < abs(g):
+                return x_new, h_b2, 0.5 * (f_a2 + f_b2), abs(f_a2 - f_b2), it + 1, True
+            return x, h_b, 0.5 * (f_a + f_b), abs(g), it, True
         x = x_new
-    return x, s_total - x, 0.0, MAX_ITER, False
+    return x, s_total - x, 0.0, 0.0, MAX_ITER, False
 
 
 @kernel
@@ -308,11 +336,15 @@ def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
     s_out[S_LAMBDA + 1] = lam_f
     s_out[S_GAMMA] = gamma
 
-    ell_w = lam_w * p[P_ELL0]
-    ell_f = lam_f * p[P_ELL0 + 1]
+    ell0_w = p[P_ELL0]
+    ell0_f = p[P_ELL0 + 1]
+    h0_w = p[P_H0]
+    h0_f = p[P_H0 + 1]
+    ell_w = lam_w * ell0_w
+    ell_f = lam_f * ell0_f
     lt0_w = p[P_LT0]
     lt0_f = p[P_LT0 + 1]
-    s_total = p[P_H0] + p[P_H0 + 1]
+    s_total = h0_w + h0_f
     a = p[P_COMP_A]
     b = p[P_COMP_B]
     ea_w = p[P_E] * p[P_AREA]
@@ -335,37 +367,57 @@ def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
     t_w = 0.0
     t_f = 0.0
     iters = 0
+    best_res = 0.0
+    best_ok = True
     for attempt in range(2):
         k_w = (1.0 - d_w) * ea_w / lt0_w
         k_f = (1.0 - d_f) * ea_f / lt0_f
         if d_w < 1.0 and d_f < 1.0:
-            h_w, h_f, f_c, it, ok = solve_crimp_heights(
-                k_w, k_f, ell_w, ell_f, lt0_w, lt0_f, s_total, a, b, s_in[S_H]
-            )
+            # The yarn with the smaller previous height carries the unknown; if
+            # round-off pins that solve short of REL_TOL, the other role is tried
+            # and the smaller residual kept (rare: near-slack, very stiff yarns).
+            warp_first = s_in[S_H] <= s_in[S_H + 1]
+            for role in range(2):
+                if warp_first == (role == 0):
+                    hw_, hf_, fc_, res_, it, ok = solve_crimp_heights(
+                        k_w, ell_w, ell0_w, h0_w, lt0_w, k_f, ell_f, ell0_f, h0_f, lt0_f, a, b,
+                        s_in[S_H],
+                    )
+                else:
+                    hf_, hw_, fc_, res_, it, ok = solve_crimp_heights(
+                        k_f, ell_f, ell0_f, h0_f, lt0_f, k_w, ell_w, ell0_w, h0_w, lt0_w, a, b,
+                        s_in[S_H + 1],
+                    )
+                iters += it
+                if role == 0 or (ok and res_ < best_res):
+                    h_w, h_f, f_c, best_res, best_ok = hw_, hf_, fc_, res_, ok
+                if best_ok and best_res <= REL_TOL * 10.0 * f_c:
+                    break
+            ok = best_ok
             iters += it
             if not ok:
                 s_out[S_ITER] = iters
                 return STATUS_NOT_CONVERGED, 0.0
         elif d_w < 1.0:  # fill broken: the warp loses its support and decrimps
-            h_w = min(s_in[S_H], slack_height(ell_w, lt0_w))
+            h_w = min(s_in[S_H], slack_height(ell_w, ell0_w, h0_w))
             f_c = 0.0
         elif d_f < 1.0:  # warp broken
-            h_f = min(s_in[S_H + 1], slack_height(ell_f, lt0_f))
+            h_f = min(s_in[S_H + 1], slack_height(ell_f, ell0_f, h0_f))
             f_c = 0.0
-        l_w = math.sqrt(ell_w * ell_w + h_w * h_w)
-        l_f = math.sqrt(ell_f * ell_f + h_f * h_f)
-        t_w = k_w * max(l_w - lt0_w, 0.0)
-        t_f = k_f * max(l_f - lt0_f, 0.0)
+        ext_w, l_w = yarn_extension(ell_w, ell0_w, h_w, h0_w, lt0_w)
+        ext_f, l_f = yarn_extension(ell_f, ell0_f, h_f, h0_f, lt0_f)
+        t_w = k_w * max(ext_w, 0.0)
+        t_f = k_f * max(ext_f, 0.0)
         if attempt == 1:
             break
         d_w_new = d_w
         d_f_new = d_f
         if p[P_FAILURE] == FAILURE_PROGRESSIVE:
             if d_w < 1.0:
-                d_w_new = softening_damage((l_w - lt0_w) / lt0_w, d_w, ea_w, p[P_TU], p[P_SOFT])
+                d_w_new = softening_damage(ext_w / lt0_w, d_w, ea_w, p[P_TU], p[P_SOFT])
             if d_f < 1.0:
                 d_f_new = softening_damage(
-                    (l_f - lt0_f) / lt0_f, d_f, ea_f, p[P_TU + 1], p[P_SOFT]
+                    ext_f / lt0_f, d_f, ea_f, p[P_TU + 1], p[P_SOFT]
                 )
         else:  # eq. (6.29): a yarn breaks for good when T ≥ T_u
             if d_w < 1.0 and t_w >= p[P_TU]:
@@ -394,18 +446,24 @@ def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
         return STATUS_OK, 0.0
 
     # 4a. yarn membrane resultant (theory §1.5)
-    l_w = math.sqrt(ell_w * ell_w + h_w * h_w)
-    l_f = math.sqrt(ell_f * ell_f + h_f * h_f)
+    ext_w, l_w = yarn_extension(ell_w, ell0_w, h_w, h0_w, lt0_w)
+    ext_f, l_f = yarn_extension(ell_f, ell0_f, h_f, h0_f, lt0_f)
     if p[P_HOMOG] == HOMOG_THESIS:  # eq. (6.30), (6.38): σ = ½ Σ T_i/A_i e_i⊗e_i, × t
         c_w = 0.5 * thick * t_w / p[P_AREA]
         c_f = 0.5 * thick * t_f / p[P_AREA + 1]
-        stiff = 0.5 * thick * max((1.0 - d_w) * p[P_E], (1.0 - d_f) * p[P_E + 1])
+        stiff = 0.5 * thick * max(
+            ((1.0 - d_w) * ea_w * ell_w / lt0_w + t_w) / p[P_AREA],
+            ((1.0 - d_f) * ea_f * ell_f / lt0_f + t_f) / p[P_AREA + 1],
+        )
     else:  # virial: N = Σ 2 T_i ℓ_i cosψ_i e_i⊗e_i / A_cell
         a_cell = 4.0 * ell_w * ell_f * sin_t
         c_w = 2.0 * t_w * ell_w * (ell_w / l_w) / a_cell
         c_f = 2.0 * t_f * ell_f * (ell_f / l_f) / a_cell
+        # ℓ_i ∂N_ii/∂ℓ_i ≤ [E A ℓ_i / L0 + T_i] / (2 ℓ_j sin θ): yarn stretch plus
+        # the turning of the truss towards the plane
         stiff = max(
-            (1.0 - d_w) * ea_w / (2.0 * p[P_ELL0 + 1]), (1.0 - d_f) * ea_f / (2.0 * p[P_ELL0])
+            ((1.0 - d_w) * ea_w * ell_w / lt0_w + t_w) / (2.0 * ell_f * sin_t),
+            ((1.0 - d_f) * ea_f * ell_f / lt0_f + t_f) / (2.0 * ell_w * sin_t),
         )
     n_out[0] = c_w * ewx * ewx + c_f * efx * efx
     n_out[1] = c_w * ewy * ewy + c_f * efy * efy
@@ -438,7 +496,7 @@ def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
     #    the compaction spring and the shear energy
     k_w = (1.0 - d_w) * ea_w / lt0_w
     k_f = (1.0 - d_f) * ea_f / lt0_f
-    u_yarn = k_w * max(l_w - lt0_w, 0.0) ** 2 + k_f * max(l_f - lt0_f, 0.0) ** 2
+    u_yarn = k_w * max(ext_w, 0.0) ** 2 + k_f * max(ext_f, 0.0) ** 2
     delta = s_total - h_w - h_f if f_c > 0.0 else 0.0
     s_out[S_ENERGY] = (u_yarn + compaction_energy(delta, a, b)) / area0 + e_shear
     return STATUS_OK, stiff

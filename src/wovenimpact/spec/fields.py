@@ -1,0 +1,186 @@
+"""Building blocks of the input schemas: quantity fields and readable error reports.
+
+:func:`quantity` makes a pydantic field type that accepts ``"96 GPa"`` and stores
+the SI float (via :func:`wovenimpact.units.to_si`). :func:`problems_from_validation`
+turns a pydantic ``ValidationError`` into :class:`Problem` records, and
+:func:`raise_problems` raises them as ONE :class:`InputError` whose lines read
+
+    <file>: material.warp.modulus: has no unit (got '96'; valid: a pressure > 0 such as '96 GPa')
+"""
+
+from __future__ import annotations
+
+import types
+import typing
+from dataclasses import dataclass
+from typing import Annotated, Any
+
+from pydantic import BaseModel, BeforeValidator, ConfigDict, ValidationError
+from pydantic_core import PydanticCustomError
+
+from wovenimpact.errors import InputError
+from wovenimpact.units import QuantityError, bounds_text, describe, to_si
+
+STRICT = ConfigDict(extra="forbid", frozen=True)
+"""Model config of every input table: unknown keys are errors."""
+
+_MISSING = object()
+
+
+class InputWarning(UserWarning):
+    """An input is valid but suspicious (inconsistent parameters, ignored settings)."""
+
+
+@dataclass(frozen=True)
+class Valid:
+    """Annotation metadata: what a valid value of the field looks like (for messages)."""
+
+    text: str
+
+
+@dataclass(frozen=True)
+class _ToSI:
+    """Before-validator converting a quantity string to its SI float."""
+
+    dimension: str
+    gt: float | None = None
+    ge: float | None = None
+    lt: float | None = None
+    le: float | None = None
+    example: str | None = None
+
+    def __call__(self, value: Any) -> float:
+        try:
+            return to_si(
+                value,
+                self.dimension,
+                "",
+                gt=self.gt,
+                ge=self.ge,
+                lt=self.lt,
+                le=self.le,
+                example=self.example,
+            )
+        except QuantityError as err:
+            raise PydanticCustomError(
+                "quantity", "{problem}", {"problem": err.problem, "valid": err.valid}
+            ) from None
+
+
+def quantity(dimension: str, *, gt=None, ge=None, lt=None, le=None, example=None) -> Any:
+    """Field type for a quantity with units, stored as an SI float.
+
+    Args:
+        dimension: a name from :data:`wovenimpact.units.DIMENSIONS`.
+        gt, ge, lt, le: bounds on the SI value.
+        example: a valid value for messages (default: the dimension's example).
+    """
+    valid = describe(dimension, bounds_text(gt, ge, lt, le), example)
+    to_si_validator = _ToSI(dimension, gt, ge, lt, le, example)
+    return Annotated[float, BeforeValidator(to_si_validator), Valid(valid)]
+
+
+@dataclass(frozen=True)
+class Problem:
+    """One thing wrong with an input: where, what, the value found and what is valid."""
+
+    path: str
+    what: str
+    got: Any = _MISSING
+    valid: str = ""
+
+    def text(self, source: str) -> str:
+        extra = []
+        if self.got is not _MISSING:
+            extra.append(f"got {_short(self.got)}")
+        if self.valid:
+            extra.append(f"valid: {self.valid}")
+        tail = f" ({'; '.join(extra)})" if extra else ""
+        return f"{source}: {self.path}: {self.what}{tail}"
+
+
+def input_error(problems: list[Problem], source: str) -> InputError:
+    """One InputError listing every problem, one per line."""
+    return InputError("\n".join(p.text(source) for p in problems))
+
+
+def raise_problems(problems: list[Problem], source: str) -> None:
+    """Raise :func:`input_error` of ``problems`` unless the list is empty."""
+    if problems:
+        raise input_error(problems, source)
+
+
+def dotted(loc: tuple) -> str:
+    """``('material', 'plasticity', 'hardening', 1, 0)`` → ``material.plasticity.hardening[1][0]``."""
+    out = ""
+    for part in loc:
+        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
+    return out
+
+
+def problems_from_validation(err: ValidationError, root: type[BaseModel]) -> list[Problem]:
+    """One :class:`Problem` per pydantic error, with dotted paths and valid alternatives."""
+    return [_problem(e, root) for e in err.errors(include_url=False)]
+
+
+def _problem(e: dict, root: type[BaseModel]) -> Problem:
+    loc, kind, ctx = tuple(e["loc"]), e["type"], e.get("ctx") or {}
+    path = dotted(loc)
+    got = e.get("input", _MISSING)
+    if kind == "quantity":
+        return Problem(path, ctx["problem"], got, ctx["valid"])
+    if kind == "missing":
+        return Problem(path, "is missing", valid=_valid_for(root, loc))
+    if kind == "extra_forbidden":
+        parent = _model_at(root, loc[:-1])
+        keys = ", ".join(parent.model_fields) if parent is not None else ""
+        return Problem(path, f"unknown key {loc[-1]!r}", got, f"one of the keys {keys}")
+    if kind == "literal_error":
+        return Problem(path, "is not one of the allowed values", got, ctx.get("expected", ""))
+    if kind in ("model_type", "model_attributes_type", "dict_type"):
+        return Problem(path, "must be a table", got, _valid_for(root, loc))
+    msg = e["msg"][:1].lower() + e["msg"][1:]
+    return Problem(path, msg, got, _valid_for(root, loc))
+
+
+def _submodel(annotation: Any) -> type[BaseModel] | None:
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return annotation
+    if typing.get_origin(annotation) in (typing.Union, types.UnionType):
+        for arg in typing.get_args(annotation):
+            found = _submodel(arg)
+            if found is not None:
+                return found
+    return None
+
+
+def _model_at(root: type[BaseModel], loc: tuple) -> type[BaseModel] | None:
+    model: type[BaseModel] | None = root
+    for part in loc:
+        if model is None or isinstance(part, int) or part not in model.model_fields:
+            return None
+        model = _submodel(model.model_fields[part].annotation)
+    return model
+
+
+def _valid_for(root: type[BaseModel], loc: tuple) -> str:
+    parent = _model_at(root, loc[:-1]) if loc else None
+    if parent is None or isinstance(loc[-1], int) or loc[-1] not in parent.model_fields:
+        return ""
+    info = parent.model_fields[loc[-1]]
+    for meta in info.metadata:
+        if isinstance(meta, Valid):
+            return meta.text
+    sub = _submodel(info.annotation)
+    if sub is not None:
+        return f"a [{dotted(loc)}] table with keys {', '.join(sub.model_fields)}"
+    if typing.get_origin(info.annotation) is typing.Literal:
+        return ", ".join(repr(a) for a in typing.get_args(info.annotation))
+    if info.annotation is str:
+        return "a string"
+    return ""
+
+
+def _short(value: Any, limit: int = 80) -> str:
+    text = repr(value)
+    return text if len(text) <= limit else text[: limit - 3] + "..."

@@ -1,0 +1,392 @@
+"""Material files (TOML) → validated SI parameter sets.
+
+``[material] kind = "woven_fabric"`` gives :class:`~wovenimpact.materials.fabric.FabricParameters`
+(MODEL.md §1, thesis Tables 5-1 and 7-2); ``kind = "j2_plastic"`` or ``"elastic"`` gives
+:class:`~wovenimpact.materials.metal.MetalParameters` (MODEL.md §5, thesis Tables 7-1,
+8-1, 8-2). Every dimensioned value carries its unit (``"96 GPa"``) and is converted
+to SI once, here. Unknown keys, missing units, wrong dimensions and unphysical
+values are errors; all problems of a file are reported together in one
+:class:`~wovenimpact.errors.InputError`, one line each::
+
+    kevlar.toml: material.warp.crimp: must be ≥ 0 (got -0.01; valid: a dimensionless number ≥ 0 ...)
+
+Suspicious but admissible inputs (a yarn area far from the lenticular section,
+h0 inconsistent with the crimp) are reported as :class:`InputWarning`.
+
+Geometry (thesis eq. 5.2, 5.5): the in-plane half-length of a family-i yarn
+between crossings is ℓ_i0 = 1/(2 n_j), n_j the thread count of the CROSSING
+family; h_i0 solves eq. (5.5) for ℓ_i0 and the crimp c_i unless given.
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+import warnings
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, Field, ValidationError
+
+from wovenimpact.calibration.crimp import crimp_amplitude, half_length_from_thread_count
+from wovenimpact.errors import InputError
+from wovenimpact.materials.fabric import FabricOptions, FabricParameters, YarnFamily
+from wovenimpact.materials.metal import MetalParameters
+from wovenimpact.spec.fields import (
+    STRICT,
+    InputWarning,
+    Problem,
+    dotted,
+    input_error,
+    problems_from_validation,
+    quantity,
+    raise_problems,
+)
+
+WIDTH_TOLERANCE = 1e-3  # width may exceed the yarn pitch by 0.1 %: rounding of printed tables
+LENTICULAR_TOLERANCE = 0.05  # warn if A differs from (2/π)·width·thickness by more than 5 %
+H0_TOLERANCE = 0.01  # warn if a given h0 differs from eq. (5.5) by more than 1 %
+
+# --- woven fabric -------------------------------------------------------------------
+
+
+class YarnSpec(BaseModel):
+    """``[material.warp]`` / ``[material.fill]``: one yarn family."""
+
+    model_config = STRICT
+    thread_count: quantity("inverse_length", gt=0)  # threads per length of THIS family
+    crimp: quantity("dimensionless", ge=0, example="0.0421")
+    area: quantity("area", gt=0)
+    modulus: quantity("pressure", gt=0)
+    ultimate_tension: quantity("force", gt=0)
+    width: quantity("length", gt=0, example="0.9407 mm")
+    thickness: quantity("length", gt=0, example="0.2499 mm")
+    # optional: the crimp amplitude given directly instead of computed from eq. (5.5)
+    h0: quantity("length", ge=0, example="0.12495 mm") | None = None
+
+
+class CompactionSpec(BaseModel):
+    """``[material.compaction]``: F = b δ / (a − δ), thesis eq. (5.8)."""
+
+    model_config = STRICT
+    a: quantity("length", gt=0, example="0.12389 mm")
+    b: quantity("force", gt=0, example="0.98432 N")
+
+
+class ShearSpec(BaseModel):
+    """``[material.shear]``: trellis moduli and compaction ratio (thesis 3.6.2, 6.2.7)."""
+
+    model_config = STRICT
+    g1: quantity("pressure", gt=0, example="0.0824 GPa")
+    g2: quantity("pressure", gt=0, example="8.24 GPa")
+    c_max: quantity("dimensionless", gt=0, le=1, example="0.65")
+
+
+class OptionsSpec(BaseModel):
+    """``[material.options]``: model variants (MODEL.md §1.4–1.7)."""
+
+    model_config = STRICT
+    homogenisation: Literal["virial", "thesis"] = "virial"
+    shear: Literal["true", "thesis"] = "true"
+    frame: Literal["fibre", "green-naghdi"] = "fibre"
+    failure: Literal["instant", "progressive"] = "instant"
+    softening_strain: quantity("dimensionless", gt=0, example="0.01") | None = None
+
+
+class FabricSpec(BaseModel):
+    """``[material]`` with ``kind = "woven_fabric"``."""
+
+    model_config = STRICT
+    name: str = Field(min_length=1)
+    kind: Literal["woven_fabric"]
+    fibre_density: quantity("density", gt=0)
+    areal_density: quantity("areal_density", gt=0, example="0.477 kg/m^2") | None = None
+    thickness: quantity("length", gt=0, example="0.4998 mm") | None = None
+    warp: YarnSpec
+    fill: YarnSpec
+    compaction: CompactionSpec
+    shear: ShearSpec
+    options: OptionsSpec = OptionsSpec()
+
+
+class FabricFile(BaseModel):
+    model_config = STRICT
+    material: FabricSpec
+
+
+# --- metals --------------------------------------------------------------------------
+
+
+class PlasticitySpec(BaseModel):
+    """``[material.plasticity]``: hardening table [[ε_p, σ_y], ...] and fracture strain."""
+
+    model_config = STRICT
+    hardening: list[
+        tuple[
+            quantity("dimensionless", ge=0, example="0.18"),
+            quantity("pressure", gt=0, example="213.78 MPa"),
+        ]
+    ] = Field(min_length=1)
+    fracture_strain: quantity("dimensionless", gt=0, example="0.18") | None = None
+
+
+class J2Spec(BaseModel):
+    """``[material]`` with ``kind = "j2_plastic"`` (aluminium casing, titanium blade)."""
+
+    model_config = STRICT
+    name: str = Field(min_length=1)
+    kind: Literal["j2_plastic"]
+    density: quantity("density", gt=0, example="2.78 g/cm^3")
+    modulus: quantity("pressure", gt=0, example="72 GPa")
+    poisson: quantity("dimensionless", ge=0, lt=0.5, example="0.3")
+    plasticity: PlasticitySpec
+
+
+class ElasticSpec(BaseModel):
+    """``[material]`` with ``kind = "elastic"`` (steel impactor when deformable)."""
+
+    model_config = STRICT
+    name: str = Field(min_length=1)
+    kind: Literal["elastic"]
+    density: quantity("density", gt=0, example="2.78 g/cm^3")
+    modulus: quantity("pressure", gt=0, example="72 GPa")
+    poisson: quantity("dimensionless", ge=0, lt=0.5, example="0.3")
+
+
+class J2File(BaseModel):
+    model_config = STRICT
+    material: J2Spec
+
+
+class ElasticFile(BaseModel):
+    model_config = STRICT
+    material: ElasticSpec
+
+
+_FILE_MODELS: dict[str, type[BaseModel]] = {
+    "woven_fabric": FabricFile,
+    "j2_plastic": J2File,
+    "elastic": ElasticFile,
+}
+
+# --- loading -------------------------------------------------------------------------
+
+
+def load_material(path: str | Path) -> FabricParameters | MetalParameters:
+    """Read a material TOML file and return its validated SI parameters.
+
+    Raises:
+        InputError: unreadable file, invalid TOML, or any invalid entry (all listed).
+    """
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as err:
+        raise InputError(f"{path}: cannot read the material file ({err.strerror})") from None
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise InputError(f"{path}: not valid TOML: {err}") from None
+    return material_from_dict(doc, source=str(path))
+
+
+def material_from_dict(
+    d: dict[str, Any], source: str = "<dict>", *, collect_warnings: list[str] | None = None
+) -> FabricParameters | MetalParameters:
+    """Validate a parsed material document ``{"material": {...}}`` and convert it to SI.
+
+    Args:
+        d: the document as read from TOML (top-level key ``material``).
+        source: file name used at the start of every message.
+        collect_warnings: if given, warnings are appended here instead of being
+            issued with :func:`warnings.warn` (category :class:`InputWarning`).
+    """
+    table = d.get("material") if isinstance(d, dict) else None
+    kind = table.get("kind") if isinstance(table, dict) else None
+    if not isinstance(kind, str) or kind not in _FILE_MODELS:
+        valid = ", ".join(repr(k) for k in _FILE_MODELS)
+        if not isinstance(table, dict):
+            problem = Problem("material", "is missing or not a table", valid="a [material] table")
+        elif kind is None:
+            problem = Problem("material.kind", "is missing", valid=valid)
+        else:
+            problem = Problem("material.kind", "is not a known material kind", kind, valid)
+        raise input_error([problem], source)
+    file_model = _FILE_MODELS[kind]
+    try:
+        spec = file_model.model_validate(d).material
+    except ValidationError as err:
+        raise input_error(problems_from_validation(err, file_model), source) from None
+    notes: list[str] = []
+    if isinstance(spec, FabricSpec):
+        result = _fabric_parameters(spec, table, source, notes)
+    else:
+        result = _metal_parameters(spec, table, source)
+    for note in notes:
+        if collect_warnings is not None:
+            collect_warnings.append(note)
+        else:
+            warnings.warn(note, InputWarning, stacklevel=2)
+    return result
+
+
+def _raw(table: dict, *keys: str | int) -> Any:
+    value: Any = table
+    for k in keys:
+        value = value[k]
+    return value
+
+
+def _fabric_parameters(
+    spec: FabricSpec, raw: dict, source: str, notes: list[str]
+) -> FabricParameters:
+    problems = _check_fabric(spec, raw)
+    raise_problems(problems, source)
+    # ℓ_i0 = 1/(2 n_j): half-length of family i between crossings of family j (eq. 5.2).
+    half = {
+        "warp": half_length_from_thread_count(spec.fill.thread_count),
+        "fill": half_length_from_thread_count(spec.warp.thread_count),
+    }
+    families = {}
+    for fam in ("warp", "fill"):
+        y: YarnSpec = getattr(spec, fam)
+        h0_eq55 = crimp_amplitude(half[fam], y.crimp)
+        h0 = h0_eq55 if y.h0 is None else y.h0
+        if y.h0 is not None and abs(h0 - h0_eq55) > H0_TOLERANCE * max(h0_eq55, 1e-300):
+            notes.append(
+                f"{source}: material.{fam}.h0: {_raw(raw, fam, 'h0')!r} differs by more than "
+                f"{H0_TOLERANCE:.0%} from the amplitude {h0_eq55 * 1e3:.5f} mm of eq. (5.5) for "
+                f"crimp {y.crimp:g}; the given h0 is used (the crimp still sets the areal mass)"
+            )
+        lenticular = 2.0 / math.pi * y.width * y.thickness
+        if abs(y.area - lenticular) > LENTICULAR_TOLERANCE * lenticular:
+            notes.append(
+                f"{source}: material.{fam}.area: {y.area * 1e6:.6g} mm^2 differs by more than "
+                f"{LENTICULAR_TOLERANCE:.0%} from the lenticular section (2/π)·width·thickness = "
+                f"{lenticular * 1e6:.6g} mm^2 (MODEL.md §1): check area, width and thickness"
+            )
+        families[fam] = YarnFamily(
+            half_length=half[fam],
+            crimp=y.crimp,
+            h0=h0,
+            area=y.area,
+            modulus=y.modulus,
+            ultimate_tension=y.ultimate_tension,
+            width=y.width,
+            thickness=y.thickness,
+        )
+    o = spec.options
+    if o.failure == "instant" and o.softening_strain is not None:
+        notes.append(
+            f"{source}: material.options.softening_strain is ignored with failure = 'instant' "
+            "(set failure = 'progressive' to use it)"
+        )
+    options = FabricOptions(
+        homogenisation=o.homogenisation,
+        shear=o.shear,
+        frame=o.frame,
+        failure=o.failure,
+        softening_strain=o.softening_strain if o.failure == "progressive" else 0.0,
+    )
+    return FabricParameters(
+        warp=families["warp"],
+        fill=families["fill"],
+        compaction_a=spec.compaction.a,
+        compaction_b=spec.compaction.b,
+        shear_g1=spec.shear.g1,
+        shear_g2=spec.shear.g2,
+        shear_c_max=spec.shear.c_max,
+        fibre_density=spec.fibre_density,
+        areal_density=spec.areal_density,
+        thickness=spec.thickness,
+        options=options,
+    )
+
+
+def _check_fabric(spec: FabricSpec, raw: dict) -> list[Problem]:
+    """Rules that involve several fields (single-field bounds are in the schema)."""
+    problems = []
+    if spec.shear.g2 < spec.shear.g1:
+        problems.append(
+            Problem(
+                "material.shear.g2",
+                "is smaller than g1 (the modulus at full compaction cannot be below the "
+                "initial one)",
+                _raw(raw, "shear", "g2"),
+                f"a pressure ≥ g1 = {_raw(raw, 'shear', 'g1')!r}",
+            )
+        )
+    for fam, other in (("warp", "fill"), ("fill", "warp")):
+        y: YarnSpec = getattr(spec, fam)
+        pitch = 1.0 / y.thread_count  # spacing of parallel family-i yarns = 2 ℓ_j0
+        if y.width > pitch * (1.0 + WIDTH_TOLERANCE):
+            problems.append(
+                Problem(
+                    f"material.{fam}.width",
+                    f"is wider than the spacing of parallel {fam} yarns, 1/thread_count = "
+                    f"2ℓ_{other}0 = {pitch * 1e3:.6g} mm, by more than the "
+                    f"{WIDTH_TOLERANCE:.1%} allowed for rounding in printed tables",
+                    _raw(raw, fam, "width"),
+                    f"a length ≤ {pitch * (1.0 + WIDTH_TOLERANCE) * 1e3:.6g} mm",
+                )
+            )
+    if spec.options.failure == "progressive" and spec.options.softening_strain is None:
+        problems.append(
+            Problem(
+                "material.options.softening_strain",
+                "is required when failure = 'progressive' (the strain over which the yarn "
+                "tension falls to zero, MODEL.md §1.4)",
+                valid="a dimensionless number > 0 such as 0.01",
+            )
+        )
+    return problems
+
+
+def _metal_parameters(spec: J2Spec | ElasticSpec, raw: dict, source: str) -> MetalParameters:
+    hardening: tuple[tuple[float, float], ...] = ()
+    fracture = None
+    if isinstance(spec, J2Spec):
+        table = spec.plasticity.hardening
+        raise_problems(_check_hardening(table, raw), source)
+        hardening = tuple((float(e), float(s)) for e, s in table)
+        fracture = spec.plasticity.fracture_strain
+    return MetalParameters(
+        name=spec.name,
+        kind=spec.kind,
+        density=spec.density,
+        modulus=spec.modulus,
+        poisson=spec.poisson,
+        hardening=hardening,
+        fracture_strain=fracture,
+    )
+
+
+def _check_hardening(table: list[tuple[float, float]], raw: dict) -> list[Problem]:
+    """ε_p starts at 0 and strictly increases; σ_y never decreases."""
+    loc = ("material", "plasticity", "hardening")
+    rows = _raw(raw, "plasticity", "hardening")
+    problems = []
+    if table[0][0] != 0.0:
+        problems.append(
+            Problem(dotted((*loc, 0, 0)), "must be 0 (the table starts at yield)", rows[0][0], "0")
+        )
+    for i in range(1, len(table)):
+        if not table[i][0] > table[i - 1][0]:
+            problems.append(
+                Problem(
+                    dotted((*loc, i, 0)),
+                    "plastic strains must strictly increase down the table",
+                    rows[i][0],
+                    f"> {rows[i - 1][0]!r}",
+                )
+            )
+        if table[i][1] < table[i - 1][1]:
+            problems.append(
+                Problem(
+                    dotted((*loc, i, 1)),
+                    "yield stresses must not decrease down the table (no softening)",
+                    rows[i][1],
+                    f"≥ {rows[i - 1][1]!r}",
+                )
+            )
+    return problems

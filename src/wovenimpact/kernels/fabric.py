@@ -24,7 +24,6 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 from numba import prange
 
 from wovenimpact.jit import kernel, loop_kernel
@@ -262,6 +261,18 @@ def softening_damage(strain, d_old, e_a, t_u, soft):
 
 # --- one material point --------------------------------------------------------
 @kernel
+def clear_eroded_point(s_out):
+    """An eroded point (theory §1.4) carries nothing: alive 0, no tension, stress or energy."""
+    s_out[S_ALIVE] = 0.0
+    s_out[S_TENSION] = 0.0
+    s_out[S_TENSION + 1] = 0.0
+    s_out[S_TAU] = 0.0
+    s_out[S_ENERGY] = 0.0
+    s_out[S_SHEAR_ENERGY] = 0.0
+
+
+
+@kernel
 def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
     """Update one crossover material point from F_old to F_new.
 
@@ -351,11 +362,7 @@ def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
     ea_f = p[P_E + 1] * p[P_AREA + 1]
 
     if s_in[S_ALIVE] == 0.0:
-        s_out[S_TENSION] = 0.0
-        s_out[S_TENSION + 1] = 0.0
-        s_out[S_TAU] = 0.0
-        s_out[S_ENERGY] = 0.0
-        s_out[S_SHEAR_ENERGY] = 0.0
+        clear_eroded_point(s_out)
         return STATUS_OK, 0.0
 
     # 2–3. crossover solve, failure check, and one re-solve if a yarn failed
@@ -437,12 +444,7 @@ def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
     s_out[S_TENSION + 1] = t_f
     s_out[S_ITER] = iters
     if d_w >= 1.0 and d_f >= 1.0:  # eroded (theory §1.4)
-        s_out[S_ALIVE] = 0.0
-        s_out[S_TENSION] = 0.0
-        s_out[S_TENSION + 1] = 0.0
-        s_out[S_TAU] = 0.0
-        s_out[S_ENERGY] = 0.0
-        s_out[S_SHEAR_ENERGY] = 0.0
+        clear_eroded_point(s_out)
         return STATUS_OK, 0.0
 
     # 4a. yarn membrane resultant (theory §1.5)

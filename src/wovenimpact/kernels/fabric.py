@@ -70,7 +70,9 @@ from wovenimpact.kernels.fabric_layout import (
 
 MAX_ITER = 100  # bisection alone halves [0, 2h0] to round-off in < 60 steps
 REL_TOL = 1e-12  # equilibrium |F_w − F_f| ≤ REL_TOL (F_w + F_f)
-RESOLUTION = 2.0 * 2.220446049250313e-16  # smallest useful step, relative to the unknown
+EPS = 2.220446049250313e-16  # machine epsilon of float64
+FINAL_STEP_TOL = 1e-8  # |g| below which one last Newton step is taken unchecked
+SWAP_RATIO = 0.25  # re-solve with the roles swapped if u_b < SWAP_RATIO u_a
 
 
 # --- constitutive pieces -------------------------------------------------------
@@ -137,68 +139,128 @@ def slack_height(ell, ell0, h0):
 
 
 @kernel
+def slack_offset(ell, ell0, h0):
+    """Slack geometry of one yarn of half-length ℓ (theory §1.3).
+
+    Returns (Hs, h0 − Hs, c): the largest height at which the yarn is slack,
+    Hs = √(L0² − ℓ²) (0 if the yarn is taut even when straight), the distance
+    h0 − Hs = (ℓ − ℓ0)(ℓ + ℓ0)/(h0 + Hs) computed without cancellation, and
+    c = max(ℓ² − L0², 0), the squared excess length of a taut straight yarn.
+    """
+    dq = (ell - ell0) * (ell + ell0)  # ℓ² − ℓ0², exact to a few ulps
+    q = h0 * h0 - dq  # L0² − ℓ²
+    if q <= 0.0:
+        return 0.0, h0, -q
+    hs = math.sqrt(q)
+    return hs, dq / (h0 + hs), 0.0
+
+
+@kernel
+def yarn_force_offset(k, ell, hs, c, u, ell_truss0):
+    """Vertical force of one yarn at height H = Hs + u above its slack height.
+
+    The extension is written in the offset u so that it keeps its relative
+    accuracy near the slack point (eq. 6.19, 6.21–6.22):
+    L − L0 = (L² − L0²)/(L + L0) = [u (u + 2 Hs) + c]/(L + L0), F = 2 T H / L.
+
+    Returns (F, dF/du, T, H); no force for u ≤ 0 (slack) or k = 0.
+    """
+    h = hs + u
+    if u <= 0.0 or k == 0.0:
+        return 0.0, 0.0, 0.0, h
+    length = math.sqrt(ell * ell + h * h)
+    ext = (u * (u + 2.0 * hs) + c) / (length + ell_truss0)
+    tension = k * ext
+    force = 2.0 * tension * h / length
+    dforce = 2.0 * k * (1.0 - ell_truss0 * ell * ell / (length * length * length))
+    return force, dforce, tension, h
+
+
+@kernel
+def yarn_vertical_stiffness(k, ell, h, ell_truss0):
+    """dF/dH = 2 k (1 − L0 ℓ²/L³) of a taut yarn at height H (eq. 6.22), ≥ 0."""
+    length = math.sqrt(ell * ell + h * h)
+    return max(2.0 * k * (1.0 - ell_truss0 * ell * ell / (length * length * length)), 0.0)
+
+
+@kernel
+def tension_predictor(tension, k, ell_truss0, ell, h_prev):
+    """Height at which a yarn of half-length ℓ keeps the tension T it had:
+    H = √((L0 + T/k)² − ℓ²); the previous height if it was slack or cannot."""
+    if tension <= 0.0 or k <= 0.0:
+        return h_prev
+    length = ell_truss0 + tension / k
+    q = length * length - ell * ell
+    return math.sqrt(q) if q > 0.0 else h_prev
+
+
+@kernel
 def solve_crimp_heights(k_a, ell_a, ell0_a, h0_a, lt0_a, k_b, ell_b, ell0_b, h0_b, lt0_b, a, b, h_a_prev):
     """Crimp heights of two intact yarns in contact (eq. 6.21–6.25; theory §1.3).
 
-    Yarn "a" carries the unknown H_a; compatibility gives
-    H_b(H_a) = S − δ(F_a(H_a)) − H_a (S = h0_a + h0_b), and the equilibrium
-    residual g(H_a) = F_a(H_a) − F_b(H_b(H_a)) is non-decreasing. With the
-    slack heights Hs_i, either Hs_a + Hs_b ≥ S (both yarns can be slack while
-    touching: g ≡ 0 on an interval, we keep the previous height projected onto
-    it) or the root is unique in [Hs_a, S − Hs_b], where g(Hs_a) < 0 ≤ g(S − Hs_b).
-    Newton steps are kept inside the shrinking bracket; a step that leaves it
-    is replaced by bisection. The caller gives the role "a" to the yarn with
-    the smaller height: g can be steep (stiff yarns, soft compaction), and the
-    attainable residual is |g'| times the spacing of floating-point numbers
-    near H_a, which is finest for the smaller height.
+    Unknown: u_a = H_a − Hs_a, the height of yarn "a" above its slack height
+    Hs_a. Compatibility H_a + H_b + δ(F) = h0_a + h0_b gives
+    u_b = D − δ(F_a(u_a)) − u_a with the overlap D = (h0_a − Hs_a) + (h0_b − Hs_b),
+    computed without cancellation, so near-slack states (small F, small D)
+    keep full relative accuracy. The residual g(u_a) = F_a − F_b is increasing;
+    if D ≤ 0 both yarns are slack while touching (g ≡ 0 on an interval: the
+    previous height is kept, projected onto it), otherwise the root is unique
+    in (0, D) with g(0) < 0 < g(D). Newton steps stay in the shrinking bracket,
+    bisection otherwise. Stops when |g| ≤ REL_TOL (F_a + F_b) or when |g| is
+    at the round-off level of its own evaluation.
 
     Returns:
-        (H_a, H_b, F_c, |F_a − F_b|, iterations, converged)
+        (H_a, H_b, F_c, |F_a − F_b|, iterations, converged, swap): swap says the
+        derived yarn ended much closer to slack than the unknown one
+        (u_b < SWAP_RATIO u_a), so the other role would be better conditioned.
     """
     s_total = h0_a + h0_b
-    hs_a = slack_height(ell_a, ell0_a, h0_a)
-    hs_b = slack_height(ell_b, ell0_b, h0_b)
-    if hs_a + hs_b >= s_total:
+    hs_a, off_a, c_a = slack_offset(ell_a, ell0_a, h0_a)
+    hs_b, off_b, c_b = slack_offset(ell_b, ell0_b, h0_b)
+    overlap = off_a + off_b
+    if overlap <= 0.0:
         lo = max(0.0, s_total - hs_b)
         hi = min(s_total, hs_a)
         h_a = min(max(h_a_prev, lo), hi)
-        return h_a, s_total - h_a, 0.0, 0.0, 0, True
-    lo = hs_a
-    hi = s_total - hs_b
-    x = min(max(h_a_prev, lo), hi)
+        return h_a, s_total - h_a, 0.0, 0.0, 0, True, False
+    lo = 0.0
+    hi = overlap
+    x = min(max(h_a_prev - hs_a, lo), hi)
     if x == lo or x == hi:
         x = 0.5 * (lo + hi)
     for it in range(1, MAX_ITER + 1):
-        f_a, df_a, t_a = yarn_vertical_force(k_a, ell_a, ell0_a, x, h0_a, lt0_a)
+        f_a, df_a, t_a, h_a = yarn_force_offset(k_a, ell_a, hs_a, c_a, x, lt0_a)
         delta, ddelta = compaction_closure(f_a, a, b)
-        h_b = s_total - delta - x
-        f_b, df_b, t_b = yarn_vertical_force(k_b, ell_b, ell0_b, h_b, h0_b, lt0_b)
+        u_b = overlap - delta - x
+        f_b, df_b, t_b, h_b = yarn_force_offset(k_b, ell_b, hs_b, c_b, u_b, lt0_b)
         g = f_a - f_b
-        if abs(g) <= REL_TOL * (f_a + f_b) and f_a > 0.0:
-            return x, h_b, 0.5 * (f_a + f_b), abs(g), it, True
+        slope = df_a + df_b * (1.0 + ddelta * df_a)
+        # round-off level of g: the forces, and one ulp of the overlap seen through F_b
+        noise = EPS * (4.0 * (f_a + f_b) + 2.0 * df_b * overlap)
+        if f_a > 0.0 and (abs(g) <= REL_TOL * (f_a + f_b) or abs(g) <= noise):
+            return h_a, h_b, 0.5 * (f_a + f_b), abs(g), it, True, u_b < SWAP_RATIO * x
+        if f_a > 0.0 and f_b > 0.0 and slope > 0.0 and abs(g) <= FINAL_STEP_TOL * (f_a + f_b):
+            # Last Newton step taken without a new evaluation: the residual left
+            # is O(step²), ~1e-14 of F here; heights and force follow linearly.
+            step = g / slope
+            du_b = (1.0 + ddelta * df_a) * step
+            if u_b + du_b > 0.0 and lo <= x - step <= hi:
+                f_c = f_a - df_a * step
+                u_b += du_b
+                x -= step
+                res = abs(g) * FINAL_STEP_TOL
+                return hs_a + x, hs_b + u_b, f_c, res, it, True, u_b < SWAP_RATIO * x
         if g < 0.0:
             lo = x
         else:
             hi = x
-        if hi - lo <= 2.0 * RESOLUTION * x:  # bracket collapsed to a few ulps
-            return x, h_b, 0.5 * (f_a + f_b), abs(g), it, True
-        slope = df_a + df_b * (1.0 + ddelta * df_a)
+        if hi - lo <= 4.0 * EPS * hi:  # bracket collapsed to a few ulps
+            return h_a, h_b, 0.5 * (f_a + f_b), abs(g), it, f_a > 0.0, u_b < SWAP_RATIO * x
         x_new = x - g / slope if slope > 0.0 else lo - 1.0
-        newton = lo < x_new < hi
-        if not newton:
+        if not (lo < x_new < hi):
             x_new = 0.5 * (lo + hi)
-        # a Newton step of a couple of ulps of H_a cannot reduce the residual
-        # any further: the root is pinned to the resolution of the unknown
-        if newton and abs(x_new - x) <= RESOLUTION * x:
-            # keep the better of the last iterate and the Newton proposal
-            f_a2 = yarn_vertical_force(k_a, ell_a, ell0_a, x_new, h0_a, lt0_a)[0]
-            h_b2 = s_total - compaction_closure(f_a2, a, b)[0] - x_new
-            f_b2 = yarn_vertical_force(k_b, ell_b, ell0_b, h_b2, h0_b, lt0_b)[0]
-            if abs(f_a2 - f_b2) < abs(g):
-                return x_new, h_b2, 0.5 * (f_a2 + f_b2), abs(f_a2 - f_b2), it + 1, True
-            return x, h_b, 0.5 * (f_a + f_b), abs(g), it, True
         x = x_new
-    return x, s_total - x, 0.0, 0.0, MAX_ITER, False
+    return hs_a + x, s_total - hs_a - x, 0.0, 0.0, MAX_ITER, False, False
 
 
 @kernel
@@ -329,17 +391,24 @@ def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
         l21 = d21 * i11 + d22 * i21
         l22 = d21 * i12 + d22 * i22
         e11, e22, e12 = l11, l22, 0.5 * (l12 + l21)
-        de_w = ewx * ewx * e11 + 2.0 * ewx * ewy * e12 + ewy * ewy * e22
-        de_f = efx * efx * e11 + 2.0 * efx * efy * e12 + efy * efy * e22
+        # project on the yarn directions of the midpoint configuration, where Δε
+        # lives (second-order accurate; a rigid rotation gives Δε = 0 exactly,
+        # ΔF F_mid⁻¹ being the Cayley form of the rotation increment)
+        nw = math.sqrt(a11 * a11 + a21 * a21)
+        nf = math.sqrt(a12 * a12 + a22 * a22)
+        pwx, pwy = a11 / nw, a21 / nw
+        pfx, pfy = a12 / nf, a22 / nf
+        de_w = pwx * pwx * e11 + 2.0 * pwx * pwy * e12 + pwy * pwy * e22
+        de_f = pfx * pfx * e11 + 2.0 * pfx * pfy * e12 + pfy * pfy * e22
         if not (1.0 + 2.0 * de_w > 0.0 and 1.0 + 2.0 * de_f > 0.0):
             return STATUS_BAD_KINEMATICS, 0.0
         lam_w = s_in[S_LAMBDA] * math.sqrt(1.0 + 2.0 * de_w)
         lam_f = s_in[S_LAMBDA + 1] * math.sqrt(1.0 + 2.0 * de_f)
-        # e_w · Δε · (e_w turned +90°) + (e_f turned −90°) · Δε · e_f
-        nwx, nwy = -ewy, ewx
-        mfx, mfy = efy, -efx
-        dgam = (ewx * nwx * e11 + (ewx * nwy + ewy * nwx) * e12 + ewy * nwy * e22) + (
-            mfx * efx * e11 + (mfx * efy + mfy * efx) * e12 + mfy * efy * e22
+        # e_w · Δε · (e_w turned +90°) + (e_f turned −90°) · Δε · e_f  (eq. 6.34)
+        nwx, nwy = -pwy, pwx
+        mfx, mfy = pfy, -pfx
+        dgam = (pwx * nwx * e11 + (pwx * nwy + pwy * nwx) * e12 + pwy * nwy * e22) + (
+            mfx * pfx * e11 + (mfx * pfy + mfy * pfx) * e12 + mfy * pfy * e22
         )
         gamma = s_in[S_GAMMA] + dgam
     dgamma = gamma - s_in[S_GAMMA]
@@ -374,34 +443,41 @@ def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
     t_w = 0.0
     t_f = 0.0
     iters = 0
-    best_res = 0.0
-    best_ok = True
     for attempt in range(2):
         k_w = (1.0 - d_w) * ea_w / lt0_w
         k_f = (1.0 - d_f) * ea_f / lt0_f
         if d_w < 1.0 and d_f < 1.0:
-            # The yarn with the smaller previous height carries the unknown; if
-            # round-off pins that solve short of REL_TOL, the other role is tried
-            # and the smaller residual kept (rare: near-slack, very stiff yarns).
-            warp_first = s_in[S_H] <= s_in[S_H + 1]
+            # The yarn that is vertically stiffer (dF/dH of eq. 6.22 at the
+            # previous heights) carries the unknown: the other yarn's height above
+            # slack, u = D − δ − u_a, is then the larger one and keeps its relative
+            # accuracy. If the converged offsets say otherwise, the roles swap and
+            # the solve restarts from the solution (rare: cold starts, role changes).
+            warp_unknown = yarn_vertical_stiffness(k_w, ell_w, s_in[S_H], lt0_w) >= (
+                yarn_vertical_stiffness(k_f, ell_f, s_in[S_H + 1], lt0_f)
+            )
             for role in range(2):
-                if warp_first == (role == 0):
-                    hw_, hf_, fc_, res_, it, ok = solve_crimp_heights(
+                if warp_unknown:
+                    h_guess = tension_predictor(s_in[S_TENSION], k_w, lt0_w, ell_w, s_in[S_H])
+                    if role == 1:
+                        h_guess = h_w
+                    h_w, h_f, f_c, res, it, ok, swap = solve_crimp_heights(
                         k_w, ell_w, ell0_w, h0_w, lt0_w, k_f, ell_f, ell0_f, h0_f, lt0_f, a, b,
-                        s_in[S_H],
+                        h_guess,
                     )
                 else:
-                    hf_, hw_, fc_, res_, it, ok = solve_crimp_heights(
+                    h_guess = tension_predictor(
+                        s_in[S_TENSION + 1], k_f, lt0_f, ell_f, s_in[S_H + 1]
+                    )
+                    if role == 1:
+                        h_guess = h_f
+                    h_f, h_w, f_c, res, it, ok, swap = solve_crimp_heights(
                         k_f, ell_f, ell0_f, h0_f, lt0_f, k_w, ell_w, ell0_w, h0_w, lt0_w, a, b,
-                        s_in[S_H + 1],
+                        h_guess,
                     )
                 iters += it
-                if role == 0 or (ok and res_ < best_res):
-                    h_w, h_f, f_c, best_res, best_ok = hw_, hf_, fc_, res_, ok
-                if best_ok and best_res <= REL_TOL * 10.0 * f_c:
+                if not (ok and swap):
                     break
-            ok = best_ok
-            iters += it
+                warp_unknown = not warp_unknown
             if not ok:
                 s_out[S_ITER] = iters
                 return STATUS_NOT_CONVERGED, 0.0

@@ -13,3 +13,10 @@ class MaterialPointError(RuntimeError):
 
     The message names the point index, the reason and the point's state.
     """
+
+
+class SimulationError(RuntimeError):
+    """A run cannot continue (NaN, inverted element, collapsed time step).
+
+    The message names the element or node, the simulated time and the cause.
+    """

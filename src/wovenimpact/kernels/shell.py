@@ -1,0 +1,394 @@
+"""Four-node corotational shell, one in-plane point (Belytschko–Lin–Tsay family).
+
+docs/theory.md §2; thesis ch. 4.4; MODEL.md §2. Per element and step, given the
+positions x^n and the half-step velocities v^{n−1/2}, ω^{n−1/2}:
+
+1. corotational frame: e3 along d13 × d24 (diagonals), e1 along side 1→2
+   projected on the element plane, e2 = e3 × e1; local coordinates of the nodes;
+2. membrane: in-plane deformation gradient F = Σ_I x̂_I ⊗ ∂N_I/∂X (centre of the
+   bilinear element, X the reference material frame with the warp along x), the
+   material gives the resultant N (fabric kernel, or an elastic St Venant–Kirchhoff
+   membrane) and the nodal forces are f̂_I = A0 P ∂N_I/∂X with P = J N F⁻ᵀ — a
+   total-Lagrangian membrane, work-conjugate to the material's stored energy;
+3. bending and transverse shear in rate form (Belytschko–Lin–Tsay 1984):
+   κ̇_x = b1·θ̇_y, κ̇_y = −b2·θ̇_x, 2κ̇_xy = b2·θ̇_y − b1·θ̇_x,
+   γ̇_xz = b1·v_z + ¼Σθ̇_y, γ̇_yz = b2·v_z − ¼Σθ̇_x (zero for any rigid
+   rotation), M += D Δκ, Q += k G t Δγ;
+4. hourglass control, Flanagan–Belytschko stiffness form, for the in-plane,
+   transverse and rotational modes, with its energy;
+5. the element's stable step L_e / c_e, L_e = A / max edge (eq. 4.9–4.11), c_e from
+   the current membrane tangent and the transverse-shear wave speed.
+
+``shell_force`` is one element; ``internal_force_for_shells`` loops over all of them
+in parallel, each writing only its own rows, so results do not depend on threads.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import prange
+
+from wovenimpact.jit import kernel, loop_kernel
+from wovenimpact.kernels import fabric_layout as FL
+from wovenimpact.kernels.fabric import fabric_update_point
+from wovenimpact.kernels.shell_layout import (
+    C_AREAL_MASS,
+    C_BEND_E,
+    C_BEND_NU,
+    C_HOURGLASS,
+    C_MAT,
+    C_SHEAR_G,
+    C_SHEAR_K,
+    C_THICK,
+    E_ALIVE,
+    E_DT,
+    E_F,
+    E_HG,
+    E_M,
+    E_MOD,
+    E_N,
+    E_NU,
+    E_Q,
+    E_U_BEND,
+    E_U_HG,
+    E_U_MEMB,
+    EL_INVERTED,
+    EL_MATERIAL,
+    EL_NAN,
+    EL_OK,
+    MAT_FABRIC,
+    N_ELEM_STATE,
+)
+
+
+
+@kernel
+def elastic_membrane(f11, f12, f21, f22, modulus, poisson, thick, n_out):
+    """St Venant–Kirchhoff plane-stress membrane from the in-plane F.
+
+    E = ½(FᵀF − I), S = C E with C = E t/(1 − ν²) [[1, ν, 0], [ν, 1, 0], [0, 0, 1 − ν]]
+    (tensor shear), N = F S Fᵀ / J (force per current length, written to n_out).
+
+    Returns (W, C_m): stored energy per reference area ½ S:E (J/m²) and the
+    membrane stiffness E t/(1 − ν²) (N/m) for the stable step.
+    """
+    c = modulus * thick / (1.0 - poisson * poisson)
+    e11 = 0.5 * (f11 * f11 + f21 * f21 - 1.0)
+    e22 = 0.5 * (f12 * f12 + f22 * f22 - 1.0)
+    e12 = 0.5 * (f11 * f12 + f21 * f22)
+    s11 = c * (e11 + poisson * e22)
+    s22 = c * (e22 + poisson * e11)
+    s12 = c * (1.0 - poisson) * e12
+    det = f11 * f22 - f12 * f21
+    # N = F S Fᵀ / J
+    a11 = f11 * s11 + f12 * s12
+    a12 = f11 * s12 + f12 * s22
+    a21 = f21 * s11 + f22 * s12
+    a22 = f21 * s12 + f22 * s22
+    n_out[0] = (a11 * f11 + a12 * f12) / det
+    n_out[1] = (a21 * f21 + a22 * f22) / det
+    n_out[2] = (a11 * f21 + a12 * f22) / det
+    return 0.5 * (s11 * e11 + s22 * e22 + 2.0 * s12 * e12), c
+
+
+@kernel
+def local_components(a, conn, ex, ey, ez):
+    """(a_I · e) for the four corners: a nodal vector field seen along axis e."""
+    return (
+        a[conn[0], 0] * ex + a[conn[0], 1] * ey + a[conn[0], 2] * ez,
+        a[conn[1], 0] * ex + a[conn[1], 1] * ey + a[conn[1], 2] * ez,
+        a[conn[2], 0] * ex + a[conn[2], 1] * ey + a[conn[2], 2] * ez,
+        a[conn[3], 0] * ex + a[conn[3], 1] * ey + a[conn[3], 2] * ez,
+    )
+
+
+@kernel
+def corotational_frame(px, py, pz):
+    """Corotational frame and one-point gradients of a quad (BLT; theory §2.1).
+
+    e3 ∥ d13 × d24 (diagonals), e1 = side 1→2 projected on the plane, e2 = e3 × e1;
+    local coordinates about the centroid; area A = ½ (x̂31 ŷ42 − x̂42 ŷ31);
+    b1 = ∂N/∂x̂ = (ŷ24, ŷ31, ŷ42, ŷ13)/2A, b2 = ∂N/∂ŷ = (x̂42, x̂13, x̂24, x̂31)/2A.
+
+    Returns ((e1), (e2), (e3), (x̂, ŷ), A, (b1, b2)); A is 0 or NaN if degenerate.
+    """
+    d13x, d13y, d13z = px[2] - px[0], py[2] - py[0], pz[2] - pz[0]
+    d24x, d24y, d24z = px[3] - px[1], py[3] - py[1], pz[3] - pz[1]
+    nx = d13y * d24z - d13z * d24y
+    ny = d13z * d24x - d13x * d24z
+    nz = d13x * d24y - d13y * d24x
+    nn = math.sqrt(nx * nx + ny * ny + nz * nz)
+    e3x, e3y, e3z = nx / nn, ny / nn, nz / nn
+    s12x, s12y, s12z = px[1] - px[0], py[1] - py[0], pz[1] - pz[0]
+    p = s12x * e3x + s12y * e3y + s12z * e3z
+    e1x, e1y, e1z = s12x - p * e3x, s12y - p * e3y, s12z - p * e3z
+    n1 = math.sqrt(e1x * e1x + e1y * e1y + e1z * e1z)
+    e1x, e1y, e1z = e1x / n1, e1y / n1, e1z / n1
+    e2x = e3y * e1z - e3z * e1y
+    e2y = e3z * e1x - e3x * e1z
+    e2z = e3x * e1y - e3y * e1x
+    cx = 0.25 * (px[0] + px[1] + px[2] + px[3])
+    cy = 0.25 * (py[0] + py[1] + py[2] + py[3])
+    cz = 0.25 * (pz[0] + pz[1] + pz[2] + pz[3])
+    x0 = (px[0] - cx) * e1x + (py[0] - cy) * e1y + (pz[0] - cz) * e1z
+    x1 = (px[1] - cx) * e1x + (py[1] - cy) * e1y + (pz[1] - cz) * e1z
+    x2 = (px[2] - cx) * e1x + (py[2] - cy) * e1y + (pz[2] - cz) * e1z
+    x3 = (px[3] - cx) * e1x + (py[3] - cy) * e1y + (pz[3] - cz) * e1z
+    y0 = (px[0] - cx) * e2x + (py[0] - cy) * e2y + (pz[0] - cz) * e2z
+    y1 = (px[1] - cx) * e2x + (py[1] - cy) * e2y + (pz[1] - cz) * e2z
+    y2 = (px[2] - cx) * e2x + (py[2] - cy) * e2y + (pz[2] - cz) * e2z
+    y3 = (px[3] - cx) * e2x + (py[3] - cy) * e2y + (pz[3] - cz) * e2z
+    area = 0.5 * ((x2 - x0) * (y3 - y1) - (x3 - x1) * (y2 - y0))
+    inv2a = 0.5 / area
+    b1 = ((y1 - y3) * inv2a, (y2 - y0) * inv2a, (y3 - y1) * inv2a, (y0 - y2) * inv2a)
+    b2 = ((x3 - x1) * inv2a, (x0 - x2) * inv2a, (x1 - x3) * inv2a, (x2 - x0) * inv2a)
+    return (
+        (e1x, e1y, e1z), (e2x, e2y, e2z), (e3x, e3y, e3z),
+        ((x0, x1, x2, x3), (y0, y1, y2, y3)), area, (b1, b2),
+    )
+
+
+@kernel
+def hourglass_vectors(lx, ly, b1, b2):
+    """Flanagan–Belytschko γ_I = ¼ (h_I − (h·x̂) b1_I − (h·ŷ) b2_I), h = (1, −1, 1, −1),
+    orthogonal to every linear field; and Σ_I (b1_I² + b2_I²)."""
+    hx = lx[0] - lx[1] + lx[2] - lx[3]
+    hy = ly[0] - ly[1] + ly[2] - ly[3]
+    gam = (
+        0.25 * (1.0 - hx * b1[0] - hy * b2[0]),
+        0.25 * (-1.0 - hx * b1[1] - hy * b2[1]),
+        0.25 * (1.0 - hx * b1[2] - hy * b2[2]),
+        0.25 * (-1.0 - hx * b1[3] - hy * b2[3]),
+    )
+    bb = 0.0
+    for i in range(4):
+        bb += b1[i] * b1[i] + b2[i] * b2[i]
+    return gam, bb
+
+
+@kernel
+def shell_force(
+    x, v, omega, conn, dt, area0, grad0, sec, mat_kind, mat_par, el_in, el_out, m_in, m_out, block
+):
+    """Internal forces of one shell element at x^n (see the module docstring).
+
+    Args:
+        x, v, omega: (n_nodes, 3) positions x^n, velocities v^{n−1/2}, spins ω^{n−1/2}.
+        conn: (4,) the element's node indices.
+        dt: Δt^{n−1/2}, the step the rates act over (0 at the start).
+        area0: reference area A0; grad0: (2, 4) ∂N_I/∂X in the material frame.
+        sec: section row; mat_kind, mat_par: material kind and parameter vector.
+        el_in, el_out: element state rows (shell_layout), start / end of step.
+        m_in, m_out: material state rows, start / end of step.
+        block: (4, 6) written: forces (global, N) and moments (global, N·m) per corner,
+            the internal (resisting) forces.
+
+    Returns:
+        (status, eroded_now): an EL_* code, and 1 if the element eroded this step.
+    """
+    for j in range(N_ELEM_STATE):
+        el_out[j] = el_in[j]
+    for j in range(m_in.shape[0]):
+        m_out[j] = m_in[j]
+    for i in range(4):
+        for j in range(6):
+            block[i, j] = 0.0
+    if el_in[E_ALIVE] == 0.0:
+        el_out[E_DT] = math.inf
+        return EL_OK, 0
+
+    # 1. corotational frame at x^n (forces) and at x^{n−1/2} = x^n − ½Δt v (rates:
+    # the velocities of the step belong to the midpoint configuration)
+    c0, c1, c2_, c3 = conn[0], conn[1], conn[2], conn[3]
+    px = (x[c0, 0], x[c1, 0], x[c2_, 0], x[c3, 0])
+    py = (x[c0, 1], x[c1, 1], x[c2_, 1], x[c3, 1])
+    pz = (x[c0, 2], x[c1, 2], x[c2_, 2], x[c3, 2])
+    frame = corotational_frame(px, py, pz)
+    area = frame[4]
+    if not (area > 0.0):
+        el_out[E_DT] = 0.0
+        return (EL_NAN if not math.isfinite(area) else EL_INVERTED), 0
+    e1x, e1y, e1z = frame[0]
+    e2x, e2y, e2z = frame[1]
+    e3x, e3y, e3z = frame[2]
+    lx, ly = frame[3]
+    b1, b2 = frame[5]
+    h = 0.5 * dt
+    mid = corotational_frame(
+        (px[0] - h * v[c0, 0], px[1] - h * v[c1, 0], px[2] - h * v[c2_, 0], px[3] - h * v[c3, 0]),
+        (py[0] - h * v[c0, 1], py[1] - h * v[c1, 1], py[2] - h * v[c2_, 1], py[3] - h * v[c3, 1]),
+        (pz[0] - h * v[c0, 2], pz[1] - h * v[c1, 2], pz[2] - h * v[c2_, 2], pz[3] - h * v[c3, 2]),
+    )
+    if not (mid[4] > 0.0):
+        el_out[E_DT] = 0.0
+        return (EL_NAN if not math.isfinite(mid[4]) else EL_INVERTED), 0
+
+    # 2. membrane: F = Σ x̂_I ⊗ ∂N_I/∂X
+    f11 = f12 = f21 = f22 = 0.0
+    for i in range(4):
+        f11 += lx[i] * grad0[0, i]
+        f12 += lx[i] * grad0[1, i]
+        f21 += ly[i] * grad0[0, i]
+        f22 += ly[i] * grad0[1, i]
+    det = f11 * f22 - f12 * f21
+    if not (det > 0.0):
+        el_out[E_DT] = 0.0
+        return (EL_NAN if not math.isfinite(det) else EL_INVERTED), 0
+    el_out[E_F] = f11
+    el_out[E_F + 1] = f12
+    el_out[E_F + 2] = f21
+    el_out[E_F + 3] = f22
+    thick = sec[C_THICK]
+    mu = sec[C_AREAL_MASS]
+    n_res = el_out[E_N : E_N + 3]
+    eroded_now = 0
+    if mat_kind == MAT_FABRIC:
+        f_old = el_in[E_F : E_F + 4].reshape((2, 2))
+        f_new = el_out[E_F : E_F + 4].reshape((2, 2))
+        status, c_memb = fabric_update_point(mat_par, f_old, f_new, m_in, m_out, n_res)
+        if status != 0:
+            el_out[E_DT] = 0.0
+            return EL_MATERIAL, 0
+        w_memb = m_out[FL.S_ENERGY]
+        if m_out[FL.S_ALIVE] == 0.0:
+            eroded_now = 1
+    else:
+        w_memb, c_memb = elastic_membrane(
+            f11, f12, f21, f22, mat_par[E_MOD], mat_par[E_NU], thick, n_res
+        )
+    el_out[E_U_MEMB] = w_memb * area0
+    if eroded_now == 1:
+        # no force from now on; the element's stored energy is booked by the caller
+        el_out[E_ALIVE] = 0.0
+        el_out[E_DT] = math.inf
+        for j in range(3):
+            el_out[E_N + j] = 0.0
+        return EL_OK, 1
+    # first Piola resultant P = J N F⁻ᵀ; F⁻ᵀ = [[f22, −f21], [−f12, f11]] / J
+    n11, n22, n12 = n_res[0], n_res[1], n_res[2]
+    p11 = n11 * f22 - n12 * f12
+    p12 = -n11 * f21 + n12 * f11
+    p21 = n12 * f22 - n22 * f12
+    p22 = -n12 * f21 + n22 * f11
+
+    # local nodal forces, accumulated in block as (fx, fy, fz, mx, my) per corner
+    # (resisting forces) and turned to global axes at the end
+    for i in range(4):
+        block[i, 0] = area0 * (p11 * grad0[0, i] + p12 * grad0[1, i])
+        block[i, 1] = area0 * (p21 * grad0[0, i] + p22 * grad0[1, i])
+
+    # 3. bending and transverse shear, rate form over Δt^{n−1/2}
+    (m1x, m1y, m1z), (m2x, m2y, m2z), (m3x, m3y, m3z) = mid[0], mid[1], mid[2]
+    mb1, mb2 = mid[5]
+    vx = local_components(v, conn, m1x, m1y, m1z)
+    vy = local_components(v, conn, m2x, m2y, m2z)
+    vz = local_components(v, conn, m3x, m3y, m3z)
+    tx = local_components(omega, conn, m1x, m1y, m1z)
+    ty = local_components(omega, conn, m2x, m2y, m2z)
+    kx = ky = kxy2 = gxz = gyz = 0.0
+    for i in range(4):
+        kx += mb1[i] * ty[i]
+        ky -= mb2[i] * tx[i]
+        kxy2 += mb2[i] * ty[i] - mb1[i] * tx[i]
+        gxz += mb1[i] * vz[i] + 0.25 * ty[i]
+        gyz += mb2[i] * vz[i] - 0.25 * tx[i]
+    e_b = sec[C_BEND_E]
+    nu_b = sec[C_BEND_NU]
+    d_b = e_b * thick * thick * thick / (12.0 * (1.0 - nu_b * nu_b))
+    kgt = sec[C_SHEAR_K] * sec[C_SHEAR_G] * thick
+    dkx, dky, dkxy2 = kx * dt, ky * dt, kxy2 * dt
+    dgxz, dgyz = gxz * dt, gyz * dt
+    m_old0, m_old1, m_old2 = el_in[E_M], el_in[E_M + 1], el_in[E_M + 2]
+    q_old0, q_old1 = el_in[E_Q], el_in[E_Q + 1]
+    mxx = m_old0 + d_b * (dkx + nu_b * dky)
+    myy = m_old1 + d_b * (dky + nu_b * dkx)
+    mxy = m_old2 + d_b * 0.5 * (1.0 - nu_b) * dkxy2
+    qx = q_old0 + kgt * dgxz
+    qy = q_old1 + kgt * dgyz
+    el_out[E_M] = mxx
+    el_out[E_M + 1] = myy
+    el_out[E_M + 2] = mxy
+    el_out[E_Q] = qx
+    el_out[E_Q + 1] = qy
+    el_out[E_U_BEND] = el_in[E_U_BEND] + area * (
+        0.5 * (m_old0 + mxx) * dkx + 0.5 * (m_old1 + myy) * dky + 0.5 * (m_old2 + mxy) * dkxy2
+        + 0.5 * (q_old0 + qx) * dgxz + 0.5 * (q_old1 + qy) * dgyz
+    )
+    for i in range(4):
+        block[i, 2] = area * (b1[i] * qx + b2[i] * qy)
+        block[i, 3] = area * (-b2[i] * myy - b1[i] * mxy - 0.25 * qy)
+        block[i, 4] = area * (b1[i] * mxx + b2[i] * mxy + 0.25 * qx)
+
+    # 4. hourglass (Flanagan–Belytschko): γ_I = ¼ (h_I − (h·x̂) b1_I − (h·ŷ) b2_I),
+    # rates with the midpoint γ, forces with the current one
+    gam, bb = hourglass_vectors(lx, ly, b1, b2)
+    gam_mid = hourglass_vectors(mid[3][0], mid[3][1], mb1, mb2)[0]
+    r = sec[C_HOURGLASS]
+    e_hg = 0.0
+    for j in range(5):
+        if j < 2:
+            k = r * c_memb * area * bb
+            rates = (vx, vy)[j]
+        elif j == 2:
+            k = r * kgt * area * bb
+            rates = vz
+        else:
+            k = r * d_b * area * bb
+            rates = (tx, ty)[j - 3]
+        rate = (gam_mid[0] * rates[0] + gam_mid[1] * rates[1] + gam_mid[2] * rates[2]
+                + gam_mid[3] * rates[3])
+        old = el_in[E_HG + j]
+        new = old + k * rate * dt
+        el_out[E_HG + j] = new
+        e_hg += 0.5 * (old + new) * rate * dt
+        for i in range(4):
+            block[i, j] += gam[i] * new
+    el_out[E_U_HG] = el_in[E_U_HG] + e_hg
+
+    # 5. back to global axes
+    for i in range(4):
+        fx, fy, fz, mx, my = block[i, 0], block[i, 1], block[i, 2], block[i, 3], block[i, 4]
+        block[i, 0] = fx * e1x + fy * e2x + fz * e3x
+        block[i, 1] = fx * e1y + fy * e2y + fz * e3y
+        block[i, 2] = fx * e1z + fy * e2z + fz * e3z
+        block[i, 3] = mx * e1x + my * e2x
+        block[i, 4] = mx * e1y + my * e2y
+        block[i, 5] = mx * e1z + my * e2z
+
+    # 6. stable step: L_e = A / longest edge, c² = max(C_m, k G t) / μ
+    edge2 = 0.0
+    for i in range(4):
+        j = (i + 1) % 4
+        dx = px[j] - px[i]
+        dy = py[j] - py[i]
+        dz = pz[j] - pz[i]
+        edge2 = max(edge2, dx * dx + dy * dy + dz * dz)
+    c2 = max(c_memb, kgt) / mu
+    el_out[E_DT] = area / math.sqrt(edge2 * c2)
+    if not math.isfinite(block[0, 0] + block[1, 0] + block[2, 0] + block[3, 0] + el_out[E_DT]):
+        return EL_NAN, 0
+    return EL_OK, 0
+
+
+@loop_kernel
+def internal_force_for_shells(
+    x, v, omega, dt, quads, elem_section, sections, mat_kind, mat_params, area0, ref_grad,
+    el_in, el_out, m_in, m_out, blocks, status, eroded_now,
+):
+    """``shell_force`` for every element (prange; each element writes its own rows).
+
+    Args: positions/velocities/spins (n_nodes, 3); dt; Model arrays; element and
+    material state in/out; blocks (n_elems, 4, 6) written; status, eroded_now
+    (n_elems,) written.
+    """
+    ne = quads.shape[0]
+    for e in prange(ne):
+        sec = sections[elem_section[e]]
+        m = int(sec[C_MAT])
+        st, er = shell_force(
+            x, v, omega, quads[e], dt, area0[e], ref_grad[e], sec, mat_kind[m], mat_params[m],
+            el_in[e], el_out[e], m_in[e], m_out[e], blocks[e],
+        )
+        status[e] = st
+        eroded_now[e] = er

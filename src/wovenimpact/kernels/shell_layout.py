@@ -1,0 +1,69 @@
+"""Column layout of the shell tables shared by the solver and the shell kernels.
+
+Sections (``Model.sections``, one row per section, SI):
+
+- ``C_THICK``: shell thickness t (m).
+- ``C_MAT``: row of ``Model.mat_params`` / ``Model.mat_kind`` (stored as float).
+- ``C_AREAL_MASS``: mass per unit reference area μ (kg/m²).
+- ``C_BEND_E``, ``C_BEND_NU``: modulus and Poisson ratio of the bending resultant
+  M = D κ, D = E t³/(12 (1 − ν²)) (the metal's own, or the small elastic bending
+  stiffness of a fabric, MODEL.md §1.8).
+- ``C_SHEAR_G``: transverse shear modulus G of Q = k G t γ (Pa); ``C_SHEAR_K`` its
+  factor k (5/6).
+- ``C_HOURGLASS``: hourglass stiffness coefficient r (—).
+
+Material kinds (``Model.mat_kind``): ``MAT_ELASTIC`` (params E, ν, ρ in columns
+``E_MOD``, ``E_NU``, ``E_RHO``) and ``MAT_FABRIC`` (the crossover parameter vector of
+:mod:`wovenimpact.kernels.fabric_layout`).
+
+Per-element state (``State.elem``, one row per element):
+
+- ``E_F``: in-plane deformation gradient F (4 values, row-major F11 F12 F21 F22)
+  from the reference material frame (warp along x) to the corotational frame.
+- ``E_N``: membrane resultant N_xx, N_yy, N_xy (N/m), corotational frame.
+- ``E_M``: moments M_xx, M_yy, M_xy (N·m/m); ``E_Q``: transverse shears Q_x, Q_y (N/m).
+- ``E_HG``: hourglass generalised forces (membrane x, y; w; θx, θy).
+- ``E_U_MEMB``: membrane stored energy (J); ``E_U_BEND``: bending + transverse shear
+  energy (J); ``E_U_HG``: hourglass energy (J).
+- ``E_DT``: the element's stable time step L_e / c_e (s), before the factor α.
+- ``E_ALIVE``: 1.0 alive, 0.0 eroded.
+"""
+
+from __future__ import annotations
+
+# sections
+C_THICK = 0
+C_MAT = 1
+C_AREAL_MASS = 2
+C_BEND_E = 3
+C_BEND_NU = 4
+C_SHEAR_G = 5
+C_SHEAR_K = 6
+C_HOURGLASS = 7
+N_SECTION = 8
+
+# material kinds and the elastic parameter vector
+MAT_ELASTIC = 0
+MAT_FABRIC = 1
+E_MOD = 0
+E_NU = 1
+E_RHO = 2
+
+# element state
+E_F = 0
+E_N = 4
+E_M = 7
+E_Q = 10
+E_HG = 12
+E_U_MEMB = 17
+E_U_BEND = 18
+E_U_HG = 19
+E_DT = 20
+E_ALIVE = 21
+N_ELEM_STATE = 22
+
+# per-element status codes written by the force kernel
+EL_OK = 0
+EL_INVERTED = 1  # non-positive area or Jacobian
+EL_MATERIAL = 2  # material point failed to converge or got inadmissible kinematics
+EL_NAN = 3

@@ -1,0 +1,367 @@
+"""Model: the immutable arrays a run is made of (geometry, sections, BCs, masses).
+
+``build_model`` turns a mesh (nodes, quads), section assignments and boundary
+conditions into a :class:`Model`: it packs the material tables, precomputes each
+element's reference shape-function gradients in its material frame (warp along
+the projected ``warp_direction``), lumps the masses and builds the node → element
+map through which nodal forces are gathered (CSR; deterministic, no scatter).
+docs/theory.md §2 (element) and §3 (integration).
+"""
+
+from __future__ import annotations
+
+import hashlib
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from wovenimpact.errors import InputError
+from wovenimpact.kernels import fabric_layout as FL
+from wovenimpact.kernels import shell_layout as S
+from wovenimpact.materials.fabric import FabricParameters
+from wovenimpact.materials.fabric import initial_state as fabric_initial_state
+from wovenimpact.materials.metal import MetalParameters
+
+FREE, FIXED, PRESCRIBED = 0, 1, 2  # boundary-condition codes per degree of freedom
+DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
+
+
+@dataclass(frozen=True)
+class Section:
+    """A shell section: thickness, material and the stiffnesses the material lacks.
+
+    Attributes:
+        material: fabric (crossover kernel) or an elastic metal.
+        thickness: t (m); default for a fabric: 4 h0 (its shell thickness).
+        bending_modulus: E_b of M = E_b t³/(12(1 − ν_b²)) κ (Pa); default the
+            metal's E; for a fabric it must be given (MODEL.md §1.8).
+        bending_poisson: ν_b (—); default the metal's ν, 0 for a fabric.
+        transverse_shear_modulus: G of Q = k G t γ (Pa); default the metal's G; for
+            a fabric it must be given (thesis: 3.28 GPa).
+        shear_factor: k (—), 5/6.
+        hourglass: r, hourglass stiffness coefficient (—), 0.05.
+        areal_mass: μ (kg/m²); default ρ t (metal) or the fabric's areal mass.
+    """
+
+    material: FabricParameters | MetalParameters
+    thickness: float | None = None
+    bending_modulus: float | None = None
+    bending_poisson: float | None = None
+    transverse_shear_modulus: float | None = None
+    shear_factor: float = 5.0 / 6.0
+    hourglass: float = 0.05
+    areal_mass: float | None = None
+
+    def row(self, mat_index: int, name: str) -> np.ndarray:
+        """The section's row of ``Model.sections`` (layout in shell_layout)."""
+        m = self.material
+        r = np.zeros(S.N_SECTION)
+        if isinstance(m, FabricParameters):
+            t = m.shell_thickness if self.thickness is None else self.thickness
+            mu = m.areal_mass if self.areal_mass is None else self.areal_mass
+            if self.bending_modulus is None or self.transverse_shear_modulus is None:
+                raise InputError(
+                    f"section {name!r}: a fabric section needs bending_modulus and "
+                    "transverse_shear_modulus (the small elastic bending stiffness of "
+                    "MODEL.md §1.8), e.g. '1 GPa' and '3.28 GPa'"
+                )
+            e_b, nu_b = self.bending_modulus, self.bending_poisson or 0.0
+            g = self.transverse_shear_modulus
+        else:
+            if m.kind != "elastic":
+                raise InputError(
+                    f"section {name!r}: material {m.name!r} is {m.kind!r}; the shell solver "
+                    "supports 'elastic' metals and woven fabrics so far"
+                )
+            if self.thickness is None:
+                raise InputError(f"section {name!r}: a metal section needs a thickness")
+            t = self.thickness
+            mu = m.density * t if self.areal_mass is None else self.areal_mass
+            e_b = m.modulus if self.bending_modulus is None else self.bending_modulus
+            nu_b = m.poisson if self.bending_poisson is None else self.bending_poisson
+            g = m.shear_modulus if self.transverse_shear_modulus is None else (
+                self.transverse_shear_modulus
+            )
+        for label, value in (("thickness", t), ("areal_mass", mu), ("bending_modulus", e_b),
+                             ("transverse_shear_modulus", g), ("shear_factor", self.shear_factor)):
+            if not value > 0.0:
+                raise InputError(f"section {name!r}: {label} = {value!r} must be > 0")
+        if not 0.0 <= self.hourglass < 1.0:
+            raise InputError(f"section {name!r}: hourglass = {self.hourglass!r}; valid: 0 ≤ r < 1")
+        r[S.C_THICK] = t
+        r[S.C_MAT] = mat_index
+        r[S.C_AREAL_MASS] = mu
+        r[S.C_BEND_E] = e_b
+        r[S.C_BEND_NU] = nu_b
+        r[S.C_SHEAR_G] = g
+        r[S.C_SHEAR_K] = self.shear_factor
+        r[S.C_HOURGLASS] = self.hourglass
+        return r
+
+
+@dataclass
+class BoundaryConditions:
+    """Per-node, per-DOF constraints: free, fixed (v = 0) or prescribed velocity.
+
+    A prescribed velocity follows the smooth-step amplitude of thesis Fig. 8-3,
+    A(t) = ξ³(10 − 15ξ + 6ξ²), ξ = min(t / ramp_time, 1) (A = 1 if ramp_time = 0).
+    """
+
+    n_nodes: int
+    ramp_time: float = 0.0
+    code: np.ndarray = field(init=False)
+    velocity: np.ndarray = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.code = np.zeros((self.n_nodes, 6), dtype=np.int8)
+        self.velocity = np.zeros((self.n_nodes, 6))
+
+    def fix(self, nodes, dofs=(0, 1, 2, 3, 4, 5)) -> BoundaryConditions:
+        """Hold ``dofs`` (0–2 translations, 3–5 rotations) of ``nodes`` at rest."""
+        idx = np.asarray(nodes, dtype=np.int64)
+        for d in dofs:
+            self.code[idx, d] = FIXED
+            self.velocity[idx, d] = 0.0
+        return self
+
+    def symmetry(self, nodes, normal_axis: int) -> BoundaryConditions:
+        """Symmetry plane with normal along axis 0/1/2: u_n = 0 and the two in-plane rotations."""
+        rot = [3 + a for a in range(3) if a != normal_axis]
+        return self.fix(nodes, (normal_axis, *rot))
+
+    def prescribe(self, nodes, dof: int, velocity: float) -> BoundaryConditions:
+        """Drive ``dof`` of ``nodes`` at ``velocity`` (m/s or rad/s) times the amplitude."""
+        idx = np.asarray(nodes, dtype=np.int64)
+        self.code[idx, dof] = PRESCRIBED
+        self.velocity[idx, dof] = velocity
+        return self
+
+
+@dataclass(frozen=True, eq=False)
+class Model:
+    """Static arrays of a run (SI). Never mutated; the solver reads them.
+
+    Attributes:
+        x0: (n_nodes, 3) reference coordinates.
+        quads: (n_elems, 4) node indices, counter-clockwise about the normal.
+        elem_section: (n_elems,) section row of each element.
+        sections: (n_sections, N_SECTION) section table (shell_layout).
+        mat_kind: (n_mats,) MAT_ELASTIC or MAT_FABRIC.
+        mat_params: (n_mats, n_params) parameter vectors, zero-padded.
+        mat_state0: (n_mats, n_mat_state) initial material state per material.
+        ref_grad: (n_elems, 2, 4) ∂N_I/∂X at the element centre in its reference
+            material frame (warp along x).
+        area0: (n_elems,) reference areas.
+        node_mass: (n_nodes,) lumped translational mass (kg).
+        node_inertia: (n_nodes,) lumped rotary inertia (kg m²).
+        bc_code, bc_velocity: (n_nodes, 6) constraint codes and prescribed velocities.
+        ramp_time: rise time of the smooth-step amplitude (s).
+        body_accel: (n_nodes, 3) body-force acceleration field (m/s²).
+        node_ptr, node_elem, node_corner: CSR map node → (element, corner).
+        alpha: stable-step factor (eq. 4.8, 0.9).
+        ply: (n_elems,) ply (or part) index of each element, for per-ply outputs.
+        node_sets, elem_sets: named index arrays (outputs, BCs).
+        section_names, material_names: labels for reports.
+    """
+
+    x0: np.ndarray
+    quads: np.ndarray
+    elem_section: np.ndarray
+    sections: np.ndarray
+    mat_kind: np.ndarray
+    mat_params: np.ndarray
+    mat_state0: np.ndarray
+    ref_grad: np.ndarray
+    area0: np.ndarray
+    node_mass: np.ndarray
+    node_inertia: np.ndarray
+    bc_code: np.ndarray
+    bc_velocity: np.ndarray
+    ramp_time: float
+    body_accel: np.ndarray
+    node_ptr: np.ndarray
+    node_elem: np.ndarray
+    node_corner: np.ndarray
+    alpha: float
+    ply: np.ndarray
+    node_sets: dict = field(default_factory=dict)
+    elem_sets: dict = field(default_factory=dict)
+    section_names: tuple = ()
+    material_names: tuple = ()
+
+    @property
+    def n_nodes(self) -> int:
+        return self.x0.shape[0]
+
+    @property
+    def n_elems(self) -> int:
+        return self.quads.shape[0]
+
+    def digest(self) -> str:
+        """SHA-256 of every array: a checkpoint is only resumed on the same Model."""
+        h = hashlib.sha256()
+        for name in ("x0", "quads", "elem_section", "sections", "mat_kind", "mat_params",
+                     "bc_code", "bc_velocity", "body_accel", "node_mass", "node_inertia"):
+            a = np.ascontiguousarray(getattr(self, name))
+            h.update(name.encode())
+            h.update(str(a.dtype).encode() + str(a.shape).encode())
+            h.update(a.tobytes())
+        h.update(repr((self.ramp_time, self.alpha)).encode())
+        return h.hexdigest()
+
+
+def material_frame_gradients(x0, quads, warp_direction):
+    """Reference centre gradients ∂N_I/∂X (n, 2, 4) and areas in each element's
+    material frame: e3 the element normal, e1 the warp direction projected on the
+    element plane, e2 = e3 × e1 (the fill direction of an unsheared fabric)."""
+    xe = x0[quads]  # (n, 4, 3)
+    d13 = xe[:, 2] - xe[:, 0]
+    d24 = xe[:, 3] - xe[:, 1]
+    n = np.cross(d13, d24)
+    area = 0.5 * np.linalg.norm(n, axis=1)
+    bad = np.flatnonzero(~(area > 0.0))
+    if bad.size:
+        raise InputError(
+            f"element {int(bad[0])} (nodes {quads[bad[0]].tolist()}) has zero area or "
+            "reversed node order; quads must be convex and counter-clockwise"
+        )
+    e3 = n / (2.0 * area[:, None])
+    w = np.broadcast_to(np.asarray(warp_direction, dtype=float), e3.shape)
+    e1 = w - np.sum(w * e3, axis=1)[:, None] * e3
+    norm1 = np.linalg.norm(e1, axis=1)
+    bad = np.flatnonzero(norm1 < 1e-8)
+    if bad.size:
+        raise InputError(
+            f"warp_direction {np.asarray(warp_direction).tolist()} is normal to element "
+            f"{int(bad[0])}; give a direction lying in the fabric plane"
+        )
+    e1 /= norm1[:, None]
+    e2 = np.cross(e3, e1)
+    rel = xe - xe.mean(axis=1, keepdims=True)
+    X = np.einsum("nij,nj->ni", rel, e1)
+    Y = np.einsum("nij,nj->ni", rel, e2)
+    grad = np.empty((len(quads), 2, 4))
+    # one-point gradients of the bilinear quad (Belytschko–Lin–Tsay B matrix)
+    a2 = 2.0 * area
+    grad[:, 0] = np.stack([Y[:, 1] - Y[:, 3], Y[:, 2] - Y[:, 0], Y[:, 3] - Y[:, 1],
+                           Y[:, 0] - Y[:, 2]], axis=1) / a2[:, None]
+    grad[:, 1] = np.stack([X[:, 3] - X[:, 1], X[:, 0] - X[:, 2], X[:, 1] - X[:, 3],
+                           X[:, 2] - X[:, 0]], axis=1) / a2[:, None]
+    return grad, area
+
+
+def node_element_map(quads: np.ndarray, n_nodes: int):
+    """CSR map node → (element, corner), elements in increasing order per node."""
+    n_el = quads.shape[0]
+    flat = quads.ravel()
+    order = np.argsort(flat, kind="stable")
+    counts = np.bincount(flat, minlength=n_nodes)
+    ptr = np.zeros(n_nodes + 1, dtype=np.int64)
+    np.cumsum(counts, out=ptr[1:])
+    elem = (order // 4).astype(np.int64)
+    corner = (order % 4).astype(np.int64)
+    assert elem.size == 4 * n_el
+    return ptr, elem, corner
+
+
+def build_model(
+    nodes,
+    quads,
+    sections: dict[str, Section],
+    elem_section,
+    bcs: BoundaryConditions | None = None,
+    warp_direction=(1.0, 0.0, 0.0),
+    body_accel=None,
+    alpha: float = 0.9,
+    ply=None,
+    node_sets: dict | None = None,
+    elem_sets: dict | None = None,
+) -> Model:
+    """Assemble a :class:`Model` from a mesh, named sections and constraints.
+
+    Args:
+        nodes: (n_nodes, 3) coordinates (m).
+        quads: (n_elems, 4) node indices; triangles as quads with a repeated last node.
+        sections: name → Section.
+        elem_section: (n_elems,) section name (str) or row index of each element.
+        bcs: constraints; default none.
+        warp_direction: global vector (or (n_elems, 3) array) projected on each
+            element to give its warp (material x) direction.
+        body_accel: (3,) or (n_nodes, 3) body-force acceleration (m/s²).
+        alpha: stable-step factor, 0 < α ≤ 1.
+        ply: (n_elems,) part index for per-ply outputs; default all 0.
+    """
+    x0 = np.ascontiguousarray(nodes, dtype=float)
+    q = np.ascontiguousarray(quads, dtype=np.int64)
+    if x0.ndim != 2 or x0.shape[1] != 3:
+        raise InputError(f"nodes must be an (n, 3) array, got shape {x0.shape}")
+    if q.ndim != 2 or q.shape[1] != 4:
+        raise InputError(f"quads must be an (n, 4) array, got shape {q.shape}")
+    if q.size and (q.min() < 0 or q.max() >= len(x0)):
+        raise InputError(f"quads refer to node {int(q.max())}, but there are {len(x0)} nodes")
+    if not 0.0 < alpha <= 1.0:
+        raise InputError(f"alpha = {alpha!r}: the stable-step factor must be in (0, 1]")
+    names = list(sections)
+    # materials: one table row per distinct material object
+    mats: list = []
+    for sec in sections.values():
+        if not any(sec.material is m for m in mats):
+            mats.append(sec.material)
+    rows = [sections[n].row(next(i for i, m in enumerate(mats) if m is sections[n].material), n)
+            for n in names]
+    sec_table = np.array(rows)
+    es = np.asarray(elem_section)
+    if es.dtype.kind in "US":
+        unknown = sorted(set(es.tolist()) - set(names))
+        if unknown:
+            raise InputError(f"unknown section {unknown[0]!r}; defined: {names}")
+        es = np.array([names.index(s) for s in es.tolist()], dtype=np.int64)
+    es = np.ascontiguousarray(es, dtype=np.int64)
+    if es.shape != (len(q),):
+        raise InputError(f"elem_section must give one section per element ({len(q)})")
+    kinds, params, states = [], [], []
+    for m in mats:
+        if isinstance(m, FabricParameters):
+            kinds.append(S.MAT_FABRIC)
+            params.append(m.to_array())
+            states.append(fabric_initial_state(m)[0])
+        else:
+            kinds.append(S.MAT_ELASTIC)
+            params.append(np.array([m.modulus, m.poisson, m.density]))
+            states.append(np.zeros(0))
+    n_par = max(len(p) for p in params)
+    n_st = max(1, max(len(s) for s in states))
+    mat_params = np.zeros((len(mats), n_par))
+    mat_state0 = np.zeros((len(mats), n_st))
+    for i, (p, s) in enumerate(zip(params, states)):
+        mat_params[i, : len(p)] = p
+        mat_state0[i, : len(s)] = s
+    ref_grad, area0 = material_frame_gradients(x0, q, warp_direction)
+    # lumped masses: a quarter of each element's mass to each corner; rotary inertia
+    # m · max(t²/12, A/8) so that rotations never govern the stable step (theory §3)
+    thick = sec_table[es, S.C_THICK]
+    m_el = sec_table[es, S.C_AREAL_MASS] * area0
+    node_mass = np.zeros(len(x0))
+    node_inertia = np.zeros(len(x0))
+    for c in range(4):
+        np.add.at(node_mass, q[:, c], 0.25 * m_el)
+        np.add.at(node_inertia, q[:, c], 0.25 * m_el * np.maximum(thick**2 / 12.0, area0 / 8.0))
+    if bcs is None:
+        bcs = BoundaryConditions(len(x0))
+    if bcs.code.shape != (len(x0), 6):
+        raise InputError(f"boundary conditions are for {bcs.code.shape[0]} nodes, mesh has {len(x0)}")
+    if bcs.ramp_time < 0.0:
+        raise InputError(f"ramp_time = {bcs.ramp_time!r} s must be ≥ 0")
+    ba = np.zeros((len(x0), 3)) if body_accel is None else np.broadcast_to(
+        np.asarray(body_accel, dtype=float), (len(x0), 3)).copy()
+    ptr, n_elem, n_corner = node_element_map(q, len(x0))
+    return Model(
+        x0=x0, quads=q, elem_section=es, sections=sec_table,
+        mat_kind=np.array(kinds, dtype=np.int64), mat_params=mat_params, mat_state0=mat_state0,
+        ref_grad=ref_grad, area0=area0, node_mass=node_mass, node_inertia=node_inertia,
+        bc_code=bcs.code.copy(), bc_velocity=bcs.velocity.copy(), ramp_time=float(bcs.ramp_time),
+        body_accel=ba, node_ptr=ptr, node_elem=n_elem, node_corner=n_corner, alpha=float(alpha),
+        ply=np.zeros(len(q), dtype=np.int64) if ply is None else np.asarray(ply, dtype=np.int64),
+        node_sets=dict(node_sets or {}), elem_sets=dict(elem_sets or {}),
+        section_names=tuple(names), material_names=tuple(getattr(m, "name", "") for m in mats),
+    )

@@ -1,0 +1,181 @@
+"""One explicit step, reading like the algorithm (docs/theory.md §3; thesis ch. 4.1).
+
+    1. element forces at x^n: corotational shells, material update F^{n−1} → F^n,
+       bending/shear/hourglass rates over Δt^{n−1/2}          (kernels.shell)
+    2. nodal forces gathered through the node → element map    (kernels.gather)
+    3. stable step Δt^{n+1/2} = α min_e L_e / c_e               (eq. 4.8–4.11)
+    4. central differences for v^{n+1/2}, x^{n+1}; reactions;   (kernels.integrate)
+       work and kinetic energy
+    5. bookkeeping: erosion, energies, time
+
+Contact and rigid bodies will enter as extra force stages between 2 and 4.
+``step`` mutates the State in place (its arrays swap with the Workspace's
+buffers), so no array is allocated inside the time loop.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from wovenimpact.errors import SimulationError
+from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels.gather import gather_nodal_forces
+from wovenimpact.kernels.integrate import central_difference_update, smooth_step
+from wovenimpact.kernels.shell import internal_force_for_shells
+from wovenimpact.state import (
+    ERODED_INTERNAL,
+    ERODED_KINETIC,
+    KINETIC,
+    KINETIC0,
+    W_EXT,
+    W_INT,
+    State,
+)
+
+DT_COLLAPSE = 1e-3  # a step below this fraction of the first one stops the run
+STATUS_TEXT = {
+    S.EL_INVERTED: "inverted or degenerate (non-positive area or Jacobian)",
+    S.EL_MATERIAL: "material point failed (no converged crimp heights or inadmissible stretch)",
+    S.EL_NAN: "non-finite force or time step (NaN/inf)",
+}
+
+
+@dataclass
+class Workspace:
+    """Preallocated scratch of one Model: swapped with the State's buffers each step."""
+
+    elem: np.ndarray
+    mat: np.ndarray
+    blocks: np.ndarray
+    status: np.ndarray
+    eroded_now: np.ndarray
+    f_int: np.ndarray
+    f_ext: np.ndarray
+    live: np.ndarray
+    w_int: np.ndarray
+    w_ext: np.ndarray
+    ke: np.ndarray
+    ke_eroded: np.ndarray
+
+    @classmethod
+    def for_model(cls, model, state: State) -> Workspace:
+        n, ne = model.n_nodes, model.n_elems
+        return cls(
+            elem=np.empty_like(state.elem), mat=np.empty_like(state.mat),
+            blocks=np.zeros((ne, 4, 6)), status=np.zeros(ne, dtype=np.int32),
+            eroded_now=np.zeros(ne, dtype=np.int32), f_int=np.zeros((n, 6)),
+            f_ext=np.zeros((n, 6)), live=np.zeros(n, dtype=np.int64), w_int=np.zeros(n),
+            w_ext=np.zeros(n), ke=np.zeros(n), ke_eroded=np.zeros(n),
+        )
+
+
+def element_forces(model, state: State, ws: Workspace) -> None:
+    """Stages 1–2: element forces at x^n and their nodal sums (into ws)."""
+    internal_force_for_shells(
+        state.x, state.v, state.omega, state.dt, model.quads, model.elem_section,
+        model.sections, model.mat_kind, model.mat_params, model.area0, model.ref_grad,
+        state.elem, ws.elem, state.mat, ws.mat, ws.blocks, ws.status, ws.eroded_now,
+    )
+    bad = np.flatnonzero(ws.status)
+    if bad.size:
+        e = int(bad[0])
+        raise SimulationError(
+            f"element {e} (nodes {model.quads[e].tolist()}) at t = {state.t:.6e} s, step "
+            f"{state.step}: {STATUS_TEXT.get(int(ws.status[e]), 'unknown failure')}"
+            + (f"; {bad.size} elements in this state" if bad.size > 1 else "")
+        )
+    gather_nodal_forces(model.node_ptr, model.node_elem, model.node_corner, ws.blocks, ws.elem,
+                        ws.f_int, ws.live)
+
+
+def stable_step(model, state: State, ws: Workspace, dt_cap: float) -> float:
+    """Stage 3: Δt = α min_e L_e/c_e (eq. 4.8), at most dt_cap; stops on collapse."""
+    dt_el = ws.elem[:, S.E_DT]
+    e = int(np.argmin(dt_el))
+    dt = min(model.alpha * float(dt_el[e]), dt_cap)
+    if not math.isfinite(dt) or dt <= 0.0:
+        raise SimulationError(
+            f"no stable time step at t = {state.t:.6e} s (element {e}: {dt_el[e]!r}); "
+            "every element eroded, or a non-finite state"
+        )
+    if state.dt_first > 0.0 and dt < DT_COLLAPSE * state.dt_first:
+        raise SimulationError(
+            f"time step collapsed at t = {state.t:.6e} s: Δt = {dt:.3e} s is below "
+            f"{DT_COLLAPSE:g} of the first step ({state.dt_first:.3e} s), governed by element "
+            f"{e} (nodes {model.quads[e].tolist()}): it is nearly crushed or distorted"
+        )
+    return dt
+
+
+def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
+    """Advance ``state`` from t^n to t^{n+1} in place (stages 1–5 of the module docstring)."""
+    element_forces(model, state, ws)
+    dt_new = stable_step(model, state, ws, dt_cap)
+    amplitude = smooth_step(state.t + 0.5 * dt_new, model.ramp_time)
+    central_difference_update(
+        model.node_mass, model.node_inertia, model.bc_code, model.bc_velocity, model.body_accel,
+        amplitude, state.dt, dt_new, ws.f_int, state.f_int, state.f_ext, ws.live,
+        state.x, state.v, state.omega, state.node_active, ws.f_ext,
+        ws.w_int, ws.w_ext, ws.ke, ws.ke_eroded,
+    )
+    if not np.isfinite(state.x).all():
+        n = int(np.flatnonzero(~np.isfinite(state.x).all(axis=1))[0])
+        raise SimulationError(f"node {n} has a non-finite position at t = {state.t:.6e} s")
+    en = state.energy
+    en[W_INT] += float(np.sum(ws.w_int))
+    en[W_EXT] += float(np.sum(ws.w_ext))
+    en[KINETIC] = float(np.sum(ws.ke))
+    en[ERODED_KINETIC] += float(np.sum(ws.ke_eroded))
+    if ws.eroded_now.any():
+        gone = ws.eroded_now != 0
+        en[ERODED_INTERNAL] += float(np.sum(
+            state.elem[gone, S.E_U_MEMB] + state.elem[gone, S.E_U_BEND] + state.elem[gone, S.E_U_HG]
+        ))
+    state.elem, ws.elem = ws.elem, state.elem
+    state.mat, ws.mat = ws.mat, state.mat
+    state.f_int, ws.f_int = ws.f_int, state.f_int
+    state.f_ext, ws.f_ext = ws.f_ext, state.f_ext
+    if state.dt_first == 0.0:
+        state.dt_first = dt_new
+    state.t += dt_new
+    state.dt = dt_new
+    state.step += 1
+
+
+def advance(model, state: State, ws: Workspace, t_stop: float, max_steps: int | None = None) -> int:
+    """Step until ``state.t ≥ t_stop`` (or ``max_steps``); returns the steps taken."""
+    taken = 0
+    while state.t < t_stop and (max_steps is None or taken < max_steps):
+        step(model, state, ws)
+        taken += 1
+    return taken
+
+
+def energy_balance(model, state: State) -> dict[str, float]:
+    """Energies (J) at the last whole step and the balance error.
+
+    total = kinetic + internal work + eroded kinetic − external work, which the
+    exact solution keeps at the initial kinetic energy; ``drift`` is total minus
+    its initial value, ``error_fraction`` the drift over the largest energy in play.
+    """
+    en = state.energy
+    stored = float(np.sum(state.elem[:, S.E_U_MEMB] + state.elem[:, S.E_U_BEND]))
+    hourglass = float(np.sum(state.elem[:, S.E_U_HG]))
+    total = en[KINETIC] + en[W_INT] + en[ERODED_KINETIC] - en[W_EXT]
+    drift = total - en[KINETIC0]
+    scale = max(en[KINETIC0], abs(en[W_EXT]), abs(en[W_INT]), en[KINETIC], 1e-300)
+    return {
+        "kinetic_J": float(en[KINETIC]),
+        "internal_work_J": float(en[W_INT]),
+        "stored_J": stored,
+        "hourglass_J": hourglass,
+        "external_work_J": float(en[W_EXT]),
+        "eroded_kinetic_J": float(en[ERODED_KINETIC]),
+        "eroded_internal_J": float(en[ERODED_INTERNAL]),
+        "total_J": float(total),
+        "drift_J": float(drift),
+        "error_fraction": float(abs(drift) / scale),
+    }

@@ -1,0 +1,120 @@
+"""State: everything that evolves during a run, as plain NumPy arrays.
+
+A checkpoint is a State (plus the Model digest); a restart loads it. The
+central-difference scheme keeps positions at whole steps and velocities at half
+steps: after ``n`` steps ``x`` is x^n and ``v``/``omega`` are v^{n−1/2}/ω^{n−1/2};
+``dt`` is the last step Δt^{n−1/2}. Energy accumulators are in ``energy``
+(indices below). docs/theory.md §3.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+import numpy as np
+
+from wovenimpact.kernels import shell_layout as S
+
+# indices of State.energy (J)
+W_INT = 0  # work of the internal forces (membrane, bending, shear, hourglass)
+W_EXT = 1  # work of external forces, body forces and support reactions
+KINETIC = 2  # kinetic energy at the last whole step (translational + rotational)
+ERODED_KINETIC = 3  # kinetic energy of nodes left without any element
+ERODED_INTERNAL = 4  # stored energy of elements at their erosion
+KINETIC0 = 5  # kinetic energy at t = 0
+N_ENERGY = 6
+ENERGY_NAMES = ("internal_work", "external_work", "kinetic", "eroded_kinetic",
+                "eroded_internal", "initial_kinetic")
+
+
+@dataclass
+class State:
+    """Evolving arrays of a run (SI).
+
+    Attributes:
+        t: time of ``x`` (s).
+        step: number of steps taken.
+        dt: last step Δt^{n−1/2} (s); 0 before the first step.
+        x: (n_nodes, 3) positions x^n.
+        v: (n_nodes, 3) velocities v^{n−1/2}.
+        omega: (n_nodes, 3) angular velocities ω^{n−1/2} (global axes).
+        elem: (n_elems, N_ELEM_STATE) element state (shell_layout).
+        mat: (n_elems, n_mat_state) material state of each element's point.
+        f_int: (n_nodes, 6) internal forces and moments at x^n.
+        f_ext: (n_nodes, 6) external forces, body forces and reactions at x^n.
+        node_active: (n_nodes,) 1 while a node belongs to at least one live element.
+        energy: (N_ENERGY,) accumulators (indices in this module).
+        dt_first: the first stable step (s), reference of the Δt-collapse check.
+    """
+
+    t: float
+    step: int
+    dt: float
+    x: np.ndarray
+    v: np.ndarray
+    omega: np.ndarray
+    elem: np.ndarray
+    mat: np.ndarray
+    f_int: np.ndarray
+    f_ext: np.ndarray
+    node_active: np.ndarray
+    energy: np.ndarray
+    dt_first: float = 0.0
+
+    def copy(self) -> State:
+        return State(**{f.name: (getattr(self, f.name).copy() if isinstance(
+            getattr(self, f.name), np.ndarray) else getattr(self, f.name)) for f in fields(self)})
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        """All fields as arrays (scalars as 0-d arrays): what a checkpoint stores."""
+        return {f.name: np.asarray(getattr(self, f.name)) for f in fields(self)}
+
+    @classmethod
+    def from_arrays(cls, data) -> State:
+        kw = {}
+        for f in fields(cls):
+            a = np.asarray(data[f.name])
+            kw[f.name] = a.item() if a.ndim == 0 else a.copy()
+        kw["step"] = int(kw["step"])
+        return cls(**kw)
+
+    def equals(self, other: State) -> bool:
+        """Bitwise equality of every field (determinism and restart checks)."""
+        for f in fields(self):
+            a, b = np.asarray(getattr(self, f.name)), np.asarray(getattr(other, f.name))
+            if a.shape != b.shape or a.tobytes() != b.tobytes():
+                return False
+        return True
+
+
+def initial_state(model, velocity=None, angular_velocity=None) -> State:
+    """State at t = 0: reference positions, the given velocity field, materials at rest.
+
+    Args:
+        model: the Model.
+        velocity: (3,) or (n_nodes, 3) initial velocities (m/s).
+        angular_velocity: (3,) or (n_nodes, 3) initial nodal spins (rad/s).
+    """
+    n, ne = model.n_nodes, model.n_elems
+    v = np.zeros((n, 3)) if velocity is None else np.broadcast_to(
+        np.asarray(velocity, dtype=float), (n, 3)).copy()
+    w = np.zeros((n, 3)) if angular_velocity is None else np.broadcast_to(
+        np.asarray(angular_velocity, dtype=float), (n, 3)).copy()
+    elem = np.zeros((ne, S.N_ELEM_STATE))
+    elem[:, S.E_F] = 1.0
+    elem[:, S.E_F + 3] = 1.0
+    elem[:, S.E_ALIVE] = 1.0
+    mat_of = model.sections[model.elem_section, S.C_MAT].astype(np.int64)
+    mat = model.mat_state0[mat_of].copy()
+    energy = np.zeros(N_ENERGY)
+    ke = 0.5 * (np.sum(model.node_mass[:, None] * v * v) + np.sum(model.node_inertia[:, None] * w * w))
+    energy[KINETIC] = ke
+    energy[KINETIC0] = ke
+    return State(t=0.0, step=0, dt=0.0, x=model.x0.copy(), v=v, omega=w, elem=elem, mat=mat,
+                 f_int=np.zeros((n, 6)), f_ext=np.zeros((n, 6)),
+                 node_active=np.ones(n, dtype=np.int8), energy=energy)
+
+
+def rigid_rotation_velocity(x: np.ndarray, omega, centre=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """v = ω × (x − c): the velocity field of a rigid rotation (rad/s about ``centre``)."""
+    return np.cross(np.asarray(omega, dtype=float), x - np.asarray(centre, dtype=float))

@@ -1,0 +1,133 @@
+"""io/fields.py: VTU frames of a plate model and the ParaView collection that lists them."""
+
+from __future__ import annotations
+
+import xml.etree.ElementTree as ET
+
+import meshio
+import numpy as np
+import pytest
+
+from wovenimpact.errors import InputError
+from wovenimpact.io.fields import PVD_NAME, FieldWriter, cell_blocks, read_pvd
+from wovenimpact.kernels import fabric_layout as FL
+from wovenimpact.kernels import shell_layout as S
+from wovenimpact.materials.metal import MetalParameters
+from wovenimpact.model import Section, build_model
+from wovenimpact.model.mesh import plate_mesh
+from wovenimpact.state import initial_state
+
+STEEL = MetalParameters(name="steel", kind="elastic", density=7850.0, modulus=210e9, poisson=0.3)
+
+
+@pytest.fixture
+def model():
+    m = plate_mesh(0.04, 0.01, plies=2, spacing=1e-3, quarter=True)
+    return build_model(m.nodes, m.quads, {"plate": Section(material=STEEL, thickness=1e-3)},
+                       np.zeros(len(m.quads), dtype=np.int64), ply=m.ply)
+
+
+def moved(model, k: int):
+    s = initial_state(model)
+    rng = np.random.default_rng(k)
+    s.t, s.step = k * 1e-6, 10 * k
+    s.x = model.x0 + 1e-4 * rng.standard_normal(model.x0.shape)
+    s.v = rng.standard_normal(model.x0.shape)
+    s.elem[:, S.E_N:S.E_N + 3] = rng.standard_normal((model.n_elems, 3))
+    s.elem[k % model.n_elems, S.E_ALIVE] = 0.0
+    return s
+
+
+def pvd_entries(path):
+    root = ET.parse(path).getroot()
+    assert root.tag == "VTKFile" and root.attrib["type"] == "Collection"
+    return [(float(d.attrib["timestep"]), d.attrib["file"]) for d in root.iter("DataSet")]
+
+
+def test_three_frames_read_back(tmp_path, model):
+    w = FieldWriter(tmp_path / "out", model)
+    states = [moved(model, k) for k in range(3)]
+    paths = [w.write(s) for s in states]
+    assert [p.name for p in paths] == ["step_000000.vtu", "step_000001.vtu", "step_000002.vtu"]
+    for s, p in zip(states, paths):
+        m = meshio.read(p)
+        assert len(m.cells) == 1 and m.cells[0].type == "quad"
+        assert np.array_equal(m.cells[0].data, model.quads)
+        assert np.array_equal(m.points, s.x)
+        assert np.array_equal(m.point_data["displacement"], s.x - model.x0)
+        assert np.array_equal(m.point_data["velocity"], s.v)
+        cd = {k: v[0] for k, v in m.cell_data.items()}
+        assert np.array_equal(cd["membrane_resultant"], s.elem[:, S.E_N:S.E_N + 3])
+        assert np.array_equal(cd["alive"], s.elem[:, S.E_ALIVE])
+        assert np.array_equal(cd["ply"], model.ply)
+        for name in ("tension_warp", "tension_fill", "damage_warp", "damage_fill"):
+            assert np.all(cd[name] == 0.0), name  # steel: not a fabric
+    entries = pvd_entries(tmp_path / "out" / PVD_NAME)
+    assert [f for _, f in entries] == [p.name for p in paths]
+    times = [t for t, _ in entries]
+    assert times == [s.t for s in states] and times == sorted(set(times))
+
+
+def test_explicit_time_and_no_going_back(tmp_path, model):
+    w = FieldWriter(tmp_path, model)
+    w.write(moved(model, 1), time=5e-6)
+    assert w.entries == ((5e-6, "step_000000.vtu"),)
+    with pytest.raises(InputError, match="before the last"):
+        w.write(moved(model, 2), time=4e-6)
+
+
+def test_resume_drops_later_frames(tmp_path, model):
+    w = FieldWriter(tmp_path, model)
+    for k in range(4):
+        w.write(moved(model, k))
+    r = FieldWriter.resume(tmp_path, model, t=1.5e-6)
+    assert [f for _, f in r.entries] == ["step_000000.vtu", "step_000001.vtu"]
+    assert not (tmp_path / "step_000002.vtu").exists()
+    assert pvd_entries(tmp_path / PVD_NAME) == list(r.entries)
+    r.write(moved(model, 2))
+    assert [f for _, f in read_pvd(tmp_path / PVD_NAME)] == [
+        "step_000000.vtu", "step_000001.vtu", "step_000002.vtu"]
+
+
+def test_resume_without_a_series_starts_one(tmp_path, model):
+    r = FieldWriter.resume(tmp_path / "new", model, t=0.0)
+    assert r.entries == ()
+    assert pvd_entries(tmp_path / "new" / PVD_NAME) == []
+
+
+def test_corrupt_collection_is_named(tmp_path, model):
+    (tmp_path / PVD_NAME).write_text("<VTKFile><Collection>")
+    with pytest.raises(InputError, match="fields.pvd"):
+        FieldWriter.resume(tmp_path, model, t=0.0)
+
+
+def test_fabric_columns_come_from_the_material_state(tmp_path, model, kevlar):
+    mesh = plate_mesh(0.02, 0.01)
+    sections = {"steel": Section(material=STEEL, thickness=1e-3),
+                "fabric": Section(material=kevlar, bending_modulus=1e9,
+                                  transverse_shear_modulus=3.28e9)}
+    which = np.array(["steel", "fabric", "fabric", "steel"])
+    fm = build_model(mesh.nodes, mesh.quads, sections, which)
+    s = initial_state(fm)
+    s.mat[:, FL.S_TENSION:FL.S_TENSION + 2] = [[1.0, 2.0], [3.0, 4.0], [5.0, 6.0], [7.0, 8.0]]
+    s.mat[:, FL.S_DAMAGE:FL.S_DAMAGE + 2] = 0.5
+    cd = {k: v[0] for k, v in meshio.read(FieldWriter(tmp_path, fm).write(s)).cell_data.items()}
+    assert cd["tension_warp"].tolist() == [0.0, 3.0, 5.0, 0.0]
+    assert cd["tension_fill"].tolist() == [0.0, 4.0, 6.0, 0.0]
+    assert cd["damage_warp"].tolist() == [0.0, 0.5, 0.5, 0.0]
+    assert cd["damage_fill"].tolist() == [0.0, 0.5, 0.5, 0.0]
+
+
+def test_triangles_go_to_their_own_block(tmp_path):
+    nodes = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 2, 0]], dtype=float)
+    quads = np.array([[0, 1, 2, 3], [3, 2, 4, 4]])
+    blocks = cell_blocks(quads)
+    assert [(k, i.tolist(), c.tolist()) for k, i, c in blocks] == [
+        ("quad", [0], [[0, 1, 2, 3]]), ("triangle", [1], [[3, 2, 4]])]
+    tm = build_model(nodes, quads, {"p": Section(material=STEEL, thickness=1e-3)}, [0, 0])
+    s = initial_state(tm)
+    s.elem[1, S.E_N] = 9.0
+    m = meshio.read(FieldWriter(tmp_path, tm).write(s))
+    assert [b.type for b in m.cells] == ["quad", "triangle"]
+    assert m.cell_data["element"][1].tolist() == [1]
+    assert m.cell_data["membrane_resultant"][1][0, 0] == 9.0

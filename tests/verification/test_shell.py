@@ -136,3 +136,173 @@ def test_cantilever_first_bending_frequency_matches_beam_theory():
     print(f"\ncantilever (10 × 2 elements, L/t = 20): f1 = {f_fe:.2f} Hz vs beam theory "
           f"{f_beam:.2f} Hz ({f_fe / f_beam - 1:+.2%}); energy error {eb['error_fraction']:.1e}")
     assert f_fe == pytest.approx(f_beam, rel=0.03)
+
+
+def test_longitudinal_wave_travels_at_the_plate_speed():
+    """A velocity step at one end of a strip held laterally (ε_yy = 0) travels at
+    c = √(E/(ρ(1 − ν²))); the front (half the driven velocity) is timed at two
+    stations (within 2 %)."""
+    length, n = 0.2, 200
+    nodes, quads = rect_grid(n, 1, length, length / n)
+    mat = elastic()
+    bc = BoundaryConditions(len(nodes), ramp_time=4e-6)
+    bc.fix(np.arange(len(nodes)), dofs=(1, 2, 3, 4, 5))
+    bc.prescribe(np.flatnonzero(nodes[:, 0] == 0.0), 0, 1.0)
+    model = build_model(nodes, quads, {"s": Section(mat, thickness=1e-3)},
+                        np.zeros(len(quads), int), bcs=bc)
+    st = initial_state(model)
+    ws = Workspace.for_model(model, st)
+    stations = [np.flatnonzero(np.isclose(nodes[:, 0], xs)) for xs in (0.05, 0.15)]
+    arrival = [None, None]
+    t_prev, v_prev = 0.0, [0.0, 0.0]
+    while arrival[1] is None:
+        step(model, st, ws)
+        t_half = st.t - 0.5 * st.dt  # velocities live at half steps
+        for k, s in enumerate(stations):
+            vk = st.v[s, 0].mean()
+            if arrival[k] is None and vk >= 0.5:  # interpolate the crossing in time
+                arrival[k] = t_prev + (0.5 - v_prev[k]) / (vk - v_prev[k]) * (t_half - t_prev)
+            v_prev[k] = vk
+        t_prev = t_half
+    c_fe = 0.1 / (arrival[1] - arrival[0])
+    c_exact = math.sqrt(mat.modulus / (mat.density * (1 - mat.poisson**2)))
+    print(f"\nlongitudinal wave: {c_fe:.1f} m/s vs √(E/(ρ(1−ν²))) = {c_exact:.1f} m/s "
+          f"({c_fe / c_exact - 1:+.2%})")
+    assert c_fe == pytest.approx(c_exact, rel=0.02)
+
+
+def test_free_vibration_conserves_energy_over_ten_periods():
+    """Cantilever in its first mode for 10 periods: |total energy drift| < 0.5 % of
+    the initial kinetic energy."""
+    length, t = 0.1, 5e-3
+    nodes, model, mat = cantilever(6, t, length)
+    f_beam = 1.875**2 / (2 * math.pi) * math.sqrt(mat.modulus * t**2 / 12 / (mat.density * length**4))
+    xi = nodes[:, 0] / length
+    shape = np.cosh(1.875 * xi) - np.cos(1.875 * xi) - 0.7341 * (np.sinh(1.875 * xi) - np.sin(1.875 * xi))
+    v0 = np.zeros((len(nodes), 3))
+    v0[:, 2] = 0.05 * shape
+    st = initial_state(model, velocity=v0)
+    ws = Workspace.for_model(model, st)
+    worst = 0.0
+    while st.t < 10.0 / f_beam:
+        step(model, st, ws)
+        worst = max(worst, abs(energy_balance(model, st)["drift_J"]))
+    ke0 = energy_balance(model, st)
+    print(f"\nfree vibration, 10 periods ({st.step} steps): max |drift| = "
+          f"{worst / st.energy[5]:.2e} of the initial kinetic energy")
+    assert worst < 5e-3 * st.energy[5]
+    assert ke0["hourglass_J"] < 1e-3 * st.energy[5]
+
+
+def test_stable_step_follows_the_formula():
+    """Δt = α L_e / c with L_e = A / longest edge and c = √(E/(ρ(1 − ν²))) (eq. 4.8–4.11),
+    for a 3 mm × 1 mm element (L_e = 1 mm)."""
+    nodes = np.array([[0, 0, 0], [3e-3, 0, 0], [3e-3, 1e-3, 0], [0, 1e-3, 0]], dtype=float)
+    mat = elastic()
+    model = build_model(nodes, [[0, 1, 2, 3]], {"s": Section(mat, thickness=1e-4)}, [0])
+    st = initial_state(model)
+    ws = Workspace.for_model(model, st)
+    step(model, st, ws)
+    c = math.sqrt(mat.modulus / (mat.density * (1 - mat.poisson**2)))
+    expected = 0.9 * (3e-6 / 3e-3) / c
+    print(f"\nstable step {st.dt:.6e} s vs α L_e / c = {expected:.6e} s")
+    assert st.dt == pytest.approx(expected, rel=1e-12)
+
+
+def test_fabric_strip_pulled_along_the_warp_reproduces_the_single_element_curve():
+    """Four crossover elements in a row, pulled slowly along the warp with the fill
+    edges free: the warp tension against the displacement per element follows the
+    single-element 'uniaxial-free' history (within 3 %), and the yarns break at its
+    failure displacement (within 3 %)."""
+    from tests.conftest import reference_fabric
+    from wovenimpact.calibration.single_element import run_element_test
+    from wovenimpact.kernels import fabric_layout as FL
+
+    fab = reference_fabric()
+    cell = 2.0 * fab.warp.half_length
+    n = 4
+    nodes, quads = rect_grid(n, 1, n * cell, cell)
+    left = np.flatnonzero(nodes[:, 0] == 0.0)
+    right = np.flatnonzero(np.isclose(nodes[:, 0], n * cell))
+    bc = BoundaryConditions(len(nodes), ramp_time=40e-6)
+    bc.fix(np.arange(len(nodes)), (2, 3, 4, 5)).fix(left, (0,)).fix(left[:1], (1,))
+    bc.prescribe(right, 0, 0.25)
+    sec = Section(fab, bending_modulus=1e9, transverse_shear_modulus=3.28e9)
+    model = build_model(nodes, quads, {"fabric": sec}, np.zeros(n, int), bcs=bc)
+    st = initial_state(model)
+    ws = Workspace.for_model(model, st)
+    u_hist, t_hist = [], []
+    while st.elem[:, S.E_ALIVE].all() and st.mat[:, FL.S_DAMAGE].max() == 0.0:
+        step(model, st, ws)
+        u_hist.append((st.x[right, 0].mean() - n * cell) / n)
+        t_hist.append(st.mat[:, FL.S_TENSION].mean())
+    u_fail = u_hist[-2]
+    ref = run_element_test(fab, "uniaxial-free", n_steps=600)
+    h = ref.history
+    probes = np.array([0.040e-3, 0.045e-3, 0.050e-3])
+    t_strip = np.interp(probes, u_hist, t_hist)
+    t_cell = np.interp(probes, h["displacement_m"], h["tension_w_N"])
+    dev = np.max(np.abs(t_strip / t_cell - 1.0))
+    print(f"\nfabric strip: T_w at {probes * 1e3} mm = {np.round(t_strip, 1)} N vs single "
+          f"element {np.round(t_cell, 1)} N (max deviation {dev:.1%}); failure at "
+          f"{u_fail * 1e3:.4f} mm vs {ref.failure_displacement_m * 1e3:.4f} mm")
+    assert dev < 0.03
+    assert u_fail == pytest.approx(ref.failure_displacement_m, rel=0.03)
+
+
+def test_hourglass_energy_stays_small_in_an_impulsively_loaded_plate():
+    """Coarse clamped plate, a patch of nodes kicked at 20 m/s (an impact-like
+    impulse that excites hourglass modes): hourglass energy < 5 % of internal energy."""
+    from wovenimpact.model.mesh import plate_mesh
+
+    mesh = plate_mesh(0.1, 0.01)
+    bc = BoundaryConditions(mesh.n_nodes).fix(mesh.node_sets["edge_outer"])
+    model = build_model(mesh.nodes, mesh.quads, {"s": Section(elastic(), thickness=1e-3)},
+                        np.zeros(mesh.n_elems, int), bcs=bc)
+    v0 = np.zeros((mesh.n_nodes, 3))
+    near = np.linalg.norm(mesh.nodes[:, :2], axis=1) < 0.011
+    v0[near, 2] = 20.0
+    st = initial_state(model, velocity=v0)
+    ws = Workspace.for_model(model, st)
+    worst = 0.0
+    while st.t < 100e-6:
+        step(model, st, ws)
+        eb = energy_balance(model, st)
+        if eb["stored_J"] > 0.05 * st.energy[5]:
+            worst = max(worst, eb["hourglass_J"] / eb["stored_J"])
+    eb = energy_balance(model, st)
+    print(f"\nimpulsively loaded plate: hourglass / internal energy max {worst:.2%}, final "
+          f"{eb['hourglass_J'] / eb['stored_J']:.2%}; energy error {eb['error_fraction']:.1e}")
+    assert worst < 0.05
+
+
+def test_steps_are_bitwise_identical_with_one_or_two_threads():
+    """The same Model and State give bitwise the same State after 30 steps of a
+    fabric plate under impact-like loading, with one thread or two."""
+    import numba
+
+    from tests.conftest import reference_fabric
+    from wovenimpact.jit import set_threads
+    from wovenimpact.model.mesh import plate_mesh
+
+    mesh = plate_mesh(0.01, 0.94e-3, quarter=True)
+    bc = BoundaryConditions(mesh.n_nodes).fix(mesh.node_sets["edge_outer"])
+    bc.symmetry(mesh.node_sets["symmetry_x"], 0).symmetry(mesh.node_sets["symmetry_y"], 1)
+    sec = Section(reference_fabric(), bending_modulus=1e9, transverse_shear_modulus=3.28e9)
+    model = build_model(mesh.nodes, mesh.quads, {"f": sec}, np.zeros(mesh.n_elems, int), bcs=bc)
+    v0 = np.zeros((mesh.n_nodes, 3))
+    v0[np.linalg.norm(mesh.nodes[:, :2], axis=1) < 2e-3, 2] = -100.0
+    results = []
+    before = numba.get_num_threads()
+    try:
+        for threads in sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)}):
+            set_threads(threads)
+            st = initial_state(model, velocity=v0)
+            ws = Workspace.for_model(model, st)
+            for _ in range(30):
+                step(model, st, ws)
+            results.append(st)
+    finally:
+        set_threads(before)
+    assert all(r.equals(results[0]) for r in results[1:])
+    assert results[0].mat[:, 9].max() > 0.0  # yarn tensions were exercised

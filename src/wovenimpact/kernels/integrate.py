@@ -6,7 +6,11 @@ isotropic lumped rotary inertia for the spins. Constrained degrees of freedom
 get their prescribed velocity; the force that imposes it is the support reaction,
 which enters the external work. Work is integrated by the trapezoid rule,
 W += ½ (f^{n−1} + f^n) · (x^n − x^{n−1}), per node; the caller sums the per-node
-terms (a deterministic reduction).
+terms (a deterministic reduction). The kinetic energy at t^n is the leapfrog form
+½ v^{n−1/2} · M v^{n+1/2}: with trapezoidal work it makes the energy balance exact
+for a linear system at constant Δt (the quantity central differences conserve);
+½ M ((v^{n−1/2} + v^{n+1/2})/2)² misreads modes near the stability limit by up
+to (ωΔt/2)².
 """
 
 from __future__ import annotations
@@ -42,6 +46,7 @@ def central_difference_update(
         dt_old, dt_new: Δt^{n−1/2}, Δt^{n+1/2}.
         f_int: (n, 6) internal forces at x^n; f_int_old, f_ext_old: at x^{n−1}.
         live_count: (n,) live elements per node (0 → the node is eroded now).
+        (Kinetic energy of the node: ½ m v^{n−1/2} · v^{n+1/2}, see the module docstring.)
         f_ext: (n, 6) written: body forces plus reactions at x^n.
         w_int, w_ext, ke, ke_eroded: (n,) written: per-node internal and external
             work increments over [x^{n−1}, x^n], kinetic energy at t^n, and kinetic
@@ -95,8 +100,7 @@ def central_difference_update(
                 ext = load
             f_ext[n, d] = ext
             w_ext[n] += 0.5 * (f_ext_old[n, d] + ext) * dt_old * old
-            vm = 0.5 * (old + new)
-            ke[n] += 0.5 * m_d * vm * vm
+            ke[n] += 0.5 * m_d * old * new
             if d < 3:
                 v[n, d] = new
                 x[n, d] += dt_new * new

@@ -15,7 +15,9 @@ positions x^n and the half-step velocities v^{n−1/2}, ω^{n−1/2}:
    γ̇_xz = b1·v_z + ¼Σθ̇_y, γ̇_yz = b2·v_z − ¼Σθ̇_x (zero for any rigid
    rotation), M += D Δκ, Q += k G t Δγ;
 4. hourglass control, Flanagan–Belytschko stiffness form, for the in-plane,
-   transverse and rotational modes, with its energy;
+   transverse and rotational modes, with its energy; generalized stiffnesses
+   r C_m A Σb², r 16 D Σb² and r D A Σb² (membrane, w, θ), each the order of the
+   physical energy of a smooth field with the same nodal values;
 5. the element's stable step L_e / c_e, L_e = A / max edge (eq. 4.9–4.11), c_e from
    the current membrane tangent and the transverse-shear wave speed.
 
@@ -331,7 +333,9 @@ def shell_force(
             k = r * c_memb * area * bb
             rates = (vx, vy)[j]
         elif j == 2:
-            k = r * kgt * area * bb
+            # w mode: the bilinear w of an element is the nodal-value trace of a
+            # twist; k = 16 D Σb² is its twist energy for a square element (r = 1)
+            k = r * 16.0 * d_b * bb
             rates = vz
         else:
             k = r * d_b * area * bb
@@ -374,13 +378,15 @@ def shell_force(
 @loop_kernel
 def internal_force_for_shells(
     x, v, omega, dt, quads, elem_section, sections, mat_kind, mat_params, area0, ref_grad,
-    el_in, el_out, m_in, m_out, blocks, status, eroded_now,
+    el_in, el_out, m_in, m_out, blocks, status, eroded_now, dt_erode,
 ):
     """``shell_force`` for every element (prange; each element writes its own rows).
 
     Args: positions/velocities/spins (n_nodes, 3); dt; Model arrays; element and
     material state in/out; blocks (n_elems, 4, 6) written; status, eroded_now
-    (n_elems,) written.
+    (n_elems,) written; dt_erode: an element whose own stable step L_e/c_e falls
+    below it is eroded (crushed or collapsed elements, e.g. fabric with one yarn
+    family broken; 0 disables).
     """
     ne = quads.shape[0]
     for e in prange(ne):
@@ -390,5 +396,12 @@ def internal_force_for_shells(
             x, v, omega, quads[e], dt, area0[e], ref_grad[e], sec, mat_kind[m], mat_params[m],
             el_in[e], el_out[e], m_in[e], m_out[e], blocks[e],
         )
+        if st == EL_OK and er == 0 and el_out[e, E_DT] < dt_erode:
+            el_out[e, E_ALIVE] = 0.0
+            el_out[e, E_DT] = math.inf
+            for i in range(4):
+                for j in range(6):
+                    blocks[e, i, j] = 0.0
+            er = 1
         status[e] = st
         eroded_now[e] = er

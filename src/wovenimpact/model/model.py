@@ -159,6 +159,10 @@ class Model:
         body_accel: (n_nodes, 3) body-force acceleration field (m/s²).
         node_ptr, node_elem, node_corner: CSR map node → (element, corner).
         alpha: stable-step factor (eq. 4.8, 0.9).
+        erode_dt_fraction: an element whose stable step α L_e/c_e falls below this
+            fraction of the first step of the run is eroded (LS-DYNA's DTMIN idea;
+            0 disables). Fabric with one yarn family broken has no stiffness
+            across it and crushes; without this the step would collapse.
         ply: (n_elems,) ply (or part) index of each element, for per-ply outputs.
         node_sets, elem_sets: named index arrays (outputs, BCs).
         section_names, material_names: labels for reports.
@@ -183,6 +187,7 @@ class Model:
     node_elem: np.ndarray
     node_corner: np.ndarray
     alpha: float
+    erode_dt_fraction: float
     ply: np.ndarray
     node_sets: dict = field(default_factory=dict)
     elem_sets: dict = field(default_factory=dict)
@@ -206,7 +211,7 @@ class Model:
             h.update(name.encode())
             h.update(str(a.dtype).encode() + str(a.shape).encode())
             h.update(a.tobytes())
-        h.update(repr((self.ramp_time, self.alpha)).encode())
+        h.update(repr((self.ramp_time, self.alpha, self.erode_dt_fraction)).encode())
         return h.hexdigest()
 
 
@@ -273,6 +278,7 @@ def build_model(
     warp_direction=(1.0, 0.0, 0.0),
     body_accel=None,
     alpha: float = 0.9,
+    erode_dt_fraction: float = 0.05,
     ply=None,
     node_sets: dict | None = None,
     elem_sets: dict | None = None,
@@ -289,6 +295,8 @@ def build_model(
             element to give its warp (material x) direction.
         body_accel: (3,) or (n_nodes, 3) body-force acceleration (m/s²).
         alpha: stable-step factor, 0 < α ≤ 1.
+        erode_dt_fraction: erode elements whose step falls below this fraction of
+            the first one, 0 ≤ f < 1 (0: never); default 0.05.
         ply: (n_elems,) part index for per-ply outputs; default all 0.
     """
     x0 = np.ascontiguousarray(nodes, dtype=float)
@@ -299,6 +307,10 @@ def build_model(
         raise InputError(f"quads must be an (n, 4) array, got shape {q.shape}")
     if q.size and (q.min() < 0 or q.max() >= len(x0)):
         raise InputError(f"quads refer to node {int(q.max())}, but there are {len(x0)} nodes")
+    if not 0.0 <= erode_dt_fraction < 1.0:
+        raise InputError(
+            f"erode_dt_fraction = {erode_dt_fraction!r}: valid 0 ≤ f < 1 (0 disables)"
+        )
     if not 0.0 < alpha <= 1.0:
         raise InputError(f"alpha = {alpha!r}: the stable-step factor must be in (0, 1]")
     names = list(sections)
@@ -361,6 +373,7 @@ def build_model(
         ref_grad=ref_grad, area0=area0, node_mass=node_mass, node_inertia=node_inertia,
         bc_code=bcs.code.copy(), bc_velocity=bcs.velocity.copy(), ramp_time=float(bcs.ramp_time),
         body_accel=ba, node_ptr=ptr, node_elem=n_elem, node_corner=n_corner, alpha=float(alpha),
+        erode_dt_fraction=float(erode_dt_fraction),
         ply=np.zeros(len(q), dtype=np.int64) if ply is None else np.asarray(ply, dtype=np.int64),
         node_sets=dict(node_sets or {}), elem_sets=dict(elem_sets or {}),
         section_names=tuple(names), material_names=tuple(getattr(m, "name", "") for m in mats),

@@ -78,6 +78,7 @@ def element_forces(model, state: State, ws: Workspace) -> None:
         state.x, state.v, state.omega, state.dt, model.quads, model.elem_section,
         model.sections, model.mat_kind, model.mat_params, model.area0, model.ref_grad,
         state.elem, ws.elem, state.mat, ws.mat, ws.blocks, ws.status, ws.eroded_now,
+        model.erode_dt_fraction * state.dt_first / model.alpha,
     )
     bad = np.flatnonzero(ws.status)
     if bad.size:

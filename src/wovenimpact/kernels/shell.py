@@ -170,6 +170,21 @@ def hourglass_vectors(lx, ly, b1, b2):
 
 
 @kernel
+def hourglass_mode(el_in, el_out, block, j, k, gam, gam_mid, rates, dt):
+    """One hourglass mode j (stiffness form): Q_j += k (γ_mid · rates) Δt, corner
+    forces γ_I Q_j added to block column j; returns the energy increment."""
+    rate = gam_mid[0] * rates[0] + gam_mid[1] * rates[1] + gam_mid[2] * rates[2] + (
+        gam_mid[3] * rates[3]
+    )
+    old = el_in[E_HG + j]
+    new = old + k * rate * dt
+    el_out[E_HG + j] = new
+    for i in range(4):
+        block[i, j] += gam[i] * new
+    return 0.5 * (old + new) * rate * dt
+
+
+@kernel
 def shell_force(
     x, v, omega, conn, dt, area0, grad0, sec, mat_kind, mat_par, el_in, el_out, m_in, m_out, block
 ):
@@ -327,27 +342,16 @@ def shell_force(
     gam, bb = hourglass_vectors(lx, ly, b1, b2)
     gam_mid = hourglass_vectors(mid[3][0], mid[3][1], mb1, mb2)[0]
     r = sec[C_HOURGLASS]
-    e_hg = 0.0
-    for j in range(5):
-        if j < 2:
-            k = r * c_memb * area * bb
-            rates = (vx, vy)[j]
-        elif j == 2:
-            # w mode: the bilinear w of an element is the nodal-value trace of a
-            # twist; k = 16 D Σb² is its twist energy for a square element (r = 1)
-            k = r * 16.0 * d_b * bb
-            rates = vz
-        else:
-            k = r * d_b * area * bb
-            rates = (tx, ty)[j - 3]
-        rate = (gam_mid[0] * rates[0] + gam_mid[1] * rates[1] + gam_mid[2] * rates[2]
-                + gam_mid[3] * rates[3])
-        old = el_in[E_HG + j]
-        new = old + k * rate * dt
-        el_out[E_HG + j] = new
-        e_hg += 0.5 * (old + new) * rate * dt
-        for i in range(4):
-            block[i, j] += gam[i] * new
+    k_m = r * c_memb * area * bb
+    # w mode: the bilinear w of an element is the nodal-value trace of a twist;
+    # k = 16 D Σb² is its twist energy for a square element (r = 1)
+    k_w = r * 16.0 * d_b * bb
+    k_t = r * d_b * area * bb
+    e_hg = hourglass_mode(el_in, el_out, block, 0, k_m, gam, gam_mid, vx, dt)
+    e_hg += hourglass_mode(el_in, el_out, block, 1, k_m, gam, gam_mid, vy, dt)
+    e_hg += hourglass_mode(el_in, el_out, block, 2, k_w, gam, gam_mid, vz, dt)
+    e_hg += hourglass_mode(el_in, el_out, block, 3, k_t, gam, gam_mid, tx, dt)
+    e_hg += hourglass_mode(el_in, el_out, block, 4, k_t, gam, gam_mid, ty, dt)
     el_out[E_U_HG] = el_in[E_U_HG] + e_hg
 
     # 5. back to global axes

@@ -16,7 +16,8 @@ buffers), so no array is allocated inside the time loop.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+import time
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -59,6 +60,15 @@ class Workspace:
     w_ext: np.ndarray
     ke: np.ndarray
     ke_eroded: np.ndarray
+    profile: bool = False
+    timings: dict = field(default_factory=dict)
+
+    def tick(self, stage: str, since: float) -> float:
+        """With ``profile`` on, add the time since ``since`` to ``stage``; returns now."""
+        now = time.perf_counter()
+        if self.profile:
+            self.timings[stage] = self.timings.get(stage, 0.0) + now - since
+        return now
 
     @classmethod
     def for_model(cls, model, state: State) -> Workspace:
@@ -74,6 +84,7 @@ class Workspace:
 
 def element_forces(model, state: State, ws: Workspace) -> None:
     """Stages 1–2: element forces at x^n and their nodal sums (into ws)."""
+    t0 = time.perf_counter()
     internal_force_for_shells(
         state.x, state.v, state.omega, state.dt, model.quads, model.elem_section,
         model.sections, model.mat_kind, model.mat_params, model.area0, model.ref_grad,
@@ -88,8 +99,10 @@ def element_forces(model, state: State, ws: Workspace) -> None:
             f"{state.step}: {STATUS_TEXT.get(int(ws.status[e]), 'unknown failure')}"
             + (f"; {bad.size} elements in this state" if bad.size > 1 else "")
         )
+    t0 = ws.tick("shell forces", t0)
     gather_nodal_forces(model.node_ptr, model.node_elem, model.node_corner, ws.blocks, ws.elem,
                         ws.f_int, ws.live)
+    ws.tick("gather", t0)
 
 
 def stable_step(model, state: State, ws: Workspace, dt_cap: float) -> float:
@@ -114,7 +127,9 @@ def stable_step(model, state: State, ws: Workspace, dt_cap: float) -> float:
 def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     """Advance ``state`` from t^n to t^{n+1} in place (stages 1–5 of the module docstring)."""
     element_forces(model, state, ws)
+    t0 = time.perf_counter()
     dt_new = stable_step(model, state, ws, dt_cap)
+    t0 = ws.tick("stable step", t0)
     amplitude = smooth_step(state.t + 0.5 * dt_new, model.ramp_time)
     central_difference_update(
         model.node_mass, model.node_inertia, model.bc_code, model.bc_velocity, model.body_accel,
@@ -122,6 +137,7 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
         state.x, state.v, state.omega, state.node_active, ws.f_ext,
         ws.w_int, ws.w_ext, ws.ke, ws.ke_eroded,
     )
+    t0 = ws.tick("integrate", t0)
     if not np.isfinite(state.x).all():
         n = int(np.flatnonzero(~np.isfinite(state.x).all(axis=1))[0])
         raise SimulationError(f"node {n} has a non-finite position at t = {state.t:.6e} s")
@@ -144,6 +160,7 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     state.t += dt_new
     state.dt = dt_new
     state.step += 1
+    ws.tick("bookkeeping", t0)
 
 
 def advance(model, state: State, ws: Workspace, t_stop: float, max_steps: int | None = None) -> int:

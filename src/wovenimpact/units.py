@@ -45,6 +45,7 @@ DIMENSIONS: dict[str, Dimension] = {
     "density": Dimension("kg/m^3", "a density", "1.44 g/cm^3"),
     "areal_density": Dimension("kg/m^2", "an areal density", "0.477 kg/m^2"),
     "velocity": Dimension("m/s", "a velocity", "120 m/s"),
+    "acceleration": Dimension("m/s^2", "an acceleration", "9.81 m/s^2"),
     "time": Dimension("s", "a time", "60 us"),
     "angular_velocity": Dimension("rad/s", "an angular velocity", "1047 rad/s"),
     "angle": Dimension("rad", "an angle", "90 deg"),

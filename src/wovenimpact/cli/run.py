@@ -1,0 +1,69 @@
+"""``wovenimpact run CASE.toml --out DIR``: run a case file with a progress bar."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import typer
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+
+from wovenimpact.cli.app import app, emit, err_console, fail
+from wovenimpact.errors import InputError, MaterialPointError, SimulationError
+
+
+def _bar(quiet: bool):
+    """A rich progress bar: simulated time, steps per second and ETA (wall clock)."""
+    progress = Progress(
+        TextColumn("[bold]{task.description}"),
+        BarColumn(),
+        TextColumn("t = {task.fields[t_us]:.2f} / {task.fields[end_us]:.2f} µs"),
+        TextColumn("{task.fields[rate]:,.0f} steps/s"),
+        TextColumn("ETA {task.fields[eta]}"),
+        TimeElapsedColumn(),
+        console=err_console,
+        disable=quiet,
+        transient=False,
+    )
+    return progress
+
+
+@app.command("run")
+def run(
+    case: Path = typer.Argument(..., help="Case file (TOML)."),
+    out: Path = typer.Option(..., "--out", help="Output directory."),
+    restart: bool = typer.Option(False, "--restart", help="Resume from the last checkpoint in OUT."),
+    threads: int = typer.Option(None, "--threads", min=1, help="Kernel threads (default: all)."),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON object (summary) on stdout."),
+) -> None:
+    """Run CASE to its end time; write history.csv, summary.json, fields/, plots/, checkpoints/."""
+    from wovenimpact.runs import run_case
+
+    bar = _bar(quiet=as_json)
+    task = bar.add_task(case.stem, total=1.0, t_us=0.0, end_us=0.0, rate=0.0, eta="?")
+    start = {"wall": time.perf_counter(), "step": None}
+
+    def report(state, end_time):
+        if start["step"] is None:  # the bar appears once the case has compiled
+            start["step"] = state.step
+            bar.start()
+        wall = time.perf_counter() - start["wall"]
+        done = state.step - start["step"]
+        rate = done / wall if wall > 0 else 0.0
+        frac = min(state.t / end_time, 1.0)
+        remaining = (max(end_time - state.t, 0.0) / state.dt / rate
+                     if rate > 0 and state.dt > 0 else None)
+        eta = "?" if remaining is None else time.strftime("%H:%M:%S", time.gmtime(remaining))
+        bar.update(task, completed=frac, t_us=state.t * 1e6, end_us=end_time * 1e6, rate=rate,
+                   eta=eta)
+
+    try:
+        summary = run_case(case, out, restart=restart, threads=threads, progress=report)
+    except (InputError, MaterialPointError) as err:
+        bar.stop()
+        fail(str(err))
+    except SimulationError as err:
+        bar.stop()
+        fail(f"the run stopped: {err}", code=3)
+    bar.stop()
+    emit(summary, as_json, f"{case.name}: summary (also in {out / 'summary.json'})")

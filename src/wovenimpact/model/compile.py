@@ -1,0 +1,136 @@
+"""From a validated case (:class:`~wovenimpact.spec.case.CaseSpec`) to Model and initial State.
+
+Reads the material files, makes the mesh (structured plate or Abaqus ``.inp``),
+assigns sections, turns the ``[[boundary]]`` entries into per-DOF constraints and
+the ``[[initial_velocity]]`` entries into the velocity field at t = 0. Errors name
+the case key that is wrong.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from wovenimpact.errors import InputError
+from wovenimpact.model.abaqus import read_inp
+from wovenimpact.model.mesh import Mesh, plate_mesh
+from wovenimpact.model.model import BoundaryConditions, Model, Section, build_model
+from wovenimpact.spec.case import DOFS, AbaqusMeshSpec, CaseSpec, PlateMeshSpec
+from wovenimpact.spec.material import load_material
+from wovenimpact.state import State, initial_state, rigid_rotation_velocity
+
+SYMMETRY_AXIS = {"symmetry_x": 0, "symmetry_y": 1, "symmetry_z": 2}
+
+
+@dataclass
+class CompiledCase:
+    """What a run needs: the Model, the State at t = 0 and the mesh it came from."""
+
+    model: Model
+    state: State
+    mesh: Mesh
+    materials: dict
+
+
+def _material_path(base: Path, name: str, rel: str) -> Path:
+    path = (base / rel).resolve()
+    if not path.is_file():
+        raise InputError(f"materials.{name}: file {rel!r} not found (looked for {path})")
+    return path
+
+
+def make_mesh(spec: CaseSpec, base: Path) -> tuple[Mesh, list[str]]:
+    """The mesh and each element's section name."""
+    m = spec.mesh
+    if isinstance(m, PlateMeshSpec):
+        mesh = plate_mesh(m.side, m.element_size, plies=m.plies, spacing=m.spacing or 0.0,
+                          quarter=m.quarter)
+        return mesh, [m.section] * mesh.n_elems
+    assert isinstance(m, AbaqusMeshSpec)
+    path = (base / m.file).resolve()
+    if not path.is_file():
+        raise InputError(f"mesh.file: {m.file!r} not found (looked for {path})")
+    mesh = read_inp(path)
+    names: list[str | None] = [None] * mesh.n_elems
+    for elset, section in m.sections.items():
+        if elset not in mesh.elem_sets:
+            raise InputError(f"mesh.sections: element set {elset!r} is not in {m.file}; "
+                             f"sets there: {sorted(mesh.elem_sets)}")
+        for e in mesh.elem_sets[elset]:
+            if names[e] is not None and names[e] != section:
+                raise InputError(f"mesh.sections: element {e} is in two sets with different "
+                                 f"sections ({names[e]!r} and {section!r})")
+            names[e] = section
+    missing = [e for e, s in enumerate(names) if s is None]
+    if missing:
+        raise InputError(f"mesh.sections: {len(missing)} elements (first: {missing[0]}) are in "
+                         "none of the listed element sets; every element needs a section")
+    return mesh, names  # type: ignore[return-value]
+
+
+def node_set(mesh: Mesh, name: str, key: str) -> np.ndarray:
+    if name == "all":
+        return np.arange(mesh.n_nodes)
+    if name not in mesh.node_sets:
+        raise InputError(f"{key}: node set {name!r} does not exist; sets: "
+                         f"{sorted(set(mesh.node_sets) | {'all'})}")
+    return np.asarray(mesh.node_sets[name], dtype=np.int64)
+
+
+def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
+    """Build the Model and the State at t = 0 of a case (paths relative to ``base``)."""
+    base = Path(base)
+    materials = {n: load_material(_material_path(base, n, rel)) for n, rel in spec.materials.items()}
+    sections = {
+        name: Section(
+            material=materials[s.material], thickness=s.thickness,
+            bending_modulus=s.bending_modulus, bending_poisson=s.bending_poisson,
+            transverse_shear_modulus=s.transverse_shear_modulus, shear_factor=s.shear_factor,
+            hourglass=s.hourglass, areal_mass=s.areal_mass,
+        )
+        for name, s in spec.sections.items()
+    }
+    mesh, elem_sections = make_mesh(spec, base)
+    bcs = BoundaryConditions(mesh.n_nodes, ramp_time=spec.amplitude.ramp_time)
+    for i, b in enumerate(spec.boundary):
+        nodes = node_set(mesh, b.nodes, f"boundary[{i}].nodes")
+        if b.type == "clamped":
+            bcs.fix(nodes)
+        elif b.type == "pinned":
+            bcs.fix(nodes, (0, 1, 2))
+        elif b.type in SYMMETRY_AXIS:
+            bcs.symmetry(nodes, SYMMETRY_AXIS[b.type])
+        else:
+            bcs.prescribe(nodes, DOFS.index(b.dof), b.velocity)
+    accel = None if spec.body_force is None else spec.body_force.acceleration
+    used = {s: i for i, s in enumerate(dict.fromkeys(elem_sections))}
+    model = build_model(
+        mesh.nodes, mesh.quads, {s: sections[s] for s in used},
+        np.array([used[s] for s in elem_sections], dtype=np.int64), bcs=bcs,
+        warp_direction=spec.mesh.warp_direction, body_accel=accel, alpha=spec.run.alpha,
+        erode_dt_fraction=spec.run.erode_dt_fraction, ply=mesh.ply,
+        node_sets=mesh.node_sets, elem_sets=mesh.elem_sets,
+    )
+    v = np.zeros((mesh.n_nodes, 3))
+    w = np.zeros((mesh.n_nodes, 3))
+    for i, iv in enumerate(spec.initial_velocity):
+        nodes = node_set(mesh, iv.nodes, f"initial_velocity[{i}].nodes")
+        centre = np.asarray(iv.centre)
+        if iv.radius is not None:
+            nodes = nodes[np.linalg.norm(mesh.nodes[nodes] - centre, axis=1) <= iv.radius]
+            if nodes.size == 0:
+                raise InputError(f"initial_velocity[{i}].radius: no node of {iv.nodes!r} lies "
+                                 f"within {iv.radius:g} m of {centre.tolist()}")
+        if iv.velocity is not None:
+            v[nodes] += np.asarray(iv.velocity)
+        if iv.angular_velocity is not None:
+            v[nodes] += rigid_rotation_velocity(mesh.nodes[nodes], iv.angular_velocity, centre)
+            w[nodes] += np.asarray(iv.angular_velocity)
+    # constrained degrees of freedom start at their constraint
+    fixed = model.bc_code[:, :3] == 1
+    v[fixed] = 0.0
+    w[model.bc_code[:, 3:] == 1] = 0.0
+    state = initial_state(model, velocity=v, angular_velocity=w)
+    return CompiledCase(model=model, state=state, mesh=mesh, materials=materials)

@@ -1,0 +1,239 @@
+"""Case files (TOML) → a validated :class:`CaseSpec` with every quantity in SI.
+
+A case says what to simulate: materials (by file), shell sections, the mesh (a
+generated plate or an Abaqus ``.inp``), constraints, initial velocities, body
+force and the run controls. Every dimensioned value carries its unit; unknown
+keys, missing units, wrong dimensions and out-of-range values are reported
+together, one line each, naming the key::
+
+    plate.toml: run.end_time: has no unit (got '200'; valid: a time > 0 such as '60 us')
+
+Schema (see README and examples/cases/)::
+
+    [case]            name, description
+    [materials]       NAME = "path/to/material.toml"   (relative to the case file)
+    [sections.NAME]   material, thickness?, bending_modulus?, bending_poisson?,
+                      transverse_shear_modulus?, shear_factor?, hourglass?, areal_mass?
+    [mesh]            kind = "plate": side, element_size, plies, spacing, quarter,
+                      section, warp_direction   | kind = "abaqus": file, sections
+                      = {ELSET = SECTION}, warp_direction
+    [[boundary]]      nodes = SET, type = clamped | pinned | symmetry_x | symmetry_y |
+                      symmetry_z | velocity (with dof and velocity)
+    [amplitude]       ramp_time (smooth step of prescribed velocities, thesis Fig. 8-3)
+    [[initial_velocity]]  nodes = SET, velocity = [vx, vy, vz] and/or
+                      angular_velocity = [wx, wy, wz] about centre; optional radius
+                      (only nodes within it of centre)
+    [body_force]      acceleration = [ax, ay, az]
+    [run]             end_time, field_interval, history_interval, checkpoint_interval,
+                      alpha, erode_dt_fraction, threads
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import tomllib
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, Field, ValidationError, model_validator
+
+from wovenimpact.errors import InputError
+from wovenimpact.spec.fields import (
+    STRICT,
+    Problem,
+    input_error,
+    problems_from_validation,
+    quantity,
+)
+
+Length = quantity("length", gt=0, example="0.94 mm")
+Time = quantity("time", gt=0, example="10 us")
+Velocity = quantity("velocity", example="-120 m/s")
+Spin = quantity("angular_velocity", example="1047 rad/s")
+Accel = quantity("acceleration", example="-9.81 m/s^2")
+Coordinate = quantity("length", example="0 mm")
+DOFS = ("ux", "uy", "uz", "rx", "ry", "rz")
+
+
+class CaseInfo(BaseModel):
+    """``[case]``: a name and a free description for reports."""
+
+    model_config = STRICT
+    name: str = Field(min_length=1)
+    description: str = ""
+
+
+class SectionSpec(BaseModel):
+    """``[sections.NAME]``: a shell section (thickness and the stiffnesses the material lacks)."""
+
+    model_config = STRICT
+    material: str = Field(min_length=1)
+    thickness: Length | None = None
+    bending_modulus: quantity("pressure", gt=0, example="1 GPa") | None = None
+    bending_poisson: quantity("dimensionless", ge=0, lt=0.5, example="0") | None = None
+    transverse_shear_modulus: quantity("pressure", gt=0, example="3.28 GPa") | None = None
+    shear_factor: quantity("dimensionless", gt=0, le=1, example="0.8333") = 5.0 / 6.0
+    hourglass: quantity("dimensionless", ge=0, lt=1, example="0.05") = 0.05
+    areal_mass: quantity("areal_density", gt=0, example="0.477 kg/m^2") | None = None
+
+
+class PlateMeshSpec(BaseModel):
+    """``[mesh] kind = "plate"``: square plies from the structured generator."""
+
+    model_config = STRICT
+    kind: Literal["plate"]
+    side: Length
+    element_size: Length
+    plies: int = Field(default=1, ge=1)
+    spacing: Length | None = None
+    quarter: bool = False
+    section: str = Field(min_length=1)
+    warp_direction: tuple[float, float, float] = (1.0, 0.0, 0.0)
+
+
+class AbaqusMeshSpec(BaseModel):
+    """``[mesh] kind = "abaqus"``: nodes, shell elements and sets from an ``.inp`` file."""
+
+    model_config = STRICT
+    kind: Literal["abaqus"]
+    file: str = Field(min_length=1)
+    sections: dict[str, str] = Field(min_length=1)  # element set → section name
+    warp_direction: tuple[float, float, float] = (1.0, 0.0, 0.0)
+
+
+class BoundarySpec(BaseModel):
+    """``[[boundary]]``: a constraint on a node set."""
+
+    model_config = STRICT
+    nodes: str = Field(min_length=1)
+    type: Literal["clamped", "pinned", "symmetry_x", "symmetry_y", "symmetry_z", "velocity"]
+    dof: Literal["ux", "uy", "uz", "rx", "ry", "rz"] | None = None
+    velocity: Velocity | None = None
+
+    @model_validator(mode="after")
+    def _velocity_needs_dof(self):
+        if self.type == "velocity" and (self.dof is None or self.velocity is None):
+            raise ValueError("a 'velocity' boundary needs dof (ux … rz) and velocity (with unit)")
+        if self.type != "velocity" and (self.dof is not None or self.velocity is not None):
+            raise ValueError(f"dof and velocity belong to type = 'velocity', not {self.type!r}")
+        return self
+
+
+class AmplitudeSpec(BaseModel):
+    """``[amplitude]``: rise time of the smooth step applied to prescribed velocities."""
+
+    model_config = STRICT
+    ramp_time: quantity("time", ge=0, example="20 us") = 0.0
+
+
+class InitialVelocitySpec(BaseModel):
+    """``[[initial_velocity]]``: translation and/or rigid rotation of a node set at t = 0."""
+
+    model_config = STRICT
+    nodes: str = "all"
+    velocity: tuple[Velocity, Velocity, Velocity] | None = None
+    angular_velocity: tuple[Spin, Spin, Spin] | None = None
+    centre: tuple[Coordinate, Coordinate, Coordinate] = (0.0, 0.0, 0.0)
+    radius: Length | None = None
+
+    @model_validator(mode="after")
+    def _something(self):
+        if self.velocity is None and self.angular_velocity is None:
+            raise ValueError("give velocity = [vx, vy, vz] and/or angular_velocity = [wx, wy, wz]")
+        return self
+
+
+class BodyForceSpec(BaseModel):
+    """``[body_force]``: a uniform acceleration field (gravity, later centrifugal loads)."""
+
+    model_config = STRICT
+    acceleration: tuple[Accel, Accel, Accel]
+
+
+class RunSpec(BaseModel):
+    """``[run]``: how long, how often to write, and solver controls."""
+
+    model_config = STRICT
+    end_time: Time
+    field_interval: Time | None = None
+    history_interval: Time | None = None
+    checkpoint_interval: Time | None = None
+    alpha: quantity("dimensionless", gt=0, le=1, example="0.9") = 0.9
+    erode_dt_fraction: quantity("dimensionless", ge=0, lt=1, example="0.05") = 0.05
+    threads: int | None = Field(default=None, ge=1)
+
+
+class CaseSpec(BaseModel):
+    """A whole case file."""
+
+    model_config = STRICT
+    case: CaseInfo
+    materials: dict[str, str] = Field(min_length=1)
+    sections: dict[str, SectionSpec] = Field(min_length=1)
+    mesh: PlateMeshSpec | AbaqusMeshSpec = Field(discriminator="kind")
+    boundary: list[BoundarySpec] = []
+    amplitude: AmplitudeSpec = AmplitudeSpec()
+    initial_velocity: list[InitialVelocitySpec] = []
+    body_force: BodyForceSpec | None = None
+    run: RunSpec
+
+
+def check_references(spec: CaseSpec) -> list[Problem]:
+    """Cross-references a schema cannot see: section → material, mesh → section."""
+    problems = []
+    for name, sec in spec.sections.items():
+        if sec.material not in spec.materials:
+            problems.append(Problem(f"sections.{name}.material", "names no material",
+                                    sec.material, f"one of {sorted(spec.materials)}"))
+    used = [spec.mesh.section] if isinstance(spec.mesh, PlateMeshSpec) else list(
+        spec.mesh.sections.values())
+    key = "mesh.section" if isinstance(spec.mesh, PlateMeshSpec) else "mesh.sections"
+    for s in used:
+        if s not in spec.sections:
+            problems.append(Problem(key, "names no section", s, f"one of {sorted(spec.sections)}"))
+    if isinstance(spec.mesh, PlateMeshSpec) and spec.mesh.plies > 1 and spec.mesh.spacing is None:
+        problems.append(Problem("mesh.spacing", "is missing", valid="the distance between ply "
+                                "mid-planes, e.g. '0.5 mm', needed when plies > 1"))
+    run = spec.run
+    for k in ("field_interval", "history_interval", "checkpoint_interval"):
+        v = getattr(run, k)
+        if v is not None and v > run.end_time:
+            problems.append(Problem(f"run.{k}", "is longer than run.end_time", v,
+                                    f"at most {run.end_time:g} s"))
+    return problems
+
+
+def _without_mesh_kind(p: Problem) -> Problem:
+    """``mesh.plate.side`` → ``mesh.side``: the kind selects the table, it is not a key."""
+    for kind in ("plate", "abaqus"):
+        if p.path.startswith(f"mesh.{kind}."):
+            return dataclasses.replace(p, path="mesh." + p.path[len(kind) + 6:])
+    return p
+
+
+def case_from_dict(doc: dict[str, Any], source: str = "<dict>") -> CaseSpec:
+    """Validate a parsed case document; all problems are raised in one InputError."""
+    try:
+        spec = CaseSpec.model_validate(doc)
+    except ValidationError as err:
+        problems = [_without_mesh_kind(p) for p in problems_from_validation(err, CaseSpec)]
+        raise input_error(problems, source) from None
+    problems = check_references(spec)
+    if problems:
+        raise input_error(problems, source)
+    return spec
+
+
+def load_case(path: str | Path) -> tuple[CaseSpec, Path]:
+    """Read and validate a case file; returns the spec and the file's directory
+    (material and mesh paths in the case are relative to it)."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as err:
+        raise InputError(f"{path}: cannot read the case file ({err.strerror})") from None
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise InputError(f"{path}: not valid TOML: {err}") from None
+    return case_from_dict(doc, source=str(path)), path.resolve().parent

@@ -1,0 +1,132 @@
+"""``wovenimpact run``: outputs, JSON summary, restart identity and input errors."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from wovenimpact.cli.app import app
+from wovenimpact.io.checkpoint import latest_checkpoint, load_checkpoint
+from wovenimpact.model.compile import compile_case
+from wovenimpact.runs import run_case
+from wovenimpact.spec.case import load_case
+
+ROOT = Path(__file__).resolve().parents[2]
+KEVLAR = ROOT / "examples" / "materials" / "kevlar_thesis.toml"
+
+CASE = """
+[case]
+name = "small fabric plate"
+
+[materials]
+kevlar = "{kevlar}"
+
+[sections.fabric]
+material = "kevlar"
+bending_modulus = "1 GPa"
+transverse_shear_modulus = "3.28 GPa"
+
+[mesh]
+kind = "plate"
+side = "10 mm"
+element_size = "0.94 mm"
+quarter = true
+section = "fabric"
+
+[[boundary]]
+nodes = "edge_outer"
+type = "clamped"
+
+[[boundary]]
+nodes = "symmetry_x"
+type = "symmetry_x"
+
+[[boundary]]
+nodes = "symmetry_y"
+type = "symmetry_y"
+
+[[initial_velocity]]
+velocity = ["0 m/s", "0 m/s", "-60 m/s"]
+radius = "1.5 mm"
+
+[run]
+end_time = "{end}"
+field_interval = "5 us"
+history_interval = "0.5 us"
+checkpoint_interval = "4 us"
+"""
+
+
+def write_case(tmp_path: Path, end="20 us", text=CASE, name="case.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(text.format(kevlar=KEVLAR.as_posix(), end=end), encoding="utf-8")
+    return path
+
+
+def test_run_writes_every_output_and_a_json_summary(tmp_path):
+    case = write_case(tmp_path)
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, ["run", str(case), "--out", str(out), "--json"])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout.strip().splitlines()[-1])
+    for key in ("steps", "wall_time_s", "ns_per_element_cycle", "energy_error_fraction",
+                "max_displacement_m", "element_cycles"):
+        assert key in summary
+    assert summary["end_time_s"] >= 20e-6
+    assert summary["energy_error_fraction"] < 1e-3
+    assert json.loads((out / "summary.json").read_text())["steps"] == summary["steps"]
+    header = (out / "history.csv").read_text().splitlines()[0].split(",")
+    assert header[0] == "time_s" and "kinetic_energy_J" in header
+    assert (out / "plots" / "energy.png").stat().st_size > 1000
+    pvd = (out / "fields" / "fields.pvd").read_text()
+    assert pvd.count("<DataSet") == 1 + 4  # t = 0, then every 5 µs to 20 µs
+    assert latest_checkpoint(out / "checkpoints") is not None
+
+
+def test_restart_ends_bitwise_identical_to_an_uninterrupted_run(tmp_path):
+    case = write_case(tmp_path, end="12 us")
+    whole, broken = tmp_path / "whole", tmp_path / "broken"
+    run_case(case, whole)
+    partial = run_case(case, broken, max_steps=60)  # "killed" after the 4 µs checkpoint
+    assert "interrupted_at_step" in partial
+    run_case(case, broken, restart=True)
+    assert (whole / "history.csv").read_text() == (broken / "history.csv").read_text()
+    spec, base = load_case(case)
+    digest = compile_case(spec, base).model.digest()
+    a = load_checkpoint(latest_checkpoint(whole / "checkpoints"), digest)
+    b = load_checkpoint(latest_checkpoint(broken / "checkpoints"), digest)
+    assert a.equals(b)
+    fa = sorted(p.name for p in (whole / "fields").glob("*.vtu"))
+    fb = sorted(p.name for p in (broken / "fields").glob("*.vtu"))
+    assert fa == fb
+
+
+@pytest.mark.parametrize(
+    "edit, message",
+    [
+        (("[run]", "[run]\nbogus = 1"), "run.bogus"),
+        (('end_time = "{end}"', 'end_time = "20"'), "run.end_time"),
+        (('element_size = "0.94 mm"', 'element_size = "-0.94 mm"'), "mesh.element_size"),
+        (('nodes = "edge_outer"', 'nodes = "rim"'), "boundary[0].nodes"),
+        (('material = "kevlar"', 'material = "aramid"'), "sections.fabric.material"),
+        (('velocity = ["0 m/s", "0 m/s", "-60 m/s"]', 'velocity = ["0 m/s", "0 m/s"]'),
+         "initial_velocity"),
+    ],
+)
+def test_bad_case_files_give_errors_that_name_the_key(tmp_path, edit, message):
+    case = write_case(tmp_path, text=CASE.replace(*edit))
+    result = CliRunner().invoke(app, ["run", str(case), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2
+    assert message in result.output
+
+
+@pytest.mark.parametrize("case", sorted((ROOT / "examples" / "cases").glob("*.toml")))
+def test_example_cases_are_valid_and_compile(case):
+    spec, base = load_case(case)
+    compiled = compile_case(spec, base)
+    assert compiled.model.n_elems > 0
+    assert np.any(compiled.state.v != 0.0) or spec.boundary

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from tests.verification.meshes import elastic, rect_grid
+from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels import shell_layout as S
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.solver import Workspace, energy_balance, step
@@ -216,8 +217,6 @@ def test_fabric_strip_pulled_along_the_warp_reproduces_the_single_element_curve(
     failure displacement (within 3 %)."""
     from tests.conftest import reference_fabric
     from wovenimpact.calibration.single_element import run_element_test
-    from wovenimpact.kernels import fabric_layout as FL
-
     fab = reference_fabric()
     cell = 2.0 * fab.warp.half_length
     n = 4
@@ -305,4 +304,65 @@ def test_steps_are_bitwise_identical_with_one_or_two_threads():
     finally:
         set_threads(before)
     assert all(r.equals(results[0]) for r in results[1:])
-    assert results[0].mat[:, 9].max() > 0.0  # yarn tensions were exercised
+    assert results[0].mat[:, FL.S_TENSION].max() > 0.0  # yarn tensions were exercised
+
+
+def test_body_force_accelerates_a_free_plate_uniformly_and_its_work_is_booked():
+    """A free plate under a uniform body force a: every node has v = a t (exact for
+    central differences), no stress, and the external work equals the kinetic energy."""
+    nodes, quads = rect_grid(4, 3, 0.04, 0.03)
+    g = np.array([0.0, 3.0, -9.81])
+    model = build_model(nodes, quads, {"s": Section(elastic(), thickness=1e-3)},
+                        np.zeros(len(quads), int), body_accel=g)
+    st = initial_state(model)
+    ws = Workspace.for_model(model, st)
+    for _ in range(200):
+        step(model, st, ws)
+    t_half = st.t - 0.5 * st.dt
+    eb = energy_balance(model, st)
+    print(f"\nbody force: velocity error {np.max(np.abs(st.v - g * t_half)):.1e} m/s, "
+          f"W_ext − KE = {eb['external_work_J'] - eb['kinetic_J']:.1e} J")
+    # exact up to the round-off stresses of x = x0 + u (strains ~1e-15, forces ~1e-9 N)
+    assert np.max(np.abs(st.v - g * t_half)) < 1e-6 * np.linalg.norm(g) * t_half
+    assert np.max(np.abs(st.elem[:, S.E_N:S.E_N + 3])) < 1e-12 * 210e9 * 1e-3
+    assert eb["external_work_J"] == pytest.approx(eb["kinetic_J"], rel=1e-9)
+
+
+def test_eroded_element_gives_no_force_and_its_energy_is_booked():
+    """Two separate fabric elements; the corners of the first are driven outwards
+    (equibiaxial, 5 m/s after a smooth 10 µs ramp) until both yarn families break at
+    T_u: it erodes, its four nodes are left without an element and leave the model;
+    their kinetic energy moves to the eroded term and the balance
+    KE + W_int + E_eroded,kin − W_ext = KE0 still holds. The second element, at rest,
+    is untouched."""
+    from tests.conftest import reference_fabric
+
+    fab = reference_fabric()
+    c = 2.0 * fab.warp.half_length
+    square = np.array([[0, 0, 0], [c, 0, 0], [c, c, 0], [0, c, 0]], dtype=float)
+    nodes = np.vstack([square, square + [3 * c, 0, 0]])
+    bc = BoundaryConditions(len(nodes), ramp_time=10e-6)
+    for i, (sx, sy) in enumerate([(-1, -1), (1, -1), (1, 1), (-1, 1)]):
+        bc.prescribe([i], 0, 5.0 * sx).prescribe([i], 1, 5.0 * sy)
+    model = build_model(nodes, [[0, 1, 2, 3], [4, 5, 6, 7]], {"f": Section(
+        fab, bending_modulus=1e9, transverse_shear_modulus=3.28e9)}, [0, 0], bcs=bc)
+    st = initial_state(model)
+    ws = Workspace.for_model(model, st)
+    peak = 0.0
+    while st.elem[0, S.E_ALIVE] == 1.0 and st.step < 20000:
+        step(model, st, ws)
+        peak = max(peak, float(np.max(st.mat[0, FL.S_TENSION:FL.S_TENSION + 2])))
+    assert st.elem[0, S.E_ALIVE] == 0.0, "the element never eroded"
+    for _ in range(5):
+        step(model, st, ws)
+    eb = energy_balance(model, st)
+    print(f"\nerosion at t = {st.t * 1e6:.2f} µs after a peak tension {peak:.1f} N; eroded "
+          f"kinetic {eb['eroded_kinetic_J']:.3e} J, external work {eb['external_work_J']:.3e} J, "
+          f"balance error {eb['error_fraction']:.1e}")
+    # the last intact step is within one load increment (~20 N here) below T_u
+    assert 0.9 * fab.warp.ultimate_tension < peak < fab.warp.ultimate_tension
+    assert np.all(st.node_active[:4] == 0) and np.all(st.v[:4] == 0.0)
+    assert np.all(st.f_int[:4] == 0.0)
+    assert np.all(st.node_active[4:] == 1) and st.elem[1, S.E_ALIVE] == 1.0
+    assert eb["eroded_kinetic_J"] > 0.0
+    assert eb["error_fraction"] < 1e-3

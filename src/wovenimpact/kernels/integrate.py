@@ -71,6 +71,10 @@ def central_difference_update(
             du = dt_old * vel
             w_int[n] += 0.5 * (f_int_old[n, d] + f_int[n, d]) * du
         if live_count[n] == 0:
+            # the loads of the last step still did work over [x^{n−1}, x^n]
+            for d in range(6):
+                vel = v[n, d] if d < 3 else omega[n, d - 3]
+                w_ext[n] += 0.5 * f_ext_old[n, d] * dt_old * vel
             # the node has lost its last element: it leaves the model with its energy
             e = 0.0
             for d in range(3):

@@ -174,3 +174,20 @@ end_time = "1 us"
     assert compiled.model.n_elems == n and compiled.model.n_nodes == 2 * (n + 1)
     summary = run_case(case, tmp_path / "out")
     assert summary["steps"] > 0 and summary["energy_error_fraction"] < 1e-6
+
+
+def test_initial_rigid_rotation_sets_v_equal_omega_cross_r(tmp_path):
+    text = CASE.replace(
+        '[[initial_velocity]]\nvelocity = ["0 m/s", "0 m/s", "-60 m/s"]\nradius = "1.5 mm"',
+        '[[initial_velocity]]\nangular_velocity = ["0 rad/s", "100 rad/s", "1047 rad/s"]\n'
+        'centre = ["1 mm", "2 mm", "0 mm"]',
+    )
+    case = write_case(tmp_path, text=text)
+    spec, base = load_case(case)
+    st = compile_case(spec, base).state
+    model = compile_case(spec, base).model
+    omega = np.array([0.0, 100.0, 1047.0])
+    expect = np.cross(omega, model.x0 - [1e-3, 2e-3, 0.0])
+    free = model.bc_code[:, :3] == 0
+    assert np.allclose(st.v[free], expect[free], rtol=0, atol=1e-12)
+    assert np.all(st.v[~free] == 0.0)

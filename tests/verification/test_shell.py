@@ -366,3 +366,24 @@ def test_eroded_element_gives_no_force_and_its_energy_is_booked():
     assert np.all(st.node_active[4:] == 1) and st.elem[1, S.E_ALIVE] == 1.0
     assert eb["eroded_kinetic_J"] > 0.0
     assert eb["error_fraction"] < 1e-3
+
+
+def test_a_crushed_element_stops_the_run_with_a_message_naming_it():
+    """A node driven into its neighbours at 1 km/s (distortion erosion off) crushes an
+    element: the run stops (step collapse or inversion) with a SimulationError naming
+    the element, its nodes and the time."""
+    from wovenimpact.errors import SimulationError
+
+    nodes, quads = rect_grid(3, 3, 0.03, 0.03)
+    model = build_model(nodes, quads, {"s": Section(elastic(), thickness=1e-3)},
+                        np.zeros(len(quads), int), erode_dt_fraction=0.0)
+    v0 = np.zeros((len(nodes), 3))
+    v0[5, 0] = 1000.0  # an interior node, towards its neighbour at +x
+    st = initial_state(model, velocity=v0)
+    ws = Workspace.for_model(model, st)
+    with pytest.raises(SimulationError) as err:
+        for _ in range(10000):
+            step(model, st, ws)
+    text = str(err.value)
+    print(f"\n{text}")
+    assert "element" in text and "t = " in text and "nodes" in text

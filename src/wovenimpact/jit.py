@@ -47,3 +47,8 @@ def set_threads(n: int) -> None:
     if not 1 <= n <= top:
         raise ValueError(f"threads = {n} is not valid: choose 1 to {top} on this machine")
     numba.set_num_threads(n)
+
+
+def inline_kernel(fn):
+    """A per-entity function inlined into its callers at Numba IR level."""
+    return numba.njit(inline="always", **JIT_FLAGS)(fn)

@@ -24,6 +24,7 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import prange
 
 from wovenimpact.jit import kernel, loop_kernel
@@ -323,69 +324,70 @@ def softening_damage(strain, d_old, e_a, t_u, soft):
 
 # --- one material point --------------------------------------------------------
 @kernel
-def clear_eroded_point(s_out):
-    """An eroded point (theory §1.4) carries nothing: alive 0, no tension, stress or energy."""
-    s_out[S_ALIVE] = 0.0
-    s_out[S_TENSION] = 0.0
-    s_out[S_TENSION + 1] = 0.0
-    s_out[S_TAU] = 0.0
-    s_out[S_ENERGY] = 0.0
-    s_out[S_SHEAR_ENERGY] = 0.0
-
+def clear_eroded_point(s_out, i):
+    """An eroded point (theory §1.4) carries nothing: alive 0, no tension, stress or energy
+    (row i of the state table s_out)."""
+    s_out[i, S_ALIVE] = 0.0
+    s_out[i, S_TENSION] = 0.0
+    s_out[i, S_TENSION + 1] = 0.0
+    s_out[i, S_TAU] = 0.0
+    s_out[i, S_ENERGY] = 0.0
+    s_out[i, S_SHEAR_ENERGY] = 0.0
 
 
 @kernel
-def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
-    """Update one crossover material point from F_old to F_new.
+def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, i):
+    """Update crossover material point i from F_old to F_new (the module's steps 1–5).
+
+    The core of :func:`fabric_update_point`, for loop kernels: whole tables and row
+    indices instead of per-point views, F as scalars and N returned, so that a call
+    costs no array views or reference counting.
 
     Args:
-        p: (N_PARAM,) parameters (layout in fabric_layout).
-        f_old, f_new: (2, 2) deformation gradients at the start and end of the step.
-        s_in: (N_STATE,) state at the start of the step.
-        s_out: (N_STATE,) state at the end (written; may not alias s_in).
-        n_out: (3,) membrane resultant (N_xx, N_yy, N_xy) in N/m (written).
+        p, m: parameter table (n_materials, N_PARAM) and the material's row.
+        fo11, fo12, fo21, fo22: F_old (row-major); f11, f12, f21, f22: F_new.
+        s_in, s_out: state tables (n, N_STATE): row i at the start of the step, and
+            row i at the end (written; the tables may not alias).
 
     Returns:
-        (status, stiffness): a STATUS_* code and an upper bound of the membrane
-        tangent stiffness dN/dε (N/m) for the stable time step (theory §1.8).
+        (status, stiffness, N_xx, N_yy, N_xy): a STATUS_* code, an upper bound of the
+        membrane tangent stiffness dN/dε (N/m) for the stable time step (theory
+        §1.8), and the membrane resultant in N/m (0 unless the status is OK).
     """
     for j in range(N_STATE):
-        s_out[j] = s_in[j]
-    n_out[0] = 0.0
-    n_out[1] = 0.0
-    n_out[2] = 0.0
-    thick = p[P_THICK]
+        s_out[i, j] = s_in[i, j]
+    thick = p[m, P_THICK]
 
     # 1. kinematics: current yarn directions and angle (eq. 6.5, fibre frame)
-    gwx, gwy = f_new[0, 0], f_new[1, 0]
-    gfx, gfy = f_new[0, 1], f_new[1, 1]
+    gwx, gwy = f11, f21
+    gfx, gfy = f12, f22
     lam_w = math.sqrt(gwx * gwx + gwy * gwy)
     lam_f = math.sqrt(gfx * gfx + gfy * gfy)
     if not (lam_w > 0.0 and lam_f > 0.0):  # also catches NaN
-        return STATUS_BAD_KINEMATICS, 0.0
+        return STATUS_BAD_KINEMATICS, 0.0, 0.0, 0.0, 0.0
     ewx, ewy = gwx / lam_w, gwy / lam_w
     efx, efy = gfx / lam_f, gfy / lam_f
     cos_t = ewx * efx + ewy * efy
     sin_t = ewx * efy - ewy * efx
     if not (sin_t > 0.0) or not math.isfinite(cos_t):
-        return STATUS_BAD_KINEMATICS, 0.0
+        return STATUS_BAD_KINEMATICS, 0.0, 0.0, 0.0, 0.0
     gamma = 0.5 * math.pi - math.atan2(sin_t, cos_t)
 
-    if p[P_FRAME] == FRAME_GREEN_NAGHDI:
+    if p[m, P_FRAME] == FRAME_GREEN_NAGHDI:
         # Incremental stretches (eq. 6.13–6.16) from the midpoint strain increment
         # Δε = sym(ΔF F_mid⁻¹), and the shear increment of eq. (6.34).
-        a11 = 0.5 * (f_old[0, 0] + f_new[0, 0])
-        a12 = 0.5 * (f_old[0, 1] + f_new[0, 1])
-        a21 = 0.5 * (f_old[1, 0] + f_new[1, 0])
-        a22 = 0.5 * (f_old[1, 1] + f_new[1, 1])
+        a11 = 0.5 * (fo11 + f11)
+        a12 = 0.5 * (fo12 + f12)
+        a21 = 0.5 * (fo21 + f21)
+        a22 = 0.5 * (fo22 + f22)
         det = a11 * a22 - a12 * a21
         if not (det > 0.0):
-            return STATUS_BAD_KINEMATICS, 0.0
+            return STATUS_BAD_KINEMATICS, 0.0, 0.0, 0.0, 0.0
         i11, i12, i21, i22 = a22 / det, -a12 / det, -a21 / det, a11 / det
-        d11 = f_new[0, 0] - f_old[0, 0]
-        d12 = f_new[0, 1] - f_old[0, 1]
-        d21 = f_new[1, 0] - f_old[1, 0]
-        d22 = f_new[1, 1] - f_old[1, 1]
+        d11 = f11 - fo11
+        d12 = f12 - fo12
+        d21 = f21 - fo21
+        d22 = f22 - fo22
         l11 = d11 * i11 + d12 * i21
         l12 = d11 * i12 + d12 * i22
         l21 = d21 * i11 + d22 * i21
@@ -401,91 +403,99 @@ def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
         de_w = pwx * pwx * e11 + 2.0 * pwx * pwy * e12 + pwy * pwy * e22
         de_f = pfx * pfx * e11 + 2.0 * pfx * pfy * e12 + pfy * pfy * e22
         if not (1.0 + 2.0 * de_w > 0.0 and 1.0 + 2.0 * de_f > 0.0):
-            return STATUS_BAD_KINEMATICS, 0.0
-        lam_w = s_in[S_LAMBDA] * math.sqrt(1.0 + 2.0 * de_w)
-        lam_f = s_in[S_LAMBDA + 1] * math.sqrt(1.0 + 2.0 * de_f)
+            return STATUS_BAD_KINEMATICS, 0.0, 0.0, 0.0, 0.0
+        lam_w = s_in[i, S_LAMBDA] * math.sqrt(1.0 + 2.0 * de_w)
+        lam_f = s_in[i, S_LAMBDA + 1] * math.sqrt(1.0 + 2.0 * de_f)
         # e_w · Δε · (e_w turned +90°) + (e_f turned −90°) · Δε · e_f  (eq. 6.34)
         nwx, nwy = -pwy, pwx
         mfx, mfy = pfy, -pfx
         dgam = (pwx * nwx * e11 + (pwx * nwy + pwy * nwx) * e12 + pwy * nwy * e22) + (
             mfx * pfx * e11 + (mfx * pfy + mfy * pfx) * e12 + mfy * pfy * e22
         )
-        gamma = s_in[S_GAMMA] + dgam
-    dgamma = gamma - s_in[S_GAMMA]
-    s_out[S_LAMBDA] = lam_w
-    s_out[S_LAMBDA + 1] = lam_f
-    s_out[S_GAMMA] = gamma
+        gamma = s_in[i, S_GAMMA] + dgam
+    dgamma = gamma - s_in[i, S_GAMMA]
+    s_out[i, S_LAMBDA] = lam_w
+    s_out[i, S_LAMBDA + 1] = lam_f
+    s_out[i, S_GAMMA] = gamma
 
-    ell0_w = p[P_ELL0]
-    ell0_f = p[P_ELL0 + 1]
-    h0_w = p[P_H0]
-    h0_f = p[P_H0 + 1]
+    if s_in[i, S_ALIVE] == 0.0:
+        clear_eroded_point(s_out, i)
+        return STATUS_OK, 0.0, 0.0, 0.0, 0.0
+
+    ell0_w = p[m, P_ELL0]
+    ell0_f = p[m, P_ELL0 + 1]
+    h0_w = p[m, P_H0]
+    h0_f = p[m, P_H0 + 1]
     ell_w = lam_w * ell0_w
     ell_f = lam_f * ell0_f
-    lt0_w = p[P_LT0]
-    lt0_f = p[P_LT0 + 1]
+    lt0_w = p[m, P_LT0]
+    lt0_f = p[m, P_LT0 + 1]
     s_total = h0_w + h0_f
-    a = p[P_COMP_A]
-    b = p[P_COMP_B]
-    ea_w = p[P_E] * p[P_AREA]
-    ea_f = p[P_E + 1] * p[P_AREA + 1]
-
-    if s_in[S_ALIVE] == 0.0:
-        clear_eroded_point(s_out)
-        return STATUS_OK, 0.0
+    a = p[m, P_COMP_A]
+    b = p[m, P_COMP_B]
+    ea_w = p[m, P_E] * p[m, P_AREA]
+    ea_f = p[m, P_E + 1] * p[m, P_AREA + 1]
 
     # 2–3. crossover solve, failure check, and one re-solve if a yarn failed
-    d_w = s_in[S_DAMAGE]
-    d_f = s_in[S_DAMAGE + 1]
-    h_w = s_in[S_H]
-    h_f = s_in[S_H + 1]
+    d_w = s_in[i, S_DAMAGE]
+    d_f = s_in[i, S_DAMAGE + 1]
+    h_w = s_in[i, S_H]
+    h_f = s_in[i, S_H + 1]
     f_c = 0.0
     t_w = 0.0
     t_f = 0.0
+    ext_w = 0.0
+    ext_f = 0.0
+    l_w = 1.0
+    l_f = 1.0
     iters = 0
     for attempt in range(2):
         k_w = (1.0 - d_w) * ea_w / lt0_w
         k_f = (1.0 - d_f) * ea_f / lt0_f
         if d_w < 1.0 and d_f < 1.0:
             # The yarn that is vertically stiffer (dF/dH of eq. 6.22 at the
-            # previous heights) carries the unknown: the other yarn's height above
-            # slack, u = D − δ − u_a, is then the larger one and keeps its relative
-            # accuracy. If the converged offsets say otherwise, the roles swap and
-            # the solve restarts from the solution (rare: cold starts, role changes).
-            warp_unknown = yarn_vertical_stiffness(k_w, ell_w, s_in[S_H], lt0_w) >= (
-                yarn_vertical_stiffness(k_f, ell_f, s_in[S_H + 1], lt0_f)
+            # previous heights) carries the unknown ("a"): the other yarn's height
+            # above slack, u = D − δ − u_a, is then the larger one and keeps its
+            # relative accuracy. If the converged offsets say otherwise, the roles
+            # swap and the solve restarts from the solution (rare: cold starts,
+            # role changes).
+            warp_unknown = yarn_vertical_stiffness(k_w, ell_w, s_in[i, S_H], lt0_w) >= (
+                yarn_vertical_stiffness(k_f, ell_f, s_in[i, S_H + 1], lt0_f)
             )
+            ok = False
             for role in range(2):
                 if warp_unknown:
-                    h_guess = tension_predictor(s_in[S_TENSION], k_w, lt0_w, ell_w, s_in[S_H])
-                    if role == 1:
-                        h_guess = h_w
-                    h_w, h_f, f_c, res, it, ok, swap = solve_crimp_heights(
-                        k_w, ell_w, ell0_w, h0_w, lt0_w, k_f, ell_f, ell0_f, h0_f, lt0_f, a, b,
-                        h_guess,
-                    )
+                    k_a, ell_a, ell0_a, h0_a, lt0_a = k_w, ell_w, ell0_w, h0_w, lt0_w
+                    k_b, ell_b, ell0_b, h0_b, lt0_b = k_f, ell_f, ell0_f, h0_f, lt0_f
+                    t_prev, h_prev, h_last = s_in[i, S_TENSION], s_in[i, S_H], h_w
                 else:
-                    h_guess = tension_predictor(
-                        s_in[S_TENSION + 1], k_f, lt0_f, ell_f, s_in[S_H + 1]
-                    )
-                    if role == 1:
-                        h_guess = h_f
-                    h_f, h_w, f_c, res, it, ok, swap = solve_crimp_heights(
-                        k_f, ell_f, ell0_f, h0_f, lt0_f, k_w, ell_w, ell0_w, h0_w, lt0_w, a, b,
-                        h_guess,
-                    )
+                    k_a, ell_a, ell0_a, h0_a, lt0_a = k_f, ell_f, ell0_f, h0_f, lt0_f
+                    k_b, ell_b, ell0_b, h0_b, lt0_b = k_w, ell_w, ell0_w, h0_w, lt0_w
+                    t_prev, h_prev, h_last = s_in[i, S_TENSION + 1], s_in[i, S_H + 1], h_f
+                if role == 0:
+                    h_guess = tension_predictor(t_prev, k_a, lt0_a, ell_a, h_prev)
+                else:
+                    h_guess = h_last
+                h_a, h_b, f_c, res, it, ok, swap = solve_crimp_heights(
+                    k_a, ell_a, ell0_a, h0_a, lt0_a, k_b, ell_b, ell0_b, h0_b, lt0_b, a, b,
+                    h_guess,
+                )
+                if warp_unknown:
+                    h_w, h_f = h_a, h_b
+                else:
+                    h_f, h_w = h_a, h_b
                 iters += it
                 if not (ok and swap):
                     break
                 warp_unknown = not warp_unknown
             if not ok:
-                s_out[S_ITER] = iters
-                return STATUS_NOT_CONVERGED, 0.0
+                s_out[i, S_ITER] = iters
+                return STATUS_NOT_CONVERGED, 0.0, 0.0, 0.0, 0.0
         elif d_w < 1.0:  # fill broken: the warp loses its support and decrimps
-            h_w = min(s_in[S_H], slack_height(ell_w, ell0_w, h0_w))
+            h_w = min(s_in[i, S_H], slack_height(ell_w, ell0_w, h0_w))
             f_c = 0.0
         elif d_f < 1.0:  # warp broken
-            h_f = min(s_in[S_H + 1], slack_height(ell_f, ell0_f, h0_f))
+            h_f = min(s_in[i, S_H + 1], slack_height(ell_f, ell0_f, h0_f))
             f_c = 0.0
         ext_w, l_w = yarn_extension(ell_w, ell0_w, h_w, h0_w, lt0_w)
         ext_f, l_f = yarn_extension(ell_f, ell0_f, h_f, h0_f, lt0_f)
@@ -495,43 +505,42 @@ def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
             break
         d_w_new = d_w
         d_f_new = d_f
-        if p[P_FAILURE] == FAILURE_PROGRESSIVE:
+        if p[m, P_FAILURE] == FAILURE_PROGRESSIVE:
             if d_w < 1.0:
-                d_w_new = softening_damage(ext_w / lt0_w, d_w, ea_w, p[P_TU], p[P_SOFT])
+                d_w_new = softening_damage(ext_w / lt0_w, d_w, ea_w, p[m, P_TU], p[m, P_SOFT])
             if d_f < 1.0:
                 d_f_new = softening_damage(
-                    ext_f / lt0_f, d_f, ea_f, p[P_TU + 1], p[P_SOFT]
+                    ext_f / lt0_f, d_f, ea_f, p[m, P_TU + 1], p[m, P_SOFT]
                 )
         else:  # eq. (6.29): a yarn breaks for good when T ≥ T_u
-            if d_w < 1.0 and t_w >= p[P_TU]:
+            if d_w < 1.0 and t_w >= p[m, P_TU]:
                 d_w_new = 1.0
-            if d_f < 1.0 and t_f >= p[P_TU + 1]:
+            if d_f < 1.0 and t_f >= p[m, P_TU + 1]:
                 d_f_new = 1.0
         if d_w_new == d_w and d_f_new == d_f:
             break
         d_w = d_w_new
         d_f = d_f_new
 
-    s_out[S_H] = h_w
-    s_out[S_H + 1] = h_f
-    s_out[S_DAMAGE] = d_w
-    s_out[S_DAMAGE + 1] = d_f
-    s_out[S_TENSION] = t_w
-    s_out[S_TENSION + 1] = t_f
-    s_out[S_ITER] = iters
+    s_out[i, S_H] = h_w
+    s_out[i, S_H + 1] = h_f
+    s_out[i, S_DAMAGE] = d_w
+    s_out[i, S_DAMAGE + 1] = d_f
+    s_out[i, S_TENSION] = t_w
+    s_out[i, S_TENSION + 1] = t_f
+    s_out[i, S_ITER] = iters
     if d_w >= 1.0 and d_f >= 1.0:  # eroded (theory §1.4)
-        clear_eroded_point(s_out)
-        return STATUS_OK, 0.0
+        clear_eroded_point(s_out, i)
+        return STATUS_OK, 0.0, 0.0, 0.0, 0.0
 
-    # 4a. yarn membrane resultant (theory §1.5)
-    ext_w, l_w = yarn_extension(ell_w, ell0_w, h_w, h0_w, lt0_w)
-    ext_f, l_f = yarn_extension(ell_f, ell0_f, h_f, h0_f, lt0_f)
-    if p[P_HOMOG] == HOMOG_THESIS:  # eq. (6.30), (6.38): σ = ½ Σ T_i/A_i e_i⊗e_i, × t
-        c_w = 0.5 * thick * t_w / p[P_AREA]
-        c_f = 0.5 * thick * t_f / p[P_AREA + 1]
+    # 4a. yarn membrane resultant (theory §1.5), with the extensions L − L0 and
+    # lengths L of the final heights from the solve above
+    if p[m, P_HOMOG] == HOMOG_THESIS:  # eq. (6.30), (6.38): σ = ½ Σ T_i/A_i e_i⊗e_i, × t
+        c_w = 0.5 * thick * t_w / p[m, P_AREA]
+        c_f = 0.5 * thick * t_f / p[m, P_AREA + 1]
         stiff = 0.5 * thick * max(
-            ((1.0 - d_w) * ea_w * ell_w / lt0_w + t_w) / p[P_AREA],
-            ((1.0 - d_f) * ea_f * ell_f / lt0_f + t_f) / p[P_AREA + 1],
+            ((1.0 - d_w) * ea_w * ell_w / lt0_w + t_w) / p[m, P_AREA],
+            ((1.0 - d_f) * ea_f * ell_f / lt0_f + t_f) / p[m, P_AREA + 1],
         )
     else:  # virial: N = Σ 2 T_i ℓ_i cosψ_i e_i⊗e_i / A_cell
         a_cell = 4.0 * ell_w * ell_f * sin_t
@@ -543,31 +552,31 @@ def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
             ((1.0 - d_w) * ea_w * ell_w / lt0_w + t_w) / (2.0 * ell_f * sin_t),
             ((1.0 - d_f) * ea_f * ell_f / lt0_f + t_f) / (2.0 * ell_w * sin_t),
         )
-    n_out[0] = c_w * ewx * ewx + c_f * efx * efx
-    n_out[1] = c_w * ewy * ewy + c_f * efy * efy
-    n_out[2] = c_w * ewx * ewy + c_f * efx * efy
+    n_xx = c_w * ewx * ewx + c_f * efx * efx
+    n_yy = c_w * ewy * ewy + c_f * efy * efy
+    n_xy = c_w * ewx * ewy + c_f * efx * efy
 
     # 4b. trellis shear (theory §1.6): τ(γ), applied through its work conjugate
-    area0 = 4.0 * p[P_ELL0] * p[P_ELL0 + 1]
+    area0 = 4.0 * ell0_w * ell0_f
     jac = lam_w * lam_f * sin_t
-    if p[P_SHEAR] == SHEAR_THESIS:  # eq. (6.35)–(6.37): G(β), τ integrated incrementally
+    if p[m, P_SHEAR] == SHEAR_THESIS:  # eq. (6.35)–(6.37): G(β), τ integrated incrementally
         sin_beta = 0.5 * (h_w / ell_w + h_f / ell_f)
-        g = shear_modulus_thesis(sin_beta, p[P_G1], p[P_G2], p[P_BETA1], p[P_BETA2])
-        tau = s_in[S_TAU] + g * dgamma
+        g = shear_modulus_thesis(sin_beta, p[m, P_G1], p[m, P_G2], p[m, P_BETA1], p[m, P_BETA2])
+        tau = s_in[i, S_TAU] + g * dgamma
         g_tan = g
-        e_shear = s_in[S_SHEAR_ENERGY] + thick * 0.5 * (s_in[S_TAU] + tau) * dgamma
+        e_shear = s_in[i, S_SHEAR_ENERGY] + thick * 0.5 * (s_in[i, S_TAU] + tau) * dgamma
     else:
         g, g_tan, e_dens = shear_modulus_true(
-            abs(gamma), p[P_G1], p[P_G2], p[P_GAMMA1], p[P_GAMMA2]
+            abs(gamma), p[m, P_G1], p[m, P_G2], p[m, P_GAMMA1], p[m, P_GAMMA2]
         )
         tau = g * gamma
         e_shear = thick * e_dens
-    s_out[S_TAU] = tau
-    s_out[S_SHEAR_ENERGY] = e_shear
+    s_out[i, S_TAU] = tau
+    s_out[i, S_SHEAR_ENERGY] = e_shear
     cs = thick * tau / (jac * sin_t)
-    n_out[0] += cs * (2.0 * ewx * efx - cos_t * (ewx * ewx + efx * efx))
-    n_out[1] += cs * (2.0 * ewy * efy - cos_t * (ewy * ewy + efy * efy))
-    n_out[2] += cs * (ewx * efy + ewy * efx - cos_t * (ewx * ewy + efx * efy))
+    n_xx += cs * (2.0 * ewx * efx - cos_t * (ewx * ewx + efx * efx))
+    n_yy += cs * (2.0 * ewy * efy - cos_t * (ewy * ewy + efy * efy))
+    n_xy += cs * (ewx * efy + ewy * efx - cos_t * (ewx * ewy + efx * efy))
     stiff += thick * g_tan
 
     # 5. stored energy per unit reference area: two half trusses per family,
@@ -576,14 +585,47 @@ def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
     k_f = (1.0 - d_f) * ea_f / lt0_f
     u_yarn = k_w * max(ext_w, 0.0) ** 2 + k_f * max(ext_f, 0.0) ** 2
     delta = s_total - h_w - h_f if f_c > 0.0 else 0.0
-    s_out[S_ENERGY] = (u_yarn + compaction_energy(delta, a, b)) / area0 + e_shear
-    return STATUS_OK, stiff
+    s_out[i, S_ENERGY] = (u_yarn + compaction_energy(delta, a, b)) / area0 + e_shear
+    return STATUS_OK, stiff, n_xx, n_yy, n_xy
+
+
+@kernel
+def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
+    """Update one crossover material point from F_old to F_new (single-point callers).
+
+    Args:
+        p: (N_PARAM,) parameters (layout in fabric_layout).
+        f_old, f_new: (2, 2) deformation gradients at the start and end of the step.
+        s_in: (N_STATE,) state at the start of the step.
+        s_out: (N_STATE,) state at the end (written; may not alias s_in).
+        n_out: (3,) membrane resultant (N_xx, N_yy, N_xy) in N/m (written).
+
+    Returns:
+        (status, stiffness): a STATUS_* code and an upper bound of the membrane
+        tangent stiffness dN/dε (N/m) for the stable time step (theory §1.8).
+
+    A thin wrapper of :func:`fabric_point` (which loop kernels call directly).
+    """
+    p_table = np.empty((1, p.shape[0]))
+    p_table[0, :] = p
+    row_in = np.empty((1, N_STATE))
+    row_in[0, :] = s_in
+    row_out = np.empty((1, N_STATE))
+    status, stiff, n_xx, n_yy, n_xy = fabric_point(
+        p_table, 0, f_old[0, 0], f_old[0, 1], f_old[1, 0], f_old[1, 1],
+        f_new[0, 0], f_new[0, 1], f_new[1, 0], f_new[1, 1], row_in, row_out, 0,
+    )
+    s_out[:] = row_out[0, :]
+    n_out[0] = n_xx
+    n_out[1] = n_yy
+    n_out[2] = n_xy
+    return status, stiff
 
 
 # --- many points ----------------------------------------------------------------
 @loop_kernel
 def fabric_update_for_points(p, f_old, f_new, state_in, state_out, n_out, stiff_out, status_out):
-    """Run :func:`fabric_update_point` on every point (independent, ``prange``).
+    """Run :func:`fabric_point` on every point (independent, ``prange``).
 
     Args:
         p: (N_PARAM,) parameters shared by all points.
@@ -594,9 +636,16 @@ def fabric_update_for_points(p, f_old, f_new, state_in, state_out, n_out, stiff_
         stiff_out: (n,) tangent stiffness bounds (written).
         status_out: (n,) int32 status codes (written).
     """
+    p_table = np.empty((1, p.shape[0]))
+    p_table[0, :] = p
     for i in prange(f_new.shape[0]):
-        status, stiff = fabric_update_point(
-            p, f_old[i], f_new[i], state_in[i], state_out[i], n_out[i]
+        status, stiff, n_xx, n_yy, n_xy = fabric_point(
+            p_table, 0, f_old[i, 0, 0], f_old[i, 0, 1], f_old[i, 1, 0], f_old[i, 1, 1],
+            f_new[i, 0, 0], f_new[i, 0, 1], f_new[i, 1, 0], f_new[i, 1, 1],
+            state_in, state_out, i,
         )
+        n_out[i, 0] = n_xx
+        n_out[i, 1] = n_yy
+        n_out[i, 2] = n_xy
         status_out[i] = status
         stiff_out[i] = stiff

@@ -23,6 +23,9 @@ positions x^n and the half-step velocities v^{n−1/2}, ω^{n−1/2}:
 
 ``shell_force`` is one element; ``internal_force_for_shells`` loops over all of them
 in parallel, each writing only its own rows, so results do not depend on threads.
+Per-element functions take the whole tables and the element's row index (no
+per-element array views: each view costs reference counting at every call) and
+the small geometric helpers work on scalars and tuples.
 """
 
 from __future__ import annotations
@@ -31,9 +34,9 @@ import math
 
 from numba import prange
 
-from wovenimpact.jit import kernel, loop_kernel
+from wovenimpact.jit import inline_kernel, kernel, loop_kernel
 from wovenimpact.kernels import fabric_layout as FL
-from wovenimpact.kernels.fabric import fabric_update_point
+from wovenimpact.kernels.fabric import fabric_point
 from wovenimpact.kernels.shell_layout import (
     C_AREAL_MASS,
     C_BEND_E,
@@ -64,16 +67,15 @@ from wovenimpact.kernels.shell_layout import (
 )
 
 
-
 @kernel
-def elastic_membrane(f11, f12, f21, f22, modulus, poisson, thick, n_out):
+def elastic_membrane(f11, f12, f21, f22, modulus, poisson, thick):
     """St Venant–Kirchhoff plane-stress membrane from the in-plane F.
 
     E = ½(FᵀF − I), S = C E with C = E t/(1 − ν²) [[1, ν, 0], [ν, 1, 0], [0, 0, 1 − ν]]
-    (tensor shear), N = F S Fᵀ / J (force per current length, written to n_out).
+    (tensor shear), N = F S Fᵀ / J (force per current length).
 
-    Returns (W, C_m): stored energy per reference area ½ S:E (J/m²) and the
-    membrane stiffness E t/(1 − ν²) (N/m) for the stable step.
+    Returns (W, C_m, N_xx, N_yy, N_xy): stored energy per reference area ½ S:E
+    (J/m²), the membrane stiffness E t/(1 − ν²) (N/m) for the stable step, and N.
     """
     c = modulus * thick / (1.0 - poisson * poisson)
     e11 = 0.5 * (f11 * f11 + f21 * f21 - 1.0)
@@ -88,24 +90,26 @@ def elastic_membrane(f11, f12, f21, f22, modulus, poisson, thick, n_out):
     a12 = f11 * s12 + f12 * s22
     a21 = f21 * s11 + f22 * s12
     a22 = f21 * s12 + f22 * s22
-    n_out[0] = (a11 * f11 + a12 * f12) / det
-    n_out[1] = (a21 * f21 + a22 * f22) / det
-    n_out[2] = (a11 * f21 + a12 * f22) / det
-    return 0.5 * (s11 * e11 + s22 * e22 + 2.0 * s12 * e12), c
+    inv_det = 1.0 / det
+    n_xx = (a11 * f11 + a12 * f12) * inv_det
+    n_yy = (a21 * f21 + a22 * f22) * inv_det
+    n_xy = (a11 * f21 + a12 * f22) * inv_det
+    return 0.5 * (s11 * e11 + s22 * e22 + 2.0 * s12 * e12), c, n_xx, n_yy, n_xy
 
 
 @kernel
-def local_components(a, conn, ex, ey, ez):
-    """(a_I · e) for the four corners: a nodal vector field seen along axis e."""
+def local_components(ax, ay, az, ex, ey, ez):
+    """(a_I · e) for the four corners: a nodal vector field (components ax, ay, az,
+    4-tuples) seen along axis e."""
     return (
-        a[conn[0], 0] * ex + a[conn[0], 1] * ey + a[conn[0], 2] * ez,
-        a[conn[1], 0] * ex + a[conn[1], 1] * ey + a[conn[1], 2] * ez,
-        a[conn[2], 0] * ex + a[conn[2], 1] * ey + a[conn[2], 2] * ez,
-        a[conn[3], 0] * ex + a[conn[3], 1] * ey + a[conn[3], 2] * ez,
+        ax[0] * ex + ay[0] * ey + az[0] * ez,
+        ax[1] * ex + ay[1] * ey + az[1] * ez,
+        ax[2] * ex + ay[2] * ey + az[2] * ez,
+        ax[3] * ex + ay[3] * ey + az[3] * ez,
     )
 
 
-@kernel
+@inline_kernel
 def corotational_frame(px, py, pz):
     """Corotational frame and one-point gradients of a quad (BLT; theory §2.1).
 
@@ -120,13 +124,13 @@ def corotational_frame(px, py, pz):
     nx = d13y * d24z - d13z * d24y
     ny = d13z * d24x - d13x * d24z
     nz = d13x * d24y - d13y * d24x
-    nn = math.sqrt(nx * nx + ny * ny + nz * nz)
-    e3x, e3y, e3z = nx / nn, ny / nn, nz / nn
+    inv_nn = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
+    e3x, e3y, e3z = nx * inv_nn, ny * inv_nn, nz * inv_nn
     s12x, s12y, s12z = px[1] - px[0], py[1] - py[0], pz[1] - pz[0]
     p = s12x * e3x + s12y * e3y + s12z * e3z
     e1x, e1y, e1z = s12x - p * e3x, s12y - p * e3y, s12z - p * e3z
-    n1 = math.sqrt(e1x * e1x + e1y * e1y + e1z * e1z)
-    e1x, e1y, e1z = e1x / n1, e1y / n1, e1z / n1
+    inv_n1 = 1.0 / math.sqrt(e1x * e1x + e1y * e1y + e1z * e1z)
+    e1x, e1y, e1z = e1x * inv_n1, e1y * inv_n1, e1z * inv_n1
     e2x = e3y * e1z - e3z * e1y
     e2y = e3z * e1x - e3x * e1z
     e2z = e3x * e1y - e3y * e1x
@@ -170,61 +174,73 @@ def hourglass_vectors(lx, ly, b1, b2):
 
 
 @kernel
-def hourglass_mode(el_in, el_out, block, j, k, gam, gam_mid, rates, dt):
-    """One hourglass mode j (stiffness form): Q_j += k (γ_mid · rates) Δt, corner
-    forces γ_I Q_j added to block column j; returns the energy increment."""
+def hourglass_mode(q_old, k, gam_mid, rates, dt):
+    """One hourglass mode (stiffness form): Q_new = Q_old + k (γ_mid · rates) Δt.
+
+    Returns (Q_new, energy increment ½ (Q_old + Q_new) (γ_mid · rates) Δt); the
+    corner forces are γ_I Q_new with the current γ.
+    """
     rate = gam_mid[0] * rates[0] + gam_mid[1] * rates[1] + gam_mid[2] * rates[2] + (
         gam_mid[3] * rates[3]
     )
-    old = el_in[E_HG + j]
-    new = old + k * rate * dt
-    el_out[E_HG + j] = new
+    new = q_old + k * rate * dt
+    return new, 0.5 * (q_old + new) * rate * dt
+
+
+@kernel
+def clear_block(blocks, e):
+    """No force or moment at any corner of element e."""
     for i in range(4):
-        block[i, j] += gam[i] * new
-    return 0.5 * (old + new) * rate * dt
+        for j in range(6):
+            blocks[e, i, j] = 0.0
 
 
 @kernel
 def shell_force(
-    x, v, omega, conn, dt, area0, grad0, sec, mat_kind, mat_par, el_in, el_out, m_in, m_out, block
+    e, x, v, omega, dt, quads, area0, ref_grad, sec, sections, mat_kind, mat_params,
+    el_in, el_out, m_in, m_out, blocks,
 ):
-    """Internal forces of one shell element at x^n (see the module docstring).
+    """Internal forces of shell element e at x^n (see the module docstring).
 
     Args:
+        e: the element (row of every per-element table below).
         x, v, omega: (n_nodes, 3) positions x^n, velocities v^{n−1/2}, spins ω^{n−1/2}.
-        conn: (4,) the element's node indices.
         dt: Δt^{n−1/2}, the step the rates act over (0 at the start).
-        area0: reference area A0; grad0: (2, 4) ∂N_I/∂X in the material frame.
-        sec: section row; mat_kind, mat_par: material kind and parameter vector.
-        el_in, el_out: element state rows (shell_layout), start / end of step.
-        m_in, m_out: material state rows, start / end of step.
-        block: (4, 6) written: forces (global, N) and moments (global, N·m) per corner,
-            the internal (resisting) forces.
+        quads: (n_elems, 4) node indices; area0: (n_elems,) reference areas A0;
+            ref_grad: (n_elems, 2, 4) ∂N_I/∂X in the material frame.
+        sec: the element's row of sections; mat_kind, mat_params: material kinds and
+            parameter table (row int(sections[sec, C_MAT])).
+        el_in, el_out: element state tables (shell_layout), start / end of step.
+        m_in, m_out: material state tables, start / end of step.
+        blocks: (n_elems, 4, 6), row e written: forces (global, N) and moments
+            (global, N·m) per corner, the internal (resisting) forces.
 
     Returns:
         (status, eroded_now): an EL_* code, and 1 if the element eroded this step.
     """
     for j in range(N_ELEM_STATE):
-        el_out[j] = el_in[j]
-    for j in range(m_in.shape[0]):
-        m_out[j] = m_in[j]
-    for i in range(4):
-        for j in range(6):
-            block[i, j] = 0.0
-    if el_in[E_ALIVE] == 0.0:
-        el_out[E_DT] = math.inf
+        el_out[e, j] = el_in[e, j]
+    for j in range(m_in.shape[1]):
+        m_out[e, j] = m_in[e, j]
+    if el_in[e, E_ALIVE] == 0.0:
+        el_out[e, E_DT] = math.inf
+        clear_block(blocks, e)
         return EL_OK, 0
 
     # 1. corotational frame at x^n (forces) and at x^{n−1/2} = x^n − ½Δt v (rates:
     # the velocities of the step belong to the midpoint configuration)
-    c0, c1, c2_, c3 = conn[0], conn[1], conn[2], conn[3]
+    c0, c1, c2_, c3 = quads[e, 0], quads[e, 1], quads[e, 2], quads[e, 3]
     px = (x[c0, 0], x[c1, 0], x[c2_, 0], x[c3, 0])
     py = (x[c0, 1], x[c1, 1], x[c2_, 1], x[c3, 1])
     pz = (x[c0, 2], x[c1, 2], x[c2_, 2], x[c3, 2])
+    vx_ = (v[c0, 0], v[c1, 0], v[c2_, 0], v[c3, 0])
+    vy_ = (v[c0, 1], v[c1, 1], v[c2_, 1], v[c3, 1])
+    vz_ = (v[c0, 2], v[c1, 2], v[c2_, 2], v[c3, 2])
     frame = corotational_frame(px, py, pz)
     area = frame[4]
     if not (area > 0.0):
-        el_out[E_DT] = 0.0
+        el_out[e, E_DT] = 0.0
+        clear_block(blocks, e)
         return (EL_NAN if not math.isfinite(area) else EL_INVERTED), 0
     e1x, e1y, e1z = frame[0]
     e2x, e2y, e2z = frame[1]
@@ -233,76 +249,84 @@ def shell_force(
     b1, b2 = frame[5]
     h = 0.5 * dt
     mid = corotational_frame(
-        (px[0] - h * v[c0, 0], px[1] - h * v[c1, 0], px[2] - h * v[c2_, 0], px[3] - h * v[c3, 0]),
-        (py[0] - h * v[c0, 1], py[1] - h * v[c1, 1], py[2] - h * v[c2_, 1], py[3] - h * v[c3, 1]),
-        (pz[0] - h * v[c0, 2], pz[1] - h * v[c1, 2], pz[2] - h * v[c2_, 2], pz[3] - h * v[c3, 2]),
+        (px[0] - h * vx_[0], px[1] - h * vx_[1], px[2] - h * vx_[2], px[3] - h * vx_[3]),
+        (py[0] - h * vy_[0], py[1] - h * vy_[1], py[2] - h * vy_[2], py[3] - h * vy_[3]),
+        (pz[0] - h * vz_[0], pz[1] - h * vz_[1], pz[2] - h * vz_[2], pz[3] - h * vz_[3]),
     )
     if not (mid[4] > 0.0):
-        el_out[E_DT] = 0.0
+        el_out[e, E_DT] = 0.0
+        clear_block(blocks, e)
         return (EL_NAN if not math.isfinite(mid[4]) else EL_INVERTED), 0
 
     # 2. membrane: F = Σ x̂_I ⊗ ∂N_I/∂X
+    g1 = (ref_grad[e, 0, 0], ref_grad[e, 0, 1], ref_grad[e, 0, 2], ref_grad[e, 0, 3])
+    g2 = (ref_grad[e, 1, 0], ref_grad[e, 1, 1], ref_grad[e, 1, 2], ref_grad[e, 1, 3])
     f11 = f12 = f21 = f22 = 0.0
     for i in range(4):
-        f11 += lx[i] * grad0[0, i]
-        f12 += lx[i] * grad0[1, i]
-        f21 += ly[i] * grad0[0, i]
-        f22 += ly[i] * grad0[1, i]
+        f11 += lx[i] * g1[i]
+        f12 += lx[i] * g2[i]
+        f21 += ly[i] * g1[i]
+        f22 += ly[i] * g2[i]
     det = f11 * f22 - f12 * f21
     if not (det > 0.0):
-        el_out[E_DT] = 0.0
+        el_out[e, E_DT] = 0.0
+        clear_block(blocks, e)
         return (EL_NAN if not math.isfinite(det) else EL_INVERTED), 0
-    el_out[E_F] = f11
-    el_out[E_F + 1] = f12
-    el_out[E_F + 2] = f21
-    el_out[E_F + 3] = f22
-    thick = sec[C_THICK]
-    mu = sec[C_AREAL_MASS]
-    n_res = el_out[E_N : E_N + 3]
-    eroded_now = 0
-    if mat_kind == MAT_FABRIC:
-        f_old = el_in[E_F : E_F + 4].reshape((2, 2))
-        f_new = el_out[E_F : E_F + 4].reshape((2, 2))
-        status, c_memb = fabric_update_point(mat_par, f_old, f_new, m_in, m_out, n_res)
-        if status != 0:
-            el_out[E_DT] = 0.0
-            return EL_MATERIAL, 0
-        w_memb = m_out[FL.S_ENERGY]
-        if m_out[FL.S_ALIVE] == 0.0:
-            eroded_now = 1
-    else:
-        w_memb, c_memb = elastic_membrane(
-            f11, f12, f21, f22, mat_par[E_MOD], mat_par[E_NU], thick, n_res
+    el_out[e, E_F] = f11
+    el_out[e, E_F + 1] = f12
+    el_out[e, E_F + 2] = f21
+    el_out[e, E_F + 3] = f22
+    thick = sections[sec, C_THICK]
+    mu = sections[sec, C_AREAL_MASS]
+    m = int(sections[sec, C_MAT])
+    a0 = area0[e]
+    if mat_kind[m] == MAT_FABRIC:
+        status, c_memb, n11, n22, n12 = fabric_point(
+            mat_params, m, el_in[e, E_F], el_in[e, E_F + 1], el_in[e, E_F + 2],
+            el_in[e, E_F + 3], f11, f12, f21, f22, m_in, m_out, e,
         )
-    el_out[E_U_MEMB] = w_memb * area0
-    if eroded_now == 1:
-        # no force from now on; the element's stored energy is booked by the caller
-        el_out[E_ALIVE] = 0.0
-        el_out[E_DT] = math.inf
-        for j in range(3):
-            el_out[E_N + j] = 0.0
-        return EL_OK, 1
+        if status != 0:
+            el_out[e, E_N] = 0.0
+            el_out[e, E_N + 1] = 0.0
+            el_out[e, E_N + 2] = 0.0
+            el_out[e, E_DT] = 0.0
+            clear_block(blocks, e)
+            return EL_MATERIAL, 0
+        w_memb = m_out[e, FL.S_ENERGY]
+        if m_out[e, FL.S_ALIVE] == 0.0:
+            # eroded: no force from now on; its stored energy is booked by the caller
+            el_out[e, E_U_MEMB] = w_memb * a0
+            el_out[e, E_ALIVE] = 0.0
+            el_out[e, E_DT] = math.inf
+            for j in range(3):
+                el_out[e, E_N + j] = 0.0
+            clear_block(blocks, e)
+            return EL_OK, 1
+    else:
+        w_memb, c_memb, n11, n22, n12 = elastic_membrane(
+            f11, f12, f21, f22, mat_params[m, E_MOD], mat_params[m, E_NU], thick
+        )
+    el_out[e, E_N] = n11
+    el_out[e, E_N + 1] = n22
+    el_out[e, E_N + 2] = n12
+    el_out[e, E_U_MEMB] = w_memb * a0
     # first Piola resultant P = J N F⁻ᵀ; F⁻ᵀ = [[f22, −f21], [−f12, f11]] / J
-    n11, n22, n12 = n_res[0], n_res[1], n_res[2]
     p11 = n11 * f22 - n12 * f12
     p12 = -n11 * f21 + n12 * f11
     p21 = n12 * f22 - n22 * f12
     p22 = -n12 * f21 + n22 * f11
 
-    # local nodal forces, accumulated in block as (fx, fy, fz, mx, my) per corner
-    # (resisting forces) and turned to global axes at the end
-    for i in range(4):
-        block[i, 0] = area0 * (p11 * grad0[0, i] + p12 * grad0[1, i])
-        block[i, 1] = area0 * (p21 * grad0[0, i] + p22 * grad0[1, i])
-
     # 3. bending and transverse shear, rate form over Δt^{n−1/2}
     (m1x, m1y, m1z), (m2x, m2y, m2z), (m3x, m3y, m3z) = mid[0], mid[1], mid[2]
     mb1, mb2 = mid[5]
-    vx = local_components(v, conn, m1x, m1y, m1z)
-    vy = local_components(v, conn, m2x, m2y, m2z)
-    vz = local_components(v, conn, m3x, m3y, m3z)
-    tx = local_components(omega, conn, m1x, m1y, m1z)
-    ty = local_components(omega, conn, m2x, m2y, m2z)
+    wx_ = (omega[c0, 0], omega[c1, 0], omega[c2_, 0], omega[c3, 0])
+    wy_ = (omega[c0, 1], omega[c1, 1], omega[c2_, 1], omega[c3, 1])
+    wz_ = (omega[c0, 2], omega[c1, 2], omega[c2_, 2], omega[c3, 2])
+    vx = local_components(vx_, vy_, vz_, m1x, m1y, m1z)
+    vy = local_components(vx_, vy_, vz_, m2x, m2y, m2z)
+    vz = local_components(vx_, vy_, vz_, m3x, m3y, m3z)
+    tx = local_components(wx_, wy_, wz_, m1x, m1y, m1z)
+    ty = local_components(wx_, wy_, wz_, m2x, m2y, m2z)
     kx = ky = kxy2 = gxz = gyz = 0.0
     for i in range(4):
         kx += mb1[i] * ty[i]
@@ -310,59 +334,72 @@ def shell_force(
         kxy2 += mb2[i] * ty[i] - mb1[i] * tx[i]
         gxz += mb1[i] * vz[i] + 0.25 * ty[i]
         gyz += mb2[i] * vz[i] - 0.25 * tx[i]
-    e_b = sec[C_BEND_E]
-    nu_b = sec[C_BEND_NU]
+    e_b = sections[sec, C_BEND_E]
+    nu_b = sections[sec, C_BEND_NU]
     d_b = e_b * thick * thick * thick / (12.0 * (1.0 - nu_b * nu_b))
-    kgt = sec[C_SHEAR_K] * sec[C_SHEAR_G] * thick
+    kgt = sections[sec, C_SHEAR_K] * sections[sec, C_SHEAR_G] * thick
     dkx, dky, dkxy2 = kx * dt, ky * dt, kxy2 * dt
     dgxz, dgyz = gxz * dt, gyz * dt
-    m_old0, m_old1, m_old2 = el_in[E_M], el_in[E_M + 1], el_in[E_M + 2]
-    q_old0, q_old1 = el_in[E_Q], el_in[E_Q + 1]
+    m_old0, m_old1, m_old2 = el_in[e, E_M], el_in[e, E_M + 1], el_in[e, E_M + 2]
+    q_old0, q_old1 = el_in[e, E_Q], el_in[e, E_Q + 1]
     mxx = m_old0 + d_b * (dkx + nu_b * dky)
     myy = m_old1 + d_b * (dky + nu_b * dkx)
     mxy = m_old2 + d_b * 0.5 * (1.0 - nu_b) * dkxy2
     qx = q_old0 + kgt * dgxz
     qy = q_old1 + kgt * dgyz
-    el_out[E_M] = mxx
-    el_out[E_M + 1] = myy
-    el_out[E_M + 2] = mxy
-    el_out[E_Q] = qx
-    el_out[E_Q + 1] = qy
-    el_out[E_U_BEND] = el_in[E_U_BEND] + area * (
+    el_out[e, E_M] = mxx
+    el_out[e, E_M + 1] = myy
+    el_out[e, E_M + 2] = mxy
+    el_out[e, E_Q] = qx
+    el_out[e, E_Q + 1] = qy
+    el_out[e, E_U_BEND] = el_in[e, E_U_BEND] + area * (
         0.5 * (m_old0 + mxx) * dkx + 0.5 * (m_old1 + myy) * dky + 0.5 * (m_old2 + mxy) * dkxy2
         + 0.5 * (q_old0 + qx) * dgxz + 0.5 * (q_old1 + qy) * dgyz
     )
-    for i in range(4):
-        block[i, 2] = area * (b1[i] * qx + b2[i] * qy)
-        block[i, 3] = area * (-b2[i] * myy - b1[i] * mxy - 0.25 * qy)
-        block[i, 4] = area * (b1[i] * mxx + b2[i] * mxy + 0.25 * qx)
 
     # 4. hourglass (Flanagan–Belytschko): γ_I = ¼ (h_I − (h·x̂) b1_I − (h·ŷ) b2_I),
     # rates with the midpoint γ, forces with the current one
     gam, bb = hourglass_vectors(lx, ly, b1, b2)
     gam_mid = hourglass_vectors(mid[3][0], mid[3][1], mb1, mb2)[0]
-    r = sec[C_HOURGLASS]
+    r = sections[sec, C_HOURGLASS]
     k_m = r * c_memb * area * bb
     # w mode: the bilinear w of an element is the nodal-value trace of a twist;
     # k = 16 D Σb² is its twist energy for a square element (r = 1)
     k_w = r * 16.0 * d_b * bb
     k_t = r * d_b * area * bb
-    e_hg = hourglass_mode(el_in, el_out, block, 0, k_m, gam, gam_mid, vx, dt)
-    e_hg += hourglass_mode(el_in, el_out, block, 1, k_m, gam, gam_mid, vy, dt)
-    e_hg += hourglass_mode(el_in, el_out, block, 2, k_w, gam, gam_mid, vz, dt)
-    e_hg += hourglass_mode(el_in, el_out, block, 3, k_t, gam, gam_mid, tx, dt)
-    e_hg += hourglass_mode(el_in, el_out, block, 4, k_t, gam, gam_mid, ty, dt)
-    el_out[E_U_HG] = el_in[E_U_HG] + e_hg
+    hg0, e_hg = hourglass_mode(el_in[e, E_HG], k_m, gam_mid, vx, dt)
+    hg1, de = hourglass_mode(el_in[e, E_HG + 1], k_m, gam_mid, vy, dt)
+    e_hg += de
+    hg2, de = hourglass_mode(el_in[e, E_HG + 2], k_w, gam_mid, vz, dt)
+    e_hg += de
+    hg3, de = hourglass_mode(el_in[e, E_HG + 3], k_t, gam_mid, tx, dt)
+    e_hg += de
+    hg4, de = hourglass_mode(el_in[e, E_HG + 4], k_t, gam_mid, ty, dt)
+    e_hg += de
+    el_out[e, E_HG] = hg0
+    el_out[e, E_HG + 1] = hg1
+    el_out[e, E_HG + 2] = hg2
+    el_out[e, E_HG + 3] = hg3
+    el_out[e, E_HG + 4] = hg4
+    el_out[e, E_U_HG] = el_in[e, E_U_HG] + e_hg
 
-    # 5. back to global axes
+    # 5. corner forces (membrane, shear, hourglass) and moments in the local frame,
+    # turned to global axes
+    fsum = 0.0
     for i in range(4):
-        fx, fy, fz, mx, my = block[i, 0], block[i, 1], block[i, 2], block[i, 3], block[i, 4]
-        block[i, 0] = fx * e1x + fy * e2x + fz * e3x
-        block[i, 1] = fx * e1y + fy * e2y + fz * e3y
-        block[i, 2] = fx * e1z + fy * e2z + fz * e3z
-        block[i, 3] = mx * e1x + my * e2x
-        block[i, 4] = mx * e1y + my * e2y
-        block[i, 5] = mx * e1z + my * e2z
+        fx = a0 * (p11 * g1[i] + p12 * g2[i]) + gam[i] * hg0
+        fy = a0 * (p21 * g1[i] + p22 * g2[i]) + gam[i] * hg1
+        fz = area * (b1[i] * qx + b2[i] * qy) + gam[i] * hg2
+        mx = area * (-b2[i] * myy - b1[i] * mxy - 0.25 * qy) + gam[i] * hg3
+        my = area * (b1[i] * mxx + b2[i] * mxy + 0.25 * qx) + gam[i] * hg4
+        gx = fx * e1x + fy * e2x + fz * e3x
+        blocks[e, i, 0] = gx
+        blocks[e, i, 1] = fx * e1y + fy * e2y + fz * e3y
+        blocks[e, i, 2] = fx * e1z + fy * e2z + fz * e3z
+        blocks[e, i, 3] = mx * e1x + my * e2x
+        blocks[e, i, 4] = mx * e1y + my * e2y
+        blocks[e, i, 5] = mx * e1z + my * e2z
+        fsum += gx
 
     # 6. stable step: L_e = A / longest edge, c² = max(C_m, k G t) / μ
     edge2 = 0.0
@@ -373,8 +410,9 @@ def shell_force(
         dz = pz[j] - pz[i]
         edge2 = max(edge2, dx * dx + dy * dy + dz * dz)
     c2 = max(c_memb, kgt) / mu
-    el_out[E_DT] = area / math.sqrt(edge2 * c2)
-    if not math.isfinite(block[0, 0] + block[1, 0] + block[2, 0] + block[3, 0] + el_out[E_DT]):
+    dt_e = area / math.sqrt(edge2 * c2)
+    el_out[e, E_DT] = dt_e
+    if not math.isfinite(fsum + dt_e):
         return EL_NAN, 0
     return EL_OK, 0
 
@@ -391,21 +429,27 @@ def internal_force_for_shells(
     (n_elems,) written; dt_erode: an element whose own stable step L_e/c_e falls
     below it is eroded (crushed or collapsed elements, e.g. fabric with one yarn
     family broken; 0 disables).
+
+    Returns:
+        (n_failed, n_eroded): elements with a non-OK status, and elements eroded
+        this step (integer counts: exact, so the same for any thread count).
     """
     ne = quads.shape[0]
+    n_failed = 0
+    n_eroded = 0
     for e in prange(ne):
-        sec = sections[elem_section[e]]
-        m = int(sec[C_MAT])
         st, er = shell_force(
-            x, v, omega, quads[e], dt, area0[e], ref_grad[e], sec, mat_kind[m], mat_params[m],
-            el_in[e], el_out[e], m_in[e], m_out[e], blocks[e],
+            e, x, v, omega, dt, quads, area0, ref_grad, elem_section[e], sections, mat_kind,
+            mat_params, el_in, el_out, m_in, m_out, blocks,
         )
         if st == EL_OK and er == 0 and el_out[e, E_DT] < dt_erode:
             el_out[e, E_ALIVE] = 0.0
             el_out[e, E_DT] = math.inf
-            for i in range(4):
-                for j in range(6):
-                    blocks[e, i, j] = 0.0
+            clear_block(blocks, e)
             er = 1
         status[e] = st
         eroded_now[e] = er
+        if st != EL_OK:
+            n_failed += 1
+        n_eroded += er
+    return n_failed, n_eroded

@@ -85,14 +85,14 @@ class Workspace:
 def element_forces(model, state: State, ws: Workspace) -> None:
     """Stages 1–2: element forces at x^n and their nodal sums (into ws)."""
     t0 = time.perf_counter()
-    internal_force_for_shells(
+    n_failed, _ = internal_force_for_shells(
         state.x, state.v, state.omega, state.dt, model.quads, model.elem_section,
         model.sections, model.mat_kind, model.mat_params, model.area0, model.ref_grad,
         state.elem, ws.elem, state.mat, ws.mat, ws.blocks, ws.status, ws.eroded_now,
         model.erode_dt_fraction * state.dt_first / model.alpha,
     )
-    bad = np.flatnonzero(ws.status)
-    if bad.size:
+    if n_failed:
+        bad = np.flatnonzero(ws.status)
         e = int(bad[0])
         raise SimulationError(
             f"element {e} (nodes {model.quads[e].tolist()}) at t = {state.t:.6e} s, step "

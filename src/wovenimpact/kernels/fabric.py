@@ -117,8 +117,8 @@ def compaction_closure(force, a, b):
     """Overclosure δ(F) = a F / (b + F), inverse of F = b δ / (a − δ) (eq. 5.8), and dδ/dF."""
     if force <= 0.0:
         return 0.0, a / b
-    denom = b + force
-    return a * force / denom, a * b / (denom * denom)
+    inv = 1.0 / (b + force)
+    return a * force * inv, a * b * (inv * inv)
 
 
 @kernel
@@ -170,10 +170,11 @@ def yarn_force_offset(k, ell, hs, c, u, ell_truss0):
     if u <= 0.0 or k == 0.0:
         return 0.0, 0.0, 0.0, h
     length = math.sqrt(ell * ell + h * h)
+    inv_len = 1.0 / length  # one division for F and dF/du (the Newton loop's latency)
     ext = (u * (u + 2.0 * hs) + c) / (length + ell_truss0)
     tension = k * ext
-    force = 2.0 * tension * h / length
-    dforce = 2.0 * k * (1.0 - ell_truss0 * ell * ell / (length * length * length))
+    force = 2.0 * tension * h * inv_len
+    dforce = 2.0 * k * (1.0 - ell_truss0 * ell * ell * (inv_len * inv_len * inv_len))
     return force, dforce, tension, h
 
 
@@ -347,7 +348,9 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
         p, m: parameter table (n_materials, N_PARAM) and the material's row.
         fo11, fo12, fo21, fo22: F_old (row-major); f11, f12, f21, f22: F_new.
         s_in, s_out: state tables (n, N_STATE): row i at the start of the step, and
-            row i at the end (written; the tables may not alias).
+            row i at the end (written; the tables may not alias). Pass the rows m and
+            i as unsigned integers (np.uint64) in loops: signed indices cost a
+            negative-index check at every access.
 
     Returns:
         (status, stiffness, N_xx, N_yy, N_xy): a STATUS_* code, an upper bound of the
@@ -642,7 +645,7 @@ def fabric_update_for_points(p, f_old, f_new, state_in, state_out, n_out, stiff_
         status, stiff, n_xx, n_yy, n_xy = fabric_point(
             p_table, 0, f_old[i, 0, 0], f_old[i, 0, 1], f_old[i, 1, 0], f_old[i, 1, 1],
             f_new[i, 0, 0], f_new[i, 0, 1], f_new[i, 1, 0], f_new[i, 1, 1],
-            state_in, state_out, i,
+            state_in, state_out, np.uint64(i),
         )
         n_out[i, 0] = n_xx
         n_out[i, 1] = n_yy

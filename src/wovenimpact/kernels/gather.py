@@ -6,6 +6,7 @@ same bitwise for any thread count (no scatter-add races). docs/theory.md §3.
 
 from __future__ import annotations
 
+import numpy as np
 from numba import prange
 
 from wovenimpact.jit import loop_kernel
@@ -28,8 +29,8 @@ def gather_nodal_forces(node_ptr, node_elem, node_corner, blocks, elem, out, liv
         acc0 = acc1 = acc2 = acc3 = acc4 = acc5 = 0.0
         live = 0
         for k in range(node_ptr[n], node_ptr[n + 1]):
-            e = node_elem[k]
-            c = node_corner[k]
+            e = np.uint64(node_elem[k])  # unsigned: no negative-index wraparound
+            c = np.uint64(node_corner[k])
             acc0 += blocks[e, c, 0]
             acc1 += blocks[e, c, 1]
             acc2 += blocks[e, c, 2]

@@ -25,13 +25,16 @@ positions x^n and the half-step velocities v^{n−1/2}, ω^{n−1/2}:
 in parallel, each writing only its own rows, so results do not depend on threads.
 Per-element functions take the whole tables and the element's row index (no
 per-element array views: each view costs reference counting at every call) and
-the small geometric helpers work on scalars and tuples.
+the small geometric helpers work on scalars and tuples. Row indices are passed
+as unsigned integers (``np.uint64``): a signed index makes Numba check every
+access for a negative index to wrap around, ~20 % of the element's time.
 """
 
 from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import prange
 
 from wovenimpact.jit import inline_kernel, kernel, loop_kernel
@@ -203,12 +206,12 @@ def shell_force(
     """Internal forces of shell element e at x^n (see the module docstring).
 
     Args:
-        e: the element (row of every per-element table below).
+        e: the element (row of every per-element table below), unsigned.
         x, v, omega: (n_nodes, 3) positions x^n, velocities v^{n−1/2}, spins ω^{n−1/2}.
         dt: Δt^{n−1/2}, the step the rates act over (0 at the start).
         quads: (n_elems, 4) node indices; area0: (n_elems,) reference areas A0;
             ref_grad: (n_elems, 2, 4) ∂N_I/∂X in the material frame.
-        sec: the element's row of sections; mat_kind, mat_params: material kinds and
+        sec: the element's row of sections (unsigned); mat_kind, mat_params: material kinds and
             parameter table (row int(sections[sec, C_MAT])).
         el_in, el_out: element state tables (shell_layout), start / end of step.
         m_in, m_out: material state tables, start / end of step.
@@ -229,7 +232,10 @@ def shell_force(
 
     # 1. corotational frame at x^n (forces) and at x^{n−1/2} = x^n − ½Δt v (rates:
     # the velocities of the step belong to the midpoint configuration)
-    c0, c1, c2_, c3 = quads[e, 0], quads[e, 1], quads[e, 2], quads[e, 3]
+    c0, c1, c2_, c3 = (
+        np.uint64(quads[e, 0]), np.uint64(quads[e, 1]), np.uint64(quads[e, 2]),
+        np.uint64(quads[e, 3]),
+    )
     px = (x[c0, 0], x[c1, 0], x[c2_, 0], x[c3, 0])
     py = (x[c0, 1], x[c1, 1], x[c2_, 1], x[c3, 1])
     pz = (x[c0, 2], x[c1, 2], x[c2_, 2], x[c3, 2])
@@ -278,7 +284,7 @@ def shell_force(
     el_out[e, E_F + 3] = f22
     thick = sections[sec, C_THICK]
     mu = sections[sec, C_AREAL_MASS]
-    m = int(sections[sec, C_MAT])
+    m = np.uint64(sections[sec, C_MAT])
     a0 = area0[e]
     if mat_kind[m] == MAT_FABRIC:
         status, c_memb, n11, n22, n12 = fabric_point(
@@ -439,8 +445,8 @@ def internal_force_for_shells(
     n_eroded = 0
     for e in prange(ne):
         st, er = shell_force(
-            e, x, v, omega, dt, quads, area0, ref_grad, elem_section[e], sections, mat_kind,
-            mat_params, el_in, el_out, m_in, m_out, blocks,
+            np.uint64(e), x, v, omega, dt, quads, area0, ref_grad, np.uint64(elem_section[e]),
+            sections, mat_kind, mat_params, el_in, el_out, m_in, m_out, blocks,
         )
         if st == EL_OK and er == 0 and el_out[e, E_DT] < dt_erode:
             el_out[e, E_ALIVE] = 0.0

@@ -104,8 +104,7 @@ def initial_state(model, velocity=None, angular_velocity=None) -> State:
     elem[:, S.E_F] = 1.0
     elem[:, S.E_F + 3] = 1.0
     elem[:, S.E_ALIVE] = 1.0
-    mat_of = model.sections[model.elem_section, S.C_MAT].astype(np.int64)
-    mat = model.mat_state0[mat_of].copy()
+    mat = model.section_state0[model.elem_section].copy()
     energy = np.zeros(N_ENERGY)
     ke = 0.5 * (np.sum(model.node_mass[:, None] * v * v) + np.sum(model.node_inertia[:, None] * w * w))
     energy[KINETIC] = ke

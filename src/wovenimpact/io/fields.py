@@ -66,11 +66,14 @@ def element_fields(model, state: State, fabric: np.ndarray) -> dict[str, np.ndar
         "ply": np.asarray(model.ply, dtype=np.int64),
         "element": np.arange(model.n_elems, dtype=np.int64),
     }
+    # integrated sections: the mid-surface point (block points // 2 of the state row)
+    mid = (model.sections[model.elem_section, S.C_POINTS].astype(np.int64) // 2) * FL.N_STATE
+    rows = np.flatnonzero(fabric)
     for name, col in (("tension_warp", FL.S_TENSION), ("tension_fill", FL.S_TENSION + 1),
                       ("damage_warp", FL.S_DAMAGE), ("damage_fill", FL.S_DAMAGE + 1)):
         values = np.zeros(model.n_elems)
-        if fabric.any():
-            values[fabric] = state.mat[fabric, col]
+        if rows.size:
+            values[rows] = state.mat[rows, mid[rows] + col]
         out[name] = values
     return out
 

@@ -46,6 +46,7 @@ from wovenimpact.kernels.shell_layout import (
     C_BEND_NU,
     C_HOURGLASS,
     C_MAT,
+    C_POINTS,
     C_SHEAR_G,
     C_SHEAR_K,
     C_THICK,
@@ -53,6 +54,7 @@ from wovenimpact.kernels.shell_layout import (
     E_DT,
     E_F,
     E_HG,
+    E_KAPPA,
     E_M,
     E_MOD,
     E_N,
@@ -199,6 +201,78 @@ def clear_block(blocks, e):
 
 
 @kernel
+def through_thickness_f(z, kx, ky, kxy2, f11, f12, f21, f22):
+    """In-plane F at height z: (I + z κ̂) F, κ̂ = [[κ_x, κ_xy], [κ_xy, κ_y]]; the strain
+    at z is then the mid-surface strain plus z κ (BLT curvature convention)."""
+    kxy = 0.5 * kxy2
+    return (
+        f11 + z * (kx * f11 + kxy * f21), f12 + z * (kx * f12 + kxy * f22),
+        f21 + z * (kxy * f11 + ky * f21), f22 + z * (kxy * f12 + ky * f22),
+    )
+
+
+@kernel
+def integrated_section(
+    e, n_pts, thick, kind, mat_params, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22,
+    ko_x, ko_y, ko_xy2, k_x, k_y, k_xy2, m_in, m_out,
+):
+    """The material at n Simpson points z_k through the thickness (theory §4).
+
+    Point k sees F_k = (I + z_k κ̂) F; its resultant N_k (force per length of the
+    whole section) is weighted by the Simpson weights w_k (Σ w_k = 1):
+    N = Σ w_k N_k, M = Σ w_k z_k N_k (exact for the bending of a linear material).
+    The fabric points' states are consecutive blocks of the element's material row.
+
+    Returns:
+        (status, eroded, C_m, W, N_xx, N_yy, N_xy, M_xx, M_yy, M_xy): status 0 if
+        every point updated; eroded if every point is eroded; the largest membrane
+        tangent; stored energy per reference area Σ w_k W_k.
+    """
+    n_xx = n_yy = n_xy = 0.0
+    mxx = myy = mxy = 0.0
+    w_sum = 0.0
+    c_max = 0.0
+    alive = 0
+    fabric = kind == MAT_FABRIC
+    if fabric:
+        blocks = m_in.shape[1] // FL.N_STATE
+        rows_in = m_in.reshape((m_in.shape[0] * blocks, FL.N_STATE))
+        rows_out = m_out.reshape((m_out.shape[0] * blocks, FL.N_STATE))
+    h = thick / (n_pts - 1)
+    for k in range(n_pts):
+        z = -0.5 * thick + k * h
+        w = (1.0 if k == 0 or k == n_pts - 1 else (4.0 if k % 2 == 1 else 2.0)) / (3.0 * (n_pts - 1))
+        g11, g12, g21, g22 = through_thickness_f(z, k_x, k_y, k_xy2, f11, f12, f21, f22)
+        if g11 * g22 - g12 * g21 <= 0.0:
+            return 1, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        if fabric:
+            o11, o12, o21, o22 = through_thickness_f(z, ko_x, ko_y, ko_xy2, fo11, fo12, fo21, fo22)
+            row = e * np.uint64(blocks) + np.uint64(k)
+            st, c, a, b, c12 = fabric_point(
+                mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, rows_in, rows_out, row
+            )
+            if st != 0:
+                return st, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+            energy = rows_out[row, FL.S_ENERGY]
+            if rows_out[row, FL.S_ALIVE] != 0.0:
+                alive += 1
+        else:
+            energy, c, a, b, c12 = elastic_membrane(
+                g11, g12, g21, g22, mat_params[m, E_MOD], mat_params[m, E_NU], thick
+            )
+            alive += 1
+        n_xx += w * a
+        n_yy += w * b
+        n_xy += w * c12
+        mxx += w * z * a
+        myy += w * z * b
+        mxy += w * z * c12
+        w_sum += w * energy
+        c_max = max(c_max, c)
+    return 0, alive == 0, c_max, w_sum, n_xx, n_yy, n_xy, mxx, myy, mxy
+
+
+@kernel
 def shell_force(
     e, x, v, omega, dt, quads, area0, ref_grad, sec, sections, mat_kind, mat_params,
     el_in, el_out, m_in, m_out, blocks,
@@ -264,7 +338,34 @@ def shell_force(
         clear_block(blocks, e)
         return (EL_NAN if not math.isfinite(mid[4]) else EL_INVERTED), 0
 
-    # 2. membrane: F = Σ x̂_I ⊗ ∂N_I/∂X
+    # 2. rates in the midpoint frame: curvature and transverse-shear increments
+    (m1x, m1y, m1z), (m2x, m2y, m2z), (m3x, m3y, m3z) = mid[0], mid[1], mid[2]
+    mb1, mb2 = mid[5]
+    wx_ = (omega[c0, 0], omega[c1, 0], omega[c2_, 0], omega[c3, 0])
+    wy_ = (omega[c0, 1], omega[c1, 1], omega[c2_, 1], omega[c3, 1])
+    wz_ = (omega[c0, 2], omega[c1, 2], omega[c2_, 2], omega[c3, 2])
+    vx = local_components(vx_, vy_, vz_, m1x, m1y, m1z)
+    vy = local_components(vx_, vy_, vz_, m2x, m2y, m2z)
+    vz = local_components(vx_, vy_, vz_, m3x, m3y, m3z)
+    tx = local_components(wx_, wy_, wz_, m1x, m1y, m1z)
+    ty = local_components(wx_, wy_, wz_, m2x, m2y, m2z)
+    kx = ky = kxy2 = gxz = gyz = 0.0
+    for i in range(4):
+        kx += mb1[i] * ty[i]
+        ky -= mb2[i] * tx[i]
+        kxy2 += mb2[i] * ty[i] - mb1[i] * tx[i]
+        gxz += mb1[i] * vz[i] + 0.25 * ty[i]
+        gyz += mb2[i] * vz[i] - 0.25 * tx[i]
+    dkx, dky, dkxy2 = kx * dt, ky * dt, kxy2 * dt
+    dgxz, dgyz = gxz * dt, gyz * dt
+    kap_x = el_in[e, E_KAPPA] + dkx
+    kap_y = el_in[e, E_KAPPA + 1] + dky
+    kap_xy2 = el_in[e, E_KAPPA + 2] + dkxy2
+    el_out[e, E_KAPPA] = kap_x
+    el_out[e, E_KAPPA + 1] = kap_y
+    el_out[e, E_KAPPA + 2] = kap_xy2
+
+    # 3. membrane: F = Σ x̂_I ⊗ ∂N_I/∂X
     g1 = (ref_grad[e, 0, 0], ref_grad[e, 0, 1], ref_grad[e, 0, 2], ref_grad[e, 0, 3])
     g2 = (ref_grad[e, 1, 0], ref_grad[e, 1, 1], ref_grad[e, 1, 2], ref_grad[e, 1, 3])
     f11 = f12 = f21 = f22 = 0.0
@@ -286,32 +387,44 @@ def shell_force(
     mu = sections[sec, C_AREAL_MASS]
     m = np.uint64(sections[sec, C_MAT])
     a0 = area0[e]
-    if mat_kind[m] == MAT_FABRIC:
+    n_pts = int(sections[sec, C_POINTS])
+    integrated = n_pts > 1
+    if integrated:
+        status, eroded, c_memb, w_memb, n11, n22, n12, mi_xx, mi_yy, mi_xy = integrated_section(
+            e, n_pts, thick, mat_kind[m], mat_params, m,
+            el_in[e, E_F], el_in[e, E_F + 1], el_in[e, E_F + 2], el_in[e, E_F + 3],
+            f11, f12, f21, f22, el_in[e, E_KAPPA], el_in[e, E_KAPPA + 1],
+            el_in[e, E_KAPPA + 2], kap_x, kap_y, kap_xy2, m_in, m_out,
+        )
+    elif mat_kind[m] == MAT_FABRIC:
         status, c_memb, n11, n22, n12 = fabric_point(
             mat_params, m, el_in[e, E_F], el_in[e, E_F + 1], el_in[e, E_F + 2],
             el_in[e, E_F + 3], f11, f12, f21, f22, m_in, m_out, e,
         )
-        if status != 0:
-            el_out[e, E_N] = 0.0
-            el_out[e, E_N + 1] = 0.0
-            el_out[e, E_N + 2] = 0.0
-            el_out[e, E_DT] = 0.0
-            clear_block(blocks, e)
-            return EL_MATERIAL, 0
         w_memb = m_out[e, FL.S_ENERGY]
-        if m_out[e, FL.S_ALIVE] == 0.0:
-            # eroded: no force from now on; its stored energy is booked by the caller
-            el_out[e, E_U_MEMB] = w_memb * a0
-            el_out[e, E_ALIVE] = 0.0
-            el_out[e, E_DT] = math.inf
-            for j in range(3):
-                el_out[e, E_N + j] = 0.0
-            clear_block(blocks, e)
-            return EL_OK, 1
+        eroded = status == 0 and m_out[e, FL.S_ALIVE] == 0.0
     else:
         w_memb, c_memb, n11, n22, n12 = elastic_membrane(
             f11, f12, f21, f22, mat_params[m, E_MOD], mat_params[m, E_NU], thick
         )
+        status = 0
+        eroded = False
+    if status != 0:
+        el_out[e, E_N] = 0.0
+        el_out[e, E_N + 1] = 0.0
+        el_out[e, E_N + 2] = 0.0
+        el_out[e, E_DT] = 0.0
+        clear_block(blocks, e)
+        return EL_MATERIAL, 0
+    if eroded:
+        # no force from now on; its stored energy is booked by the caller
+        el_out[e, E_U_MEMB] = w_memb * a0
+        el_out[e, E_ALIVE] = 0.0
+        el_out[e, E_DT] = math.inf
+        for j in range(3):
+            el_out[e, E_N + j] = 0.0
+        clear_block(blocks, e)
+        return EL_OK, 1
     el_out[e, E_N] = n11
     el_out[e, E_N + 1] = n22
     el_out[e, E_N + 2] = n12
@@ -322,35 +435,23 @@ def shell_force(
     p21 = n12 * f22 - n22 * f12
     p22 = -n12 * f21 + n22 * f11
 
-    # 3. bending and transverse shear, rate form over Δt^{n−1/2}
-    (m1x, m1y, m1z), (m2x, m2y, m2z), (m3x, m3y, m3z) = mid[0], mid[1], mid[2]
-    mb1, mb2 = mid[5]
-    wx_ = (omega[c0, 0], omega[c1, 0], omega[c2_, 0], omega[c3, 0])
-    wy_ = (omega[c0, 1], omega[c1, 1], omega[c2_, 1], omega[c3, 1])
-    wz_ = (omega[c0, 2], omega[c1, 2], omega[c2_, 2], omega[c3, 2])
-    vx = local_components(vx_, vy_, vz_, m1x, m1y, m1z)
-    vy = local_components(vx_, vy_, vz_, m2x, m2y, m2z)
-    vz = local_components(vx_, vy_, vz_, m3x, m3y, m3z)
-    tx = local_components(wx_, wy_, wz_, m1x, m1y, m1z)
-    ty = local_components(wx_, wy_, wz_, m2x, m2y, m2z)
-    kx = ky = kxy2 = gxz = gyz = 0.0
-    for i in range(4):
-        kx += mb1[i] * ty[i]
-        ky -= mb2[i] * tx[i]
-        kxy2 += mb2[i] * ty[i] - mb1[i] * tx[i]
-        gxz += mb1[i] * vz[i] + 0.25 * ty[i]
-        gyz += mb2[i] * vz[i] - 0.25 * tx[i]
-    e_b = sections[sec, C_BEND_E]
-    nu_b = sections[sec, C_BEND_NU]
-    d_b = e_b * thick * thick * thick / (12.0 * (1.0 - nu_b * nu_b))
+    # 4. bending and transverse shear: M = D Δκ accumulated (resultant section) or
+    # from the points (integrated section, bending energy then in the membrane term)
     kgt = sections[sec, C_SHEAR_K] * sections[sec, C_SHEAR_G] * thick
-    dkx, dky, dkxy2 = kx * dt, ky * dt, kxy2 * dt
-    dgxz, dgyz = gxz * dt, gyz * dt
     m_old0, m_old1, m_old2 = el_in[e, E_M], el_in[e, E_M + 1], el_in[e, E_M + 2]
     q_old0, q_old1 = el_in[e, E_Q], el_in[e, E_Q + 1]
-    mxx = m_old0 + d_b * (dkx + nu_b * dky)
-    myy = m_old1 + d_b * (dky + nu_b * dkx)
-    mxy = m_old2 + d_b * 0.5 * (1.0 - nu_b) * dkxy2
+    if integrated:
+        d_b = c_memb * thick * thick / 12.0  # for the hourglass stiffness only
+        mxx, myy, mxy = mi_xx, mi_yy, mi_xy
+        w_bend = 0.0
+    else:
+        e_b = sections[sec, C_BEND_E]
+        nu_b = sections[sec, C_BEND_NU]
+        d_b = e_b * thick * thick * thick / (12.0 * (1.0 - nu_b * nu_b))
+        mxx = m_old0 + d_b * (dkx + nu_b * dky)
+        myy = m_old1 + d_b * (dky + nu_b * dkx)
+        mxy = m_old2 + d_b * 0.5 * (1.0 - nu_b) * dkxy2
+        w_bend = 1.0
     qx = q_old0 + kgt * dgxz
     qy = q_old1 + kgt * dgyz
     el_out[e, E_M] = mxx
@@ -359,11 +460,12 @@ def shell_force(
     el_out[e, E_Q] = qx
     el_out[e, E_Q + 1] = qy
     el_out[e, E_U_BEND] = el_in[e, E_U_BEND] + area * (
-        0.5 * (m_old0 + mxx) * dkx + 0.5 * (m_old1 + myy) * dky + 0.5 * (m_old2 + mxy) * dkxy2
+        w_bend * (0.5 * (m_old0 + mxx) * dkx + 0.5 * (m_old1 + myy) * dky
+                  + 0.5 * (m_old2 + mxy) * dkxy2)
         + 0.5 * (q_old0 + qx) * dgxz + 0.5 * (q_old1 + qy) * dgyz
     )
 
-    # 4. hourglass (Flanagan–Belytschko): γ_I = ¼ (h_I − (h·x̂) b1_I − (h·ŷ) b2_I),
+    # 5. hourglass (Flanagan–Belytschko): γ_I = ¼ (h_I − (h·x̂) b1_I − (h·ŷ) b2_I),
     # rates with the midpoint γ, forces with the current one
     gam, bb = hourglass_vectors(lx, ly, b1, b2)
     gam_mid = hourglass_vectors(mid[3][0], mid[3][1], mb1, mb2)[0]
@@ -389,7 +491,7 @@ def shell_force(
     el_out[e, E_HG + 4] = hg4
     el_out[e, E_U_HG] = el_in[e, E_U_HG] + e_hg
 
-    # 5. corner forces (membrane, shear, hourglass) and moments in the local frame,
+    # 6. corner forces (membrane, shear, hourglass) and moments in the local frame,
     # turned to global axes
     fsum = 0.0
     for i in range(4):
@@ -407,7 +509,7 @@ def shell_force(
         blocks[e, i, 5] = mx * e1z + my * e2z
         fsum += gx
 
-    # 6. stable step: L_e = A / longest edge, c² = max(C_m, k G t) / μ
+    # 7. stable step: L_e = A / longest edge, c² = max(C_m, k G t) / μ
     edge2 = 0.0
     for i in range(4):
         j = (i + 1) % 4

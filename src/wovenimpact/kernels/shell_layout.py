@@ -11,6 +11,9 @@ Sections (``Model.sections``, one row per section, SI):
 - ``C_SHEAR_G``: transverse shear modulus G of Q = k G t γ (Pa); ``C_SHEAR_K`` its
   factor k (5/6).
 - ``C_HOURGLASS``: hourglass stiffness coefficient r (—).
+- ``C_POINTS``: through-thickness integration points: 1 = resultant section (membrane
+  from the material, bending M = D κ), n ≥ 3 odd = the material evaluated at n
+  Simpson points z_k (membrane N = Σ w_k N_k, bending M = Σ w_k z_k N_k).
 
 Material kinds (``Model.mat_kind``): ``MAT_ELASTIC`` (params E, ν, ρ in columns
 ``E_MOD``, ``E_NU``, ``E_RHO``) and ``MAT_FABRIC`` (the crossover parameter vector of
@@ -27,6 +30,11 @@ Per-element state (``State.elem``, one row per element):
   energy (J); ``E_U_HG``: hourglass energy (J).
 - ``E_DT``: the element's stable time step L_e / c_e (s), before the factor α.
 - ``E_ALIVE``: 1.0 alive, 0.0 eroded.
+- ``E_KAPPA``: total curvatures κ_x, κ_y, 2κ_xy (1/m), accumulated from the rates (used
+  by integrated sections).
+
+The material state of an element is ``n_points`` consecutive blocks of the material's
+state vector (one block for a resultant section).
 """
 
 from __future__ import annotations
@@ -40,7 +48,8 @@ C_BEND_NU = 4
 C_SHEAR_G = 5
 C_SHEAR_K = 6
 C_HOURGLASS = 7
-N_SECTION = 8
+C_POINTS = 8
+N_SECTION = 9
 
 # material kinds and the elastic parameter vector
 MAT_ELASTIC = 0
@@ -60,7 +69,8 @@ E_U_BEND = 18
 E_U_HG = 19
 E_DT = 20
 E_ALIVE = 21
-N_ELEM_STATE = 22
+E_KAPPA = 22
+N_ELEM_STATE = 25
 
 # per-element status codes written by the force kernel
 EL_OK = 0

@@ -88,7 +88,7 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
             material=materials[s.material], thickness=s.thickness,
             bending_modulus=s.bending_modulus, bending_poisson=s.bending_poisson,
             transverse_shear_modulus=s.transverse_shear_modulus, shear_factor=s.shear_factor,
-            hourglass=s.hourglass, areal_mass=s.areal_mass,
+            hourglass=s.hourglass, areal_mass=s.areal_mass, points=s.points,
         )
         for name, s in spec.sections.items()
     }

@@ -41,6 +41,11 @@ class Section:
         shear_factor: k (—), 5/6.
         hourglass: r, hourglass stiffness coefficient (—), 0.05.
         areal_mass: μ (kg/m²); default ρ t (metal) or the fabric's areal mass.
+        points: 1 = resultant section (membrane from the material at the mid-surface,
+            elastic bending M = D κ with the bending modulus); an odd n ≥ 3 = the
+            material evaluated at n Simpson points through the thickness (the
+            thesis's S4R + VUMAT section; metals' default in Abaqus is 5), its
+            bending stiffness then comes from the material itself.
     """
 
     material: FabricParameters | MetalParameters
@@ -51,6 +56,7 @@ class Section:
     shear_factor: float = 5.0 / 6.0
     hourglass: float = 0.05
     areal_mass: float | None = None
+    points: int = 1
 
     def row(self, mat_index: int, name: str) -> np.ndarray:
         """The section's row of ``Model.sections`` (layout in shell_layout)."""
@@ -59,13 +65,17 @@ class Section:
         if isinstance(m, FabricParameters):
             t = m.shell_thickness if self.thickness is None else self.thickness
             mu = m.areal_mass if self.areal_mass is None else self.areal_mass
-            if self.bending_modulus is None or self.transverse_shear_modulus is None:
+            if self.transverse_shear_modulus is None or (
+                self.bending_modulus is None and self.points == 1
+            ):
                 raise InputError(
-                    f"section {name!r}: a fabric section needs bending_modulus and "
-                    "transverse_shear_modulus (the small elastic bending stiffness of "
-                    "MODEL.md §1.8), e.g. '1 GPa' and '3.28 GPa'"
+                    f"section {name!r}: a fabric section needs transverse_shear_modulus "
+                    "(e.g. '3.28 GPa') and, unless it is integrated through the thickness "
+                    "(points ≥ 3), bending_modulus (the small elastic bending stiffness of "
+                    "MODEL.md §1.8, e.g. '1 GPa')"
                 )
-            e_b, nu_b = self.bending_modulus, self.bending_poisson or 0.0
+            e_b = 1.0 if self.bending_modulus is None else self.bending_modulus  # unused if points > 1
+            nu_b = self.bending_poisson or 0.0
             g = self.transverse_shear_modulus
         else:
             if m.kind != "elastic":
@@ -86,6 +96,9 @@ class Section:
                              ("transverse_shear_modulus", g), ("shear_factor", self.shear_factor)):
             if not value > 0.0:
                 raise InputError(f"section {name!r}: {label} = {value!r} must be > 0")
+        if not (self.points == 1 or (self.points >= 3 and self.points % 2 == 1)):
+            raise InputError(f"section {name!r}: points = {self.points!r}; valid: 1 (resultant "
+                             "section) or an odd number ≥ 3 (Simpson integration)")
         if not 0.0 <= self.hourglass < 1.0:
             raise InputError(f"section {name!r}: hourglass = {self.hourglass!r}; valid: 0 ≤ r < 1")
         r[S.C_THICK] = t
@@ -96,6 +109,7 @@ class Section:
         r[S.C_SHEAR_G] = g
         r[S.C_SHEAR_K] = self.shear_factor
         r[S.C_HOURGLASS] = self.hourglass
+        r[S.C_POINTS] = self.points
         return r
 
 
@@ -148,7 +162,8 @@ class Model:
         sections: (n_sections, N_SECTION) section table (shell_layout).
         mat_kind: (n_mats,) MAT_ELASTIC or MAT_FABRIC.
         mat_params: (n_mats, n_params) parameter vectors, zero-padded.
-        mat_state0: (n_mats, n_mat_state) initial material state per material.
+        section_state0: (n_sections, n_mat_state) initial material state of an element
+            of each section (its points' state blocks side by side).
         ref_grad: (n_elems, 2, 4) ∂N_I/∂X at the element centre in its reference
             material frame (warp along x).
         area0: (n_elems,) reference areas.
@@ -174,7 +189,7 @@ class Model:
     sections: np.ndarray
     mat_kind: np.ndarray
     mat_params: np.ndarray
-    mat_state0: np.ndarray
+    section_state0: np.ndarray
     ref_grad: np.ndarray
     area0: np.ndarray
     node_mass: np.ndarray
@@ -342,12 +357,14 @@ def build_model(
             params.append(np.array([m.modulus, m.poisson, m.density]))
             states.append(np.zeros(0))
     n_par = max(len(p) for p in params)
-    n_st = max(1, max(len(s) for s in states))
     mat_params = np.zeros((len(mats), n_par))
-    mat_state0 = np.zeros((len(mats), n_st))
-    for i, (p, s) in enumerate(zip(params, states)):
+    for i, p in enumerate(params):
         mat_params[i, : len(p)] = p
-        mat_state0[i, : len(s)] = s
+    # per section: its points' state blocks side by side (width: the widest section)
+    blocks = [np.tile(states[int(r[S.C_MAT])], int(r[S.C_POINTS])) for r in sec_table]
+    section_state0 = np.zeros((len(blocks), max(1, max(len(b) for b in blocks))))
+    for i, b in enumerate(blocks):
+        section_state0[i, : len(b)] = b
     ref_grad, area0 = material_frame_gradients(x0, q, warp_direction)
     # lumped masses: a quarter of each element's mass to each corner; rotary inertia
     # m · max(t²/12, A/8) so that rotations never govern the stable step (theory §3)
@@ -369,7 +386,8 @@ def build_model(
     ptr, n_elem, n_corner = node_element_map(q, len(x0))
     return Model(
         x0=x0, quads=q, elem_section=es, sections=sec_table,
-        mat_kind=np.array(kinds, dtype=np.int64), mat_params=mat_params, mat_state0=mat_state0,
+        mat_kind=np.array(kinds, dtype=np.int64), mat_params=mat_params,
+        section_state0=section_state0,
         ref_grad=ref_grad, area0=area0, node_mass=node_mass, node_inertia=node_inertia,
         bc_code=bcs.code.copy(), bc_velocity=bcs.velocity.copy(), ramp_time=float(bcs.ramp_time),
         body_accel=ba, node_ptr=ptr, node_elem=n_elem, node_corner=n_corner, alpha=float(alpha),

@@ -13,7 +13,8 @@ Schema (see README and examples/cases/)::
     [case]            name, description
     [materials]       NAME = "path/to/material.toml"   (relative to the case file)
     [sections.NAME]   material, thickness?, bending_modulus?, bending_poisson?,
-                      transverse_shear_modulus?, shear_factor?, hourglass?, areal_mass?
+                      transverse_shear_modulus?, shear_factor?, hourglass?, areal_mass?,
+                      points? (1: resultant section; odd n ≥ 3: n Simpson points)
     [mesh]            kind = "plate": side, element_size, plies, spacing, quarter,
                       section, warp_direction   | kind = "abaqus": file, sections
                       = {ELSET = SECTION}, warp_direction
@@ -75,6 +76,7 @@ class SectionSpec(BaseModel):
     shear_factor: quantity("dimensionless", gt=0, le=1, example="0.8333") = 5.0 / 6.0
     hourglass: quantity("dimensionless", ge=0, lt=1, example="0.05") = 0.05
     areal_mass: quantity("areal_density", gt=0, example="0.477 kg/m^2") | None = None
+    points: int = Field(default=1, ge=1)  # 1: resultant section; odd ≥ 3: Simpson points
 
 
 class PlateMeshSpec(BaseModel):

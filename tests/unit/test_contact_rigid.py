@@ -1,0 +1,64 @@
+"""Signed distance and penalty forces of the rigid body-of-revolution contact."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from wovenimpact.impactor import Impactor
+from wovenimpact.kernels.contact_rigid import profile_distance, rigid_contact_forces
+
+R = 2e-3
+
+
+@settings(max_examples=300, deadline=None)
+@given(zeta=st.floats(-3 * R, 5 * R), rho=st.floats(0.0, 3 * R))
+def test_sphere_distance_is_exact(zeta, rho):
+    """Sphere of radius R, tip at ζ = 0: d = |(ζ − R, ρ)| − R to the polyline's chord error."""
+    prof = Impactor("sphere", R).profile(n=400)
+    d, nz, nr = profile_distance(zeta, rho, prof[:, 0], prof[:, 1])
+    exact = math.hypot(zeta - R, rho) - R
+    chord = R * (1 - math.cos(math.pi / 800))  # sagitta of one polyline segment
+    assert d == pytest.approx(exact, abs=chord + 1e-15)
+    if abs(exact) > 10 * chord:
+        r = math.hypot(zeta - R, rho)
+        assert nz == pytest.approx((zeta - R) / r, abs=1e-2)
+        assert nr == pytest.approx(rho / r, abs=1e-2)
+
+
+@pytest.mark.parametrize("zeta, rho, expect", [
+    (-1e-3, 0.5e-3, 1e-3),       # in front of the flat face
+    (1e-3, 0.5e-3, -1e-3),       # inside, closest to the flat face
+    (3e-3, 3e-3, 1e-3),          # beside the shank
+    (3e-3, 1.5e-3, -0.5e-3),     # inside, closest to the shank
+    (7e-3, 0.0, 1e-3),           # behind the tail
+])
+def test_flat_cylinder_distances(zeta, rho, expect):
+    prof = Impactor("cylinder", R, 6e-3).profile()
+    d = profile_distance(zeta, rho, prof[:, 0], prof[:, 1])[0]
+    assert d == pytest.approx(expect, abs=1e-15)
+
+
+def test_penalty_force_pushes_nodes_out_along_the_normal():
+    """A flat-faced cylinder moving along −z with its face at z = 0.1 mm below a
+    row of nodes offset by h = 0.25 mm: nodes under the face get f = k (h − d) along −z
+    (away from the body, which lies above... here the body is below the nodes)."""
+    imp = Impactor("cylinder", R, 6e-3)
+    prof = imp.profile()
+    axis = np.array([0.0, 0.0, -1.0])  # tail below the tip: the body lies under z = tip
+    tip = np.array([0.0, 0.0, -0.1e-3])
+    x = np.array([[0.0, 0.0, 0.0], [1e-3, 0.0, 0.0], [5e-3, 0.0, 0.0]])
+    k = np.full(3, 1e6)
+    force = np.zeros((3, 3))
+    energy = np.zeros(3)
+    rigid_contact_forces(x, np.ones(3, np.int8), np.full(3, 0.25e-3), k, tip, axis,
+                         prof[:, 0], prof[:, 1], 10e-3, force, energy)
+    gap = 0.25e-3 - 0.1e-3
+    assert force[0] == pytest.approx([0.0, 0.0, 1e6 * gap])
+    assert force[1] == pytest.approx([0.0, 0.0, 1e6 * gap])
+    assert np.all(force[2] == 0.0)  # beyond the radius: no contact
+    assert energy[0] == pytest.approx(0.5 * 1e6 * gap * gap)

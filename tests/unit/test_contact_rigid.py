@@ -44,9 +44,9 @@ def test_flat_cylinder_distances(zeta, rho, expect):
 
 
 def test_penalty_force_pushes_nodes_out_along_the_normal():
-    """A flat-faced cylinder moving along −z with its face at z = 0.1 mm below a
-    row of nodes offset by h = 0.25 mm: nodes under the face get f = k (h − d) along −z
-    (away from the body, which lies above... here the body is below the nodes)."""
+    """A flat-faced cylinder lying below z = −0.1 mm (its face), nodes at z = 0 with a
+    contact offset h = 0.25 mm: the nodes over the face are within h of it and get
+    f = k (h − d) along +z, away from the body; the node beyond the radius gets none."""
     imp = Impactor("cylinder", R, 6e-3)
     prof = imp.profile()
     axis = np.array([0.0, 0.0, -1.0])  # tail below the tip: the body lies under z = tip

@@ -99,7 +99,23 @@ def run_case(
             (as a crash would; used to test restarts).
     """
     spec, base = load_case(case_path)
-    compiled = compile_case(spec, base)
+    return run_spec(spec, base, out_dir, restart=restart, threads=threads, progress=progress,
+                    max_steps=max_steps)
+
+
+def run_spec(
+    spec,
+    base: str | Path,
+    out_dir: str | Path,
+    *,
+    restart: bool = False,
+    threads: int | None = None,
+    progress: Callable[[State, float], None] | None = None,
+    max_steps: int | None = None,
+) -> dict:
+    """:func:`run_case` for a validated :class:`~wovenimpact.spec.case.CaseSpec` whose
+    relative paths (materials, mesh) are relative to ``base``."""
+    compiled = compile_case(spec, Path(base))
     model = compiled.model
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)

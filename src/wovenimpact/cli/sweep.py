@@ -1,0 +1,42 @@
+"""``wovenimpact sweep STUDY.toml``: run a parameter study locally or on a Dask cluster."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import typer
+from rich.table import Table
+
+from wovenimpact.cli.app import app, console, fail
+from wovenimpact.errors import InputError
+
+
+@app.command("sweep")
+def sweep(
+    study: Path = typer.Argument(..., help="Study file (TOML)."),
+    out: Path = typer.Option(None, "--out", help="Output directory (default: out/<study name>)."),
+    scheduler: str = typer.Option(None, "--scheduler", help="Dask scheduler address (tcp://host:8786)."),
+    workers: int = typer.Option(2, "--workers", min=1, help="Local worker processes."),
+    as_json: bool = typer.Option(False, "--json", help="Print the results as one JSON object."),
+) -> None:
+    """Run every variant of STUDY (finished ones are kept), write results.csv and plots/."""
+    from wovenimpact.studies.sweep import run_study
+
+    out_dir = out or Path("out") / study.stem
+    try:
+        rows = run_study(study, out_dir, scheduler=scheduler, workers=workers)
+    except InputError as err:
+        fail(str(err))
+    failed = [r for r in rows if r["status"] != "done"]
+    if as_json:
+        typer.echo(json.dumps({"results": rows, "failed": len(failed), "out": str(out_dir)}))
+    else:
+        table = Table(title=f"{study.name}: {len(rows)} variants ({len(failed)} failed) → {out_dir}")
+        for col in rows[0]:
+            table.add_column(col)
+        for r in rows:
+            table.add_row(*(f"{v:.6g}" if isinstance(v, float) else str(v) for v in r.values()))
+        console.print(table)
+    if failed:
+        raise typer.Exit(1)

@@ -1,0 +1,227 @@
+"""Parameter studies: many variants of one case, on local processes or a Dask cluster.
+
+A study file (TOML) names a base case and the values to try for any key of it,
+addressed by its dotted path in the case document::
+
+    [study]
+    name = "striking velocity"
+    case = "../cases/fabric_plate_impulse.toml"    # relative to the study file
+    combine = "grid"                               # or "zip"
+    metrics = ["max_displacement_m", "energy_error_fraction"]
+
+    [parameters]
+    "initial_velocity.0.velocity" = [["0 m/s", "0 m/s", "-40 m/s"], ["0 m/s", "0 m/s", "-60 m/s"]]
+    "mesh.element_size" = ["0.94 mm", "1.88 mm"]
+
+``grid`` runs every combination, ``zip`` the i-th value of every parameter together.
+Every variant is validated like a case file (a bad value fails that variant, with the
+key named, and the others still run), run in ``OUT/runs/<id>/`` and summarised in
+``OUT/results.csv``. A variant whose ``summary.json`` exists with the same parameters
+is not run again (the study resumes). Runs go to a local process pool by default, or
+to a Dask cluster when a scheduler address is given.
+"""
+
+from __future__ import annotations
+
+import copy
+import csv
+import hashlib
+import io
+import itertools
+import json
+import tomllib
+import traceback
+from concurrent.futures import ProcessPoolExecutor
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+from pydantic import BaseModel, Field, ValidationError
+
+from wovenimpact.errors import InputError
+from wovenimpact.io.atomic import atomic_write_text
+from wovenimpact.spec.fields import STRICT, input_error, problems_from_validation
+
+
+class StudyInfo(BaseModel):
+    """``[study]``."""
+
+    model_config = STRICT
+    name: str = Field(min_length=1)
+    case: str = Field(min_length=1)
+    combine: Literal["grid", "zip"] = "grid"
+    metrics: list[str] = ["energy_error_fraction", "max_displacement_m"]
+
+
+class StudyFile(BaseModel):
+    model_config = STRICT
+    study: StudyInfo
+    parameters: dict[str, list[Any]] = Field(min_length=1)
+
+
+@dataclass
+class Variant:
+    """One case of a study: its id, the parameter values and the case document."""
+
+    id: str
+    values: dict[str, Any]
+    document: dict = field(repr=False)
+
+
+def set_dotted(doc: dict, key: str, value: Any) -> None:
+    """doc["a"]["b"][0]["c"] = value for key "a.b.0.c" (list items by index); the key
+    must exist in the base case except for its last part (a new optional key)."""
+    parts = key.split(".")
+    node: Any = doc
+    for i, part in enumerate(parts[:-1]):
+        try:
+            node = node[int(part)] if isinstance(node, list) else node[part]
+        except (KeyError, IndexError, ValueError):
+            where = ".".join(parts[: i + 1])
+            raise InputError(f"parameters.{key!r}: the base case has no {where!r}") from None
+    last = parts[-1]
+    if isinstance(node, list):
+        try:
+            node[int(last)] = value
+        except (IndexError, ValueError):
+            raise InputError(f"parameters.{key!r}: no item {last!r} in that list") from None
+    elif isinstance(node, dict):
+        node[last] = value
+    else:
+        raise InputError(f"parameters.{key!r}: {'.'.join(parts[:-1])!r} is not a table")
+
+
+def variant_id(values: dict) -> str:
+    """A stable short id for a set of parameter values."""
+    text = json.dumps(values, sort_keys=True, default=str)
+    return hashlib.sha256(text.encode()).hexdigest()[:10]
+
+
+def load_study(path: str | Path) -> tuple[StudyInfo, list[Variant], Path]:
+    """Read a study file; returns its header, its variants and the base case's directory."""
+    path = Path(path)
+    try:
+        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+    except OSError as err:
+        raise InputError(f"{path}: cannot read the study file ({err.strerror})") from None
+    except tomllib.TOMLDecodeError as err:
+        raise InputError(f"{path}: not valid TOML: {err}") from None
+    try:
+        spec = StudyFile.model_validate(doc)
+    except ValidationError as err:
+        raise input_error(problems_from_validation(err, StudyFile), str(path)) from None
+    case_path = (path.parent / spec.study.case).resolve()
+    try:
+        base_doc = tomllib.loads(case_path.read_text(encoding="utf-8"))
+    except OSError as err:
+        raise InputError(f"study.case: cannot read {case_path} ({err.strerror})") from None
+    keys = list(spec.parameters)
+    columns = [spec.parameters[k] for k in keys]
+    if spec.study.combine == "zip":
+        lengths = {len(c) for c in columns}
+        if len(lengths) != 1:
+            raise InputError(f"{path}: combine = 'zip' needs lists of equal length, got "
+                             + ", ".join(f"{k}: {len(c)}" for k, c in zip(keys, columns)))
+        rows = list(zip(*columns))
+    else:
+        rows = list(itertools.product(*columns))
+    variants = []
+    for row in rows:
+        values = dict(zip(keys, row))
+        document = copy.deepcopy(base_doc)
+        for k, v in values.items():
+            set_dotted(document, k, v)
+        variants.append(Variant(variant_id(values), values, document))
+    return spec.study, variants, case_path.parent
+
+
+def run_variant(document: dict, base: str, out_dir: str, values: dict, threads: int = 1) -> dict:
+    """Run one variant (in a worker process); never raises: failures are reported."""
+    from wovenimpact.runs import run_spec
+    from wovenimpact.spec.case import case_from_dict
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    atomic_write_text(out / "parameters.json", json.dumps(values, indent=2, default=str) + "\n")
+    try:
+        spec = case_from_dict(document, source=f"variant {out.name}")
+        summary = run_spec(spec, base, out, threads=threads)
+        return {"status": "done", **summary}
+    except Exception as err:  # one failing case is reported, the others finish
+        message = f"{type(err).__name__}: {err}"
+        atomic_write_text(out / "error.txt", message + "\n\n" + traceback.format_exc())
+        return {"status": "failed", "error": message}
+
+
+def finished(out: Path, values: dict) -> dict | None:
+    """The summary of a variant already run with these values, else None."""
+    try:
+        same = json.loads((out / "parameters.json").read_text()) == json.loads(
+            json.dumps(values, default=str))
+        summary = json.loads((out / "summary.json").read_text())
+    except (OSError, ValueError):
+        return None
+    return {"status": "done", **summary} if same else None
+
+
+def run_study(
+    study_path: str | Path,
+    out_dir: str | Path,
+    *,
+    scheduler: str | None = None,
+    workers: int = 2,
+    threads_per_run: int = 1,
+) -> list[dict]:
+    """Run every variant of a study (resuming), write results.csv and plots; returns the rows."""
+    info, variants, base = load_study(study_path)
+    out = Path(out_dir)
+    (out / "runs").mkdir(parents=True, exist_ok=True)
+    results: dict[str, dict] = {}
+    todo = []
+    for v in variants:
+        done = finished(out / "runs" / v.id, v.values)
+        if done is not None:
+            results[v.id] = {**done, "resumed": True}
+        else:
+            todo.append(v)
+    args = [(v.document, str(base), str(out / "runs" / v.id), v.values, threads_per_run)
+            for v in todo]
+    if todo and scheduler:
+        try:
+            from distributed import Client
+        except ImportError:
+            raise InputError("--scheduler needs dask.distributed: pip install 'dask[distributed]'") from None
+        with Client(scheduler) as client:
+            futures = [client.submit(run_variant, *a, pure=False) for a in args]
+            for v, res in zip(todo, client.gather(futures)):
+                results[v.id] = res
+    elif todo:
+        with ProcessPoolExecutor(max_workers=max(1, workers)) as pool:
+            for v, res in zip(todo, pool.map(run_variant, *zip(*args))):
+                results[v.id] = res
+    rows = []
+    for v in variants:
+        r = results[v.id]
+        row = {"id": v.id, **{k: _short(val) for k, val in v.values.items()},
+               "status": r.get("status"), "error": r.get("error", "")}
+        for m in info.metrics:
+            row[m] = r.get(m, "")
+        rows.append(row)
+    _write_csv(out / "results.csv", rows)
+    atomic_write_text(out / "results.json", json.dumps(rows, indent=2, default=str) + "\n")
+    from wovenimpact.studies.plots import study_plots
+
+    study_plots(info, variants, rows, out)
+    return rows
+
+
+def _short(value: Any) -> str:
+    return value if isinstance(value, str) else json.dumps(value)
+
+
+def _write_csv(path: Path, rows: list[dict]) -> None:
+    buf = io.StringIO()
+    writer = csv.DictWriter(buf, fieldnames=list(rows[0]))
+    writer.writeheader()
+    writer.writerows(rows)
+    atomic_write_text(path, buf.getvalue())

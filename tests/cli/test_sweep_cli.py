@@ -1,0 +1,81 @@
+"""``wovenimpact sweep``: variants, failure isolation, resume, results table and plots."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from tests.cli.test_run_cli import write_case
+from wovenimpact.cli.app import app
+
+STUDY = """
+[study]
+name = "kick velocity"
+case = "case.toml"
+metrics = ["max_displacement_m", "energy_error_fraction"]
+
+[parameters]
+"initial_velocity.0.velocity" = [["0 m/s", "0 m/s", "-30 m/s"], ["0 m/s", "0 m/s", "-60 m/s"], ["0 m/s", "0 m/s", "-60"]]
+"""
+
+
+def test_sweep_runs_variants_isolates_a_failure_and_resumes(tmp_path: Path):
+    write_case(tmp_path, end="8 us")
+    study = tmp_path / "study.toml"
+    study.write_text(STUDY)
+    out = tmp_path / "out"
+    result = CliRunner().invoke(app, ["sweep", str(study), "--out", str(out), "--json"])
+    assert result.exit_code == 1, result.output  # one variant has a value without unit
+    res = json.loads(result.stdout.strip().splitlines()[-1])
+    rows = res["results"]
+    assert [r["status"] for r in rows] == ["done", "done", "failed"]
+    assert "velocity" in rows[2]["error"] and "unit" in rows[2]["error"]
+    d30, d60 = (float(r["max_displacement_m"]) for r in rows[:2])
+    assert d60 > 1.5 * d30  # the faster kick moves the plate further
+    assert (out / "results.csv").read_text().count("\n") == 4
+    assert (out / "plots" / "max_displacement_m.png").exists()
+    assert (out / "plots" / "kinetic_energy_J_histories.png").exists()
+    # resume: finished variants are not run again
+    stamp = (out / "runs" / rows[0]["id"] / "summary.json").stat().st_mtime_ns
+    again = CliRunner().invoke(app, ["sweep", str(study), "--out", str(out), "--json"])
+    assert again.exit_code == 1
+    assert (out / "runs" / rows[0]["id"] / "summary.json").stat().st_mtime_ns == stamp
+
+
+def test_sweep_reports_a_bad_parameter_key(tmp_path: Path):
+    write_case(tmp_path, end="8 us")
+    study = tmp_path / "study.toml"
+    study.write_text(STUDY.replace('"initial_velocity.0.velocity"', '"impactor.velocity"'))
+    result = CliRunner().invoke(app, ["sweep", str(study), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2 and "impactor" in result.output
+
+
+def test_sweep_on_a_dask_cluster_gives_the_local_results(tmp_path: Path):
+    """The same study through a Dask scheduler (a local one here) gives the same rows."""
+    from distributed import LocalCluster
+
+    write_case(tmp_path, end="8 us")
+    study = tmp_path / "study.toml"
+    study.write_text(STUDY.replace(', ["0 m/s", "0 m/s", "-60"]', ""))
+    from wovenimpact.studies.sweep import run_study
+
+    local = run_study(study, tmp_path / "local")
+    with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
+                      dashboard_address=None) as cluster:
+        remote = run_study(study, tmp_path / "dask", scheduler=cluster.scheduler_address)
+    assert [r["status"] for r in remote] == ["done", "done"]
+    assert [r["max_displacement_m"] for r in remote] == [r["max_displacement_m"] for r in local]
+
+
+def test_example_studies_load_and_their_variants_validate():
+    from wovenimpact.spec.case import case_from_dict
+    from wovenimpact.studies.sweep import load_study
+
+    root = Path(__file__).resolve().parents[2] / "examples" / "studies"
+    for study in sorted(root.glob("*.toml")):
+        info, variants, base = load_study(study)
+        assert variants
+        for v in variants:
+            case_from_dict(v.document, source=f"{study.name}:{v.id}")

@@ -9,10 +9,11 @@ steps: after ``n`` steps ``x`` is x^n and ``v``/``omega`` are v^{n−1/2}/ω^{n�
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
 
 import numpy as np
 
+from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as S
 
 # indices of State.energy (J)
@@ -21,10 +22,12 @@ W_EXT = 1  # work of external forces, body forces and support reactions
 KINETIC = 2  # kinetic energy at the last whole step (translational + rotational)
 ERODED_KINETIC = 3  # kinetic energy of nodes left without any element
 ERODED_INTERNAL = 4  # stored energy of elements at their erosion
-KINETIC0 = 5  # kinetic energy at t = 0
-N_ENERGY = 6
+KINETIC0 = 5  # kinetic energy at t = 0 (nodes and rigid bodies)
+BODY_KINETIC = 6  # kinetic energy of the rigid bodies at the last whole step
+CONTACT_WORK = 7  # work of the contact forces on nodes and bodies (−penalty energy)
+N_ENERGY = 8
 ENERGY_NAMES = ("internal_work", "external_work", "kinetic", "eroded_kinetic",
-                "eroded_internal", "initial_kinetic")
+                "eroded_internal", "initial_kinetic", "body_kinetic", "contact_work")
 
 
 @dataclass
@@ -45,6 +48,7 @@ class State:
         node_active: (n_nodes,) 1 while a node belongs to at least one live element.
         energy: (N_ENERGY,) accumulators (indices in this module).
         dt_first: the first stable step (s), reference of the Δt-collapse check.
+        bodies: (n_bodies, N_BODY_STATE) rigid impactors (kernels.rigid_body layout).
     """
 
     t: float
@@ -60,6 +64,7 @@ class State:
     node_active: np.ndarray
     energy: np.ndarray
     dt_first: float = 0.0
+    bodies: np.ndarray = field(default_factory=lambda: np.zeros((0, RB.N_BODY_STATE)))
 
     def copy(self) -> State:
         return State(**{f.name: (getattr(self, f.name).copy() if isinstance(
@@ -107,11 +112,19 @@ def initial_state(model, velocity=None, angular_velocity=None) -> State:
     mat = model.section_state0[model.elem_section].copy()
     energy = np.zeros(N_ENERGY)
     ke = 0.5 * (np.sum(model.node_mass[:, None] * v * v) + np.sum(model.node_inertia[:, None] * w * w))
+    bodies = model.body_state0.copy()
+    ke_b = 0.0
+    for b, p in zip(bodies, model.body_params):
+        w = b[RB.B_W:RB.B_W + 3]
+        inertia = np.array([p[RB.BP_I_AXIAL], p[RB.BP_I_TRANS], p[RB.BP_I_TRANS]])
+        ke_b += 0.5 * p[RB.BP_MASS] * float(b[RB.B_V:RB.B_V + 3] @ b[RB.B_V:RB.B_V + 3])
+        ke_b += 0.5 * float(w @ (inertia * w))
     energy[KINETIC] = ke
-    energy[KINETIC0] = ke
+    energy[BODY_KINETIC] = ke_b
+    energy[KINETIC0] = ke + ke_b
     return State(t=0.0, step=0, dt=0.0, x=model.x0.copy(), v=v, omega=w, elem=elem, mat=mat,
                  f_int=np.zeros((n, 6)), f_ext=np.zeros((n, 6)),
-                 node_active=np.ones(n, dtype=np.int8), energy=energy)
+                 node_active=np.ones(n, dtype=np.int8), energy=energy, bodies=bodies)
 
 
 def rigid_rotation_velocity(x: np.ndarray, omega, centre=(0.0, 0.0, 0.0)) -> np.ndarray:

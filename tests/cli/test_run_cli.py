@@ -191,3 +191,38 @@ def test_initial_rigid_rotation_sets_v_equal_omega_cross_r(tmp_path):
     free = model.bc_code[:, :3] == 0
     assert np.allclose(st.v[free], expect[free], rtol=0, atol=1e-12)
     assert np.all(st.v[~free] == 0.0)
+
+
+IMPACTOR = """
+[impactor]
+shape = "cylinder"
+radius = "2.78 mm"
+length = "5.72 mm"
+mass = "1.1 g"
+position = ["0 mm", "0 mm", "{z}"]
+direction = [0, 0, -1]
+velocity = "120 m/s"
+"""
+
+
+def test_impactor_is_placed_with_its_mass_and_velocity(tmp_path):
+    from wovenimpact.kernels import rigid_body as RB
+
+    case = write_case(tmp_path, text=CASE + IMPACTOR.replace("{z}", "1 mm"))
+    spec, base = load_case(case)
+    compiled = compile_case(spec, base)
+    p, st = compiled.model.body_params[0], compiled.state.bodies[0]
+    assert p[RB.BP_MASS] == pytest.approx(1.1e-3)
+    assert st[RB.B_V:RB.B_V + 3] == pytest.approx([0.0, 0.0, -120.0])
+    # centre of mass half a length behind the tip, along +z (the tail is behind)
+    assert st[RB.B_X + 2] == pytest.approx(1e-3 + 0.5 * 5.72e-3)
+    ke = 0.5 * 1.1e-3 * 120.0**2
+    assert compiled.state.energy[5] == pytest.approx(ke + 0.5 * compiled.model.node_mass @ (
+        np.sum(compiled.state.v**2, axis=1)))
+
+
+def test_impactor_overlapping_the_plies_is_an_error(tmp_path):
+    case = write_case(tmp_path, text=CASE + IMPACTOR.replace("{z}", "0.1 mm"))
+    result = CliRunner().invoke(app, ["run", str(case), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2
+    assert "impactor.position" in result.output and "overlaps" in result.output

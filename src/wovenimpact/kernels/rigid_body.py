@@ -26,6 +26,16 @@ B_R = 6  # rotation matrix body → global (9, row-major)
 B_W = 15  # body-frame angular velocity (3)
 N_BODY_STATE = 18
 
+# static parameters of a body (Model.body_params)
+BP_MASS = 0  # m (kg)
+BP_I_AXIAL = 1  # moment of inertia about the axis of revolution (kg m²)
+BP_I_TRANS = 2  # about a transverse axis through the centre of mass (kg m²)
+BP_TIP = 3  # distance from the nose tip to the centre of mass along the axis (m)
+BP_BETA = 4  # penalty factor β of k = β m_node / Δt²
+BP_REACH = 5  # radius of a sphere about the tip enclosing the body (m)
+BP_NPTS = 6  # number of profile points used in Model.body_profiles
+N_BODY_PARAM = 7
+
 
 @kernel
 def advance_body(s, mass, i_axial, i_trans, force, torque, dt_old, dt_new):

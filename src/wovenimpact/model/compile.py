@@ -16,7 +16,10 @@ import numpy as np
 from wovenimpact.errors import InputError
 from wovenimpact.model.abaqus import read_inp
 from wovenimpact.model.mesh import Mesh, plate_mesh
-from wovenimpact.model.model import BoundaryConditions, Model, Section, build_model
+from wovenimpact.impactor import Impactor
+from wovenimpact.kernels import rigid_body as RB
+from wovenimpact.kernels.contact_rigid import rigid_contact_forces
+from wovenimpact.model.model import BoundaryConditions, Model, RigidBody, Section, build_model
 from wovenimpact.spec.case import DOFS, AbaqusMeshSpec, CaseSpec, PlateMeshSpec
 from wovenimpact.spec.material import load_material
 from wovenimpact.state import State, initial_state, rigid_rotation_velocity
@@ -79,6 +82,33 @@ def node_set(mesh: Mesh, name: str, key: str) -> np.ndarray:
     return np.asarray(mesh.node_sets[name], dtype=np.int64)
 
 
+def check_impactor_clearance(model: Model) -> None:
+    """Every node must start outside each impactor by at least its contact offset."""
+    n = model.n_nodes
+    force = np.zeros((n, 3))
+    energy = np.zeros(n)
+    for b in range(model.body_params.shape[0]):
+        p = model.body_params[b]
+        st = model.body_state0[b]
+        axis = st[RB.B_R:RB.B_R + 9].reshape(3, 3)[:, 0]
+        tip = st[RB.B_X:RB.B_X + 3] - p[RB.BP_TIP] * axis
+        prof = model.body_profiles[b, : int(p[RB.BP_NPTS])]
+        rigid_contact_forces(model.x0, np.ones(n, np.int8), model.node_offset, np.ones(n), tip,
+                             axis, np.ascontiguousarray(prof[:, 0]),
+                             np.ascontiguousarray(prof[:, 1]),
+                             p[RB.BP_REACH] + float(model.node_offset.max()), force, energy)
+        bad = np.flatnonzero(energy > 0.0)
+        if bad.size:
+            worst = int(bad[np.argmax(energy[bad])])
+            depth = np.sqrt(2.0 * energy[worst])
+            raise InputError(
+                f"impactor.position: the impactor overlaps the structure at t = 0 ({bad.size} "
+                f"nodes, node {worst} at {model.x0[worst].tolist()} is {depth * 1e3:.3g} mm "
+                "inside its contact offset, half the shell thickness); move the nose tip "
+                "further away"
+            )
+
+
 def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     """Build the Model and the State at t = 0 of a case (paths relative to ``base``)."""
     base = Path(base)
@@ -105,12 +135,23 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         else:
             bcs.prescribe(nodes, DOFS.index(b.dof), b.velocity)
     accel = None if spec.body_force is None else spec.body_force.acceleration
+    bodies = []
+    if spec.impactor is not None:
+        im = spec.impactor
+        try:
+            geometry = Impactor(shape=im.shape, radius=im.radius, length=im.length or 0.0,
+                                nose=im.nose, nose_length=im.nose_length, fillet=im.fillet,
+                                density=im.density)
+        except InputError as err:
+            raise InputError(f"impactor: {err}") from None
+        bodies.append(RigidBody(geometry, tip=im.position, direction=im.direction,
+                                speed=im.velocity, mass=im.mass, beta=im.contact_stiffness))
     used = {s: i for i, s in enumerate(dict.fromkeys(elem_sections))}
     model = build_model(
         mesh.nodes, mesh.quads, {s: sections[s] for s in used},
         np.array([used[s] for s in elem_sections], dtype=np.int64), bcs=bcs,
         warp_direction=spec.mesh.warp_direction, body_accel=accel, alpha=spec.run.alpha,
-        erode_dt_fraction=spec.run.erode_dt_fraction, ply=mesh.ply,
+        erode_dt_fraction=spec.run.erode_dt_fraction, ply=mesh.ply, bodies=bodies,
         node_sets=mesh.node_sets, elem_sets=mesh.elem_sets,
     )
     v = np.zeros((mesh.n_nodes, 3))
@@ -132,5 +173,6 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     fixed = model.bc_code[:, :3] == 1
     v[fixed] = 0.0
     w[model.bc_code[:, 3:] == 1] = 0.0
+    check_impactor_clearance(model)
     state = initial_state(model, velocity=v, angular_velocity=w)
     return CompiledCase(model=model, state=state, mesh=mesh, materials=materials)

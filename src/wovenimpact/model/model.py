@@ -16,7 +16,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from wovenimpact.errors import InputError
+from wovenimpact.impactor import Impactor
 from wovenimpact.kernels import fabric_layout as FL
+from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as S
 from wovenimpact.materials.fabric import FabricParameters
 from wovenimpact.materials.fabric import initial_state as fabric_initial_state
@@ -151,6 +153,53 @@ class BoundaryConditions:
         return self
 
 
+@dataclass(frozen=True)
+class RigidBody:
+    """A rigid impactor placed in the model.
+
+    Attributes:
+        impactor: its geometry and density.
+        tip: nose-tip position at t = 0 (m).
+        direction: direction of travel (the nose leads); normalised here.
+        speed: initial speed along ``direction`` (m/s).
+        mass: if given, the mass (kg) the density is scaled to.
+        beta: penalty factor of the node contact stiffness k = β m_node/Δt².
+    """
+
+    impactor: Impactor
+    tip: tuple[float, float, float]
+    direction: tuple[float, float, float] = (0.0, 0.0, -1.0)
+    speed: float = 0.0
+    mass: float | None = None
+    beta: float = 0.1
+
+    def pack(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(parameter row, profile polyline, initial state row) for the Model/State."""
+        imp = self.impactor
+        m, zc, i_a, i_t = imp.mass_properties()
+        if self.mass is not None:
+            scale = self.mass / m
+            m, i_a, i_t = m * scale, i_a * scale, i_t * scale
+        travel = np.asarray(self.direction, dtype=float)
+        travel = travel / np.linalg.norm(travel)
+        axis = -travel  # body axis: tip → tail
+        helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        e2 = np.cross(axis, helper)
+        e2 /= np.linalg.norm(e2)
+        e3 = np.cross(axis, e2)
+        rot = np.stack([axis, e2, e3], axis=1)  # columns: body axes in global coordinates
+        profile = imp.profile()
+        reach = float(np.max(np.hypot(profile[:, 0], profile[:, 1])))
+        params = np.zeros(RB.N_BODY_PARAM)
+        params[[RB.BP_MASS, RB.BP_I_AXIAL, RB.BP_I_TRANS, RB.BP_TIP, RB.BP_BETA, RB.BP_REACH,
+                RB.BP_NPTS]] = (m, i_a, i_t, zc, self.beta, reach, len(profile))
+        state = np.zeros(RB.N_BODY_STATE)
+        state[RB.B_X:RB.B_X + 3] = np.asarray(self.tip, dtype=float) + zc * axis
+        state[RB.B_V:RB.B_V + 3] = self.speed * travel
+        state[RB.B_R:RB.B_R + 9] = rot.ravel()
+        return params, profile, state
+
+
 @dataclass(frozen=True, eq=False)
 class Model:
     """Static arrays of a run (SI). Never mutated; the solver reads them.
@@ -179,6 +228,11 @@ class Model:
             0 disables). Fabric with one yarn family broken has no stiffness
             across it and crushes; without this the step would collapse.
         ply: (n_elems,) ply (or part) index of each element, for per-ply outputs.
+        node_offset: (n_nodes,) contact offset of each node: half the thickness of the
+            thickest section it belongs to (m).
+        body_params: (n_bodies, N_BODY_PARAM) rigid impactors (kernels.rigid_body).
+        body_profiles: (n_bodies, n_points, 2) their meridian polylines (ζ, ρ), padded.
+        body_state0: (n_bodies, N_BODY_STATE) their state at t = 0.
         node_sets, elem_sets: named index arrays (outputs, BCs).
         section_names, material_names: labels for reports.
     """
@@ -204,6 +258,10 @@ class Model:
     alpha: float
     erode_dt_fraction: float
     ply: np.ndarray
+    node_offset: np.ndarray
+    body_params: np.ndarray
+    body_profiles: np.ndarray
+    body_state0: np.ndarray
     node_sets: dict = field(default_factory=dict)
     elem_sets: dict = field(default_factory=dict)
     section_names: tuple = ()
@@ -221,7 +279,8 @@ class Model:
         """SHA-256 of every array: a checkpoint is only resumed on the same Model."""
         h = hashlib.sha256()
         for name in ("x0", "quads", "elem_section", "sections", "mat_kind", "mat_params",
-                     "bc_code", "bc_velocity", "body_accel", "node_mass", "node_inertia"):
+                     "bc_code", "bc_velocity", "body_accel", "node_mass", "node_inertia",
+                     "body_params", "body_profiles", "body_state0"):
             a = np.ascontiguousarray(getattr(self, name))
             h.update(name.encode())
             h.update(str(a.dtype).encode() + str(a.shape).encode())
@@ -295,6 +354,7 @@ def build_model(
     alpha: float = 0.9,
     erode_dt_fraction: float = 0.05,
     ply=None,
+    bodies: list[RigidBody] | None = None,
     node_sets: dict | None = None,
     elem_sets: dict | None = None,
 ) -> Model:
@@ -313,6 +373,7 @@ def build_model(
         erode_dt_fraction: erode elements whose step falls below this fraction of
             the first one, 0 ≤ f < 1 (0: never); default 0.05.
         ply: (n_elems,) part index for per-ply outputs; default all 0.
+        bodies: rigid impactors.
     """
     x0 = np.ascontiguousarray(nodes, dtype=float)
     q = np.ascontiguousarray(quads, dtype=np.int64)
@@ -384,6 +445,18 @@ def build_model(
     ba = np.zeros((len(x0), 3)) if body_accel is None else np.broadcast_to(
         np.asarray(body_accel, dtype=float), (len(x0), 3)).copy()
     ptr, n_elem, n_corner = node_element_map(q, len(x0))
+    node_offset = np.zeros(len(x0))
+    for c in range(4):
+        np.maximum.at(node_offset, q[:, c], 0.5 * thick)
+    packed = [b.pack() for b in (bodies or [])]
+    n_pts = max((len(p[1]) for p in packed), default=0)
+    body_params = np.zeros((len(packed), RB.N_BODY_PARAM))
+    body_profiles = np.zeros((len(packed), n_pts, 2))
+    body_state0 = np.zeros((len(packed), RB.N_BODY_STATE))
+    for i, (bp, prof, st0) in enumerate(packed):
+        body_params[i] = bp
+        body_profiles[i, : len(prof)] = prof
+        body_state0[i] = st0
     return Model(
         x0=x0, quads=q, elem_section=es, sections=sec_table,
         mat_kind=np.array(kinds, dtype=np.int64), mat_params=mat_params,
@@ -393,6 +466,8 @@ def build_model(
         body_accel=ba, node_ptr=ptr, node_elem=n_elem, node_corner=n_corner, alpha=float(alpha),
         erode_dt_fraction=float(erode_dt_fraction),
         ply=np.zeros(len(q), dtype=np.int64) if ply is None else np.asarray(ply, dtype=np.int64),
+        node_offset=node_offset, body_params=body_params, body_profiles=body_profiles,
+        body_state0=body_state0,
         node_sets=dict(node_sets or {}), elem_sets=dict(elem_sets or {}),
         section_names=tuple(names), material_names=tuple(getattr(m, "name", "") for m in mats),
     )

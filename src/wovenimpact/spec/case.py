@@ -25,6 +25,9 @@ Schema (see README and examples/cases/)::
                       angular_velocity = [wx, wy, wz] about centre; optional radius
                       (only nodes within it of centre)
     [body_force]      acceleration = [ax, ay, az]
+    [impactor]        shape = sphere | cylinder, radius, length, nose, nose_length, fillet,
+                      density | mass, position (nose tip), direction, velocity,
+                      contact_stiffness (penalty factor β of k = β m / Δt²)
     [run]             end_time, field_interval, history_interval, checkpoint_interval,
                       alpha, erode_dt_fraction, threads
 """
@@ -165,6 +168,37 @@ class RunSpec(BaseModel):
     threads: int | None = Field(default=None, ge=1)
 
 
+class ImpactorSpec(BaseModel):
+    """``[impactor]``: a rigid body of revolution launched at the structure (MODEL §4).
+
+    ``position`` is the nose tip at t = 0, ``direction`` the direction of travel (the
+    nose leads), ``velocity`` the speed along it. Mass from ``density`` (steel by
+    default) unless ``mass`` is given (the density is then scaled to match).
+    """
+
+    model_config = STRICT
+    shape: Literal["sphere", "cylinder"]
+    radius: Length
+    length: Length | None = None
+    nose: Literal["flat", "hemispherical", "conical", "ogive"] = "flat"
+    nose_length: quantity("length", ge=0, example="3 mm") = 0.0
+    fillet: quantity("length", ge=0, example="0.2 mm") = 0.0
+    density: quantity("density", gt=0, example="7922 kg/m^3") = 7922.0
+    mass: quantity("mass", gt=0, example="1.1 g") | None = None
+    position: tuple[Coordinate, Coordinate, Coordinate]
+    direction: tuple[float, float, float] = (0.0, 0.0, -1.0)
+    velocity: quantity("velocity", gt=0, example="120 m/s")
+    contact_stiffness: quantity("dimensionless", gt=0, le=0.5, example="0.1") = 0.1
+
+    @model_validator(mode="after")
+    def _cylinder_needs_length(self):
+        if self.shape == "cylinder" and self.length is None:
+            raise ValueError("a cylinder needs length (with unit)")
+        if sum(c * c for c in self.direction) == 0.0:
+            raise ValueError("direction must be a non-zero vector")
+        return self
+
+
 class CaseSpec(BaseModel):
     """A whole case file."""
 
@@ -177,6 +211,7 @@ class CaseSpec(BaseModel):
     amplitude: AmplitudeSpec = AmplitudeSpec()
     initial_velocity: list[InitialVelocitySpec] = []
     body_force: BodyForceSpec | None = None
+    impactor: ImpactorSpec | None = None
     run: RunSpec
 
 

@@ -1,0 +1,366 @@
+"""Narrow phase of the shell–shell contact: node-to-segment penalty (MODEL.md §4).
+
+Input: the node-major candidate list of :mod:`contact_broad` (``pair_ptr``,
+``pair_seg``). Every node of every ply is tested against the segments of the other
+plies, so each ply is both master and slave (two-pass contact).
+
+Projection (``closest_point_on_quad``): the closest point of the node p on the
+bilinear segment x(ξ, η) = x̄ + ξ a + η b + ξη c, (ξ, η) ∈ [−1, 1]²,
+a = ¼(−x1 + x2 + x3 − x4), b = ¼(−x1 − x2 + x3 + x4), c = ¼(x1 − x2 + x3 − x4).
+Newton on ½|p − x(ξ, η)|² (Hessian [[x,ξ·x,ξ, x,ξ·x,η − r·c], [·, x,η·x,η]],
+r = p − x; Gauss–Newton where it is not positive; exact in one step for a flat
+parallelogram); if the
+stationary point lies in the square it is the projection and the contact normal is
+the surface normal n = x,ξ × x,η / |…| there, turned toward the node; otherwise the
+closest point is on one of the four straight edges (exact segment projections) and
+the normal is (p − x_c)/|p − x_c| — the shell edge is rounded, and the normal turns
+continuously as a node slides off a segment.
+
+Selection: per node, candidates are grouped by (ply of the segment, side of the node
+with respect to the surface normal); only the closest candidate of a group is kept
+(ties: the lower segment index). A node sliding across a segment boundary thus sees
+one contact whose closest point moves continuously from one segment to the next.
+
+Gap and penalty, for a kept pair of node p and segment s:
+
+    g = d − (h_p + h_s − o_p),    d = |p − x_c|,
+    k = β · min(m_p, m̄_s) / Δt²,  m̄_s = ¼ Σ_I m_I (mean nodal mass of s),
+    f_n = −k g n  on the node when g < 0,  energy ½ k g²,
+
+h the half-thicknesses (shell offsets) and o_p the node's initial-overlap
+allowance (``initial_overlap``; 0 if unused). With β ≤ ½ the pair's frequency obeys
+ω² Δt² = β min(m_p, m̄_s)(1/m_p + 1/m̄_s) ≤ 2β ≤ 1 < 4: contact never limits the
+stable step.
+
+Friction (Coulomb, optional, stateless): with the relative velocity of the node and
+the closest point v_r = v_p − Σ N_I(ξ, η) v_I and its tangential part v_t,
+
+    f_t = −min(μ |f_n|, ½ m_red |v_t| / Δt) v_t / |v_t|,   m_red = m_p m̄_s / (m_p + m̄_s):
+
+kinetic friction, regularised near sticking by a cap that removes at most half the
+relative tangential velocity in one step (no spring memory, so no true stick).
+The friction force is applied at the closest point of the mid-surface: it leaves a
+couple |p − x_c| |f_t| that a shell with rotational offsets would carry.
+
+Reaction: the segment nodes get −N_I(ξ, η) f (Σ_I N_I = 1, so the pair's forces sum
+to zero; for a frictionless pair f ∥ p − x_c, so their moment vanishes too).
+
+Assembly without scatter (``assemble_contact_forces``): each pair k stores its force
+f_k and weights N_I in its own rows; a node sums its own pairs (node-major already);
+the segment side is gathered through a CSR (segment node → (pair, corner)) built by
+a serial counting sort in pair order. Energy and active count are summed serially
+in pair order. Results are bitwise independent of the thread count.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import prange
+
+from wovenimpact.jit import kernel, loop_kernel
+
+GEO_XI, GEO_ETA, GEO_DIST, GEO_N, GEO_SIDE = 0, 1, 2, 3, 6  # columns of the pair table
+N_GEO = 7
+INSIDE_TOL = 1e-10  # |ξ|, |η| ≤ 1 + tol counts as inside the segment
+GN_ITERATIONS = 12
+
+
+@kernel
+def closest_point_on_quad(px, py, pz, x, quads, s):
+    """Closest point of (px, py, pz) on the bilinear segment s (module docstring).
+
+    Returns (ξ, η, c_x, c_y, c_z, n_x, n_y, n_z, inside): natural coordinates and
+    position of the closest point, the unit surface normal x,ξ × x,η there (its
+    orientation follows the node order of s) and 1 if the point is inside the square.
+    """
+    q0, q1, q2, q3 = quads[s, 0], quads[s, 1], quads[s, 2], quads[s, 3]
+    x1, y1, z1 = x[q0, 0], x[q0, 1], x[q0, 2]
+    x2, y2, z2 = x[q1, 0], x[q1, 1], x[q1, 2]
+    x3, y3, z3 = x[q2, 0], x[q2, 1], x[q2, 2]
+    x4, y4, z4 = x[q3, 0], x[q3, 1], x[q3, 2]
+    mx, my, mz = 0.25 * (x1 + x2 + x3 + x4), 0.25 * (y1 + y2 + y3 + y4), 0.25 * (z1 + z2 + z3 + z4)
+    ax, ay, az = 0.25 * (x2 + x3 - x1 - x4), 0.25 * (y2 + y3 - y1 - y4), 0.25 * (z2 + z3 - z1 - z4)
+    bx, by, bz = 0.25 * (x3 + x4 - x1 - x2), 0.25 * (y3 + y4 - y1 - y2), 0.25 * (z3 + z4 - z1 - z2)
+    cx, cy, cz = 0.25 * (x1 + x3 - x2 - x4), 0.25 * (y1 + y3 - y2 - y4), 0.25 * (z1 + z3 - z2 - z4)
+    xi = 0.0
+    eta = 0.0
+    for _ in range(GN_ITERATIONS):
+        rx = px - (mx + xi * ax + eta * bx + xi * eta * cx)
+        ry = py - (my + xi * ay + eta * by + xi * eta * cy)
+        rz = pz - (mz + xi * az + eta * bz + xi * eta * cz)
+        t1x, t1y, t1z = ax + eta * cx, ay + eta * cy, az + eta * cz
+        t2x, t2y, t2z = bx + xi * cx, by + xi * cy, bz + xi * cz
+        g1 = rx * t1x + ry * t1y + rz * t1z
+        g2 = rx * t2x + ry * t2y + rz * t2z
+        a11 = t1x * t1x + t1y * t1y + t1z * t1z
+        a22 = t2x * t2x + t2y * t2y + t2z * t2z
+        a12 = t1x * t2x + t1y * t2y + t1z * t2z - (rx * cx + ry * cy + rz * cz)  # Newton
+        det = a11 * a22 - a12 * a12
+        if not det > 0.0:  # far from a warped quad: Gauss–Newton (drop r · x,ξη)
+            a12 = t1x * t2x + t1y * t2y + t1z * t2z
+            det = a11 * a22 - a12 * a12
+            if not det > 0.0:
+                break
+        dxi = (a22 * g1 - a12 * g2) / det
+        deta = (a11 * g2 - a12 * g1) / det
+        xi = min(max(xi + dxi, -2.0), 2.0)
+        eta = min(max(eta + deta, -2.0), 2.0)
+        if abs(dxi) + abs(deta) < 1e-14:
+            break
+    inside = abs(xi) <= 1.0 + INSIDE_TOL and abs(eta) <= 1.0 + INSIDE_TOL
+    if inside:
+        xi = min(max(xi, -1.0), 1.0)
+        eta = min(max(eta, -1.0), 1.0)
+        ox = mx + xi * ax + eta * bx + xi * eta * cx
+        oy = my + xi * ay + eta * by + xi * eta * cy
+        oz = mz + xi * az + eta * bz + xi * eta * cz
+    else:  # closest point on the boundary: the four straight edges, exactly
+        best = math.inf
+        ox = oy = oz = 0.0
+        for e in range(4):
+            qa, qb = quads[s, e], quads[s, (e + 1) % 4]
+            ex, ey, ez = x[qb, 0] - x[qa, 0], x[qb, 1] - x[qa, 1], x[qb, 2] - x[qa, 2]
+            ll = ex * ex + ey * ey + ez * ez
+            t = 0.0
+            if ll > 0.0:
+                t = ((px - x[qa, 0]) * ex + (py - x[qa, 1]) * ey + (pz - x[qa, 2]) * ez) / ll
+                t = min(max(t, 0.0), 1.0)
+            kx, ky, kz = x[qa, 0] + t * ex, x[qa, 1] + t * ey, x[qa, 2] + t * ez
+            d2 = (px - kx) ** 2 + (py - ky) ** 2 + (pz - kz) ** 2
+            if d2 < best:
+                best = d2
+                ox, oy, oz = kx, ky, kz
+                # corners (−1,−1), (1,−1), (1,1), (−1,1): edge e runs from corner e to e+1
+                xa = -1.0 if e == 0 or e == 3 else 1.0
+                ya = -1.0 if e <= 1 else 1.0
+                xb = -1.0 if e == 2 or e == 3 else 1.0
+                yb = -1.0 if e == 0 or e == 3 else 1.0
+                xi = xa + t * (xb - xa)
+                eta = ya + t * (yb - ya)
+    t1x, t1y, t1z = ax + eta * cx, ay + eta * cy, az + eta * cz
+    t2x, t2y, t2z = bx + xi * cx, by + xi * cy, bz + xi * cz
+    nx, ny, nz = t1y * t2z - t1z * t2y, t1z * t2x - t1x * t2z, t1x * t2y - t1y * t2x
+    nn = math.sqrt(nx * nx + ny * ny + nz * nz)
+    scale = ax * ax + ay * ay + az * az + bx * bx + by * by + bz * bz
+    if not nn > 1e-12 * scale:  # collapsed corner of a triangle: the centre normal
+        nx, ny, nz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+        nn = math.sqrt(nx * nx + ny * ny + nz * nz)
+    inv = 1.0 / nn
+    return xi, eta, ox, oy, oz, nx * inv, ny * inv, nz * inv, 1 if inside else 0
+
+
+@kernel
+def shape_functions(xi, eta):
+    """Bilinear N_I(ξ, η), corners (−1,−1), (1,−1), (1,1), (−1,1)."""
+    return (
+        0.25 * (1.0 - xi) * (1.0 - eta),
+        0.25 * (1.0 + xi) * (1.0 - eta),
+        0.25 * (1.0 + xi) * (1.0 + eta),
+        0.25 * (1.0 - xi) * (1.0 + eta),
+    )
+
+
+@kernel
+def evaluate_node_pairs(p, x, quads, ply, pair_ptr, pair_seg, geo, keep):
+    """Project node p on each of its candidate segments and keep the closest per group.
+
+    Writes, for k in pair_ptr[p] … pair_ptr[p + 1] − 1: geo[k] = (ξ, η, d, n_x, n_y,
+    n_z, side) with d = |p − x_c|, n the unit contact normal pointing from the
+    segment to the node, side = ±1 the node's side of the surface normal; keep[k] = 1
+    for the closest candidate of each (ply, side) group, else 0.
+    """
+    px, py, pz = x[p, 0], x[p, 1], x[p, 2]
+    k0, k1 = pair_ptr[p], pair_ptr[p + 1]
+    for k in range(k0, k1):
+        xi, eta, ox, oy, oz, sx, sy, sz, inside = closest_point_on_quad(
+            px, py, pz, x, quads, pair_seg[k])
+        rx, ry, rz = px - ox, py - oy, pz - oz
+        dn = rx * sx + ry * sy + rz * sz
+        side = 1.0 if dn >= 0.0 else -1.0
+        d = math.sqrt(rx * rx + ry * ry + rz * rz)
+        if inside == 1 or not d > 0.0:  # the surface normal, turned toward the node
+            nx, ny, nz = side * sx, side * sy, side * sz
+            d = abs(dn) if inside == 1 else d
+        else:  # beyond an edge: along p − x_c
+            nx, ny, nz = rx / d, ry / d, rz / d
+        geo[k, GEO_XI] = xi
+        geo[k, GEO_ETA] = eta
+        geo[k, GEO_DIST] = d
+        geo[k, GEO_N] = nx
+        geo[k, GEO_N + 1] = ny
+        geo[k, GEO_N + 2] = nz
+        geo[k, GEO_SIDE] = side
+    for k in range(k0, k1):
+        sk = pair_seg[k]
+        best = True
+        for j in range(k0, k1):
+            sj = pair_seg[j]
+            if j == k or ply[sj] != ply[sk] or geo[j, GEO_SIDE] != geo[k, GEO_SIDE]:
+                continue
+            dj, dk = geo[j, GEO_DIST], geo[k, GEO_DIST]
+            if dj < dk or (dj == dk and sj < sk):
+                best = False
+                break
+        keep[k] = 1 if best else 0
+
+
+@loop_kernel
+def penalty_forces(
+    x, v, quads, ply, node_mass, h_node, h_seg, overlap, beta, mu, dt,
+    pair_ptr, pair_seg, geo, pair_on, pair_f, pair_w, pair_e, node_f,
+):
+    """Penalty (and friction) force of every candidate pair (module docstring).
+
+    Args:
+        x, v: (n_nodes, 3) positions x^n and velocities (v^{n−1/2} in the solver).
+        quads, ply: segments and their plies; node_mass: (n_nodes,) lumped masses.
+        h_node, h_seg: node and segment offsets (m); overlap: (n_nodes,) o_p (m).
+        beta: penalty scale β; mu: friction coefficient μ (0: frictionless).
+        dt: the time step the forces are for (s), > 0.
+        pair_ptr, pair_seg: candidates (contact_broad.find_candidates).
+        geo: (capacity, N_GEO), pair_on: (capacity,) int8: scratch / written.
+        pair_f: (capacity, 3) written: force on the node of each pair (N).
+        pair_w: (capacity, 4) written: N_I(ξ, η) of each pair.
+        pair_e: (capacity,) written: ½ k g² of each pair (J).
+        node_f: (n_nodes, 3) written: Σ of each node's own pair forces (N).
+    """
+    n_nodes = x.shape[0]
+    inv_dt2 = 1.0 / (dt * dt)
+    for p in prange(n_nodes):
+        fx = fy = fz = 0.0
+        k0, k1 = pair_ptr[p], pair_ptr[p + 1]
+        if k1 > k0:
+            evaluate_node_pairs(p, x, quads, ply, pair_ptr, pair_seg, geo, pair_on)
+        for k in range(k0, k1):
+            pair_f[k, 0] = pair_f[k, 1] = pair_f[k, 2] = 0.0
+            pair_e[k] = 0.0
+            if pair_on[k] == 0:
+                continue
+            s = pair_seg[k]
+            g = geo[k, GEO_DIST] - (h_node[p] + h_seg[s] - overlap[p])
+            if not g < 0.0:
+                pair_on[k] = 0
+                continue
+            n1, n2, n3, n4 = shape_functions(geo[k, GEO_XI], geo[k, GEO_ETA])
+            pair_w[k, 0] = n1
+            pair_w[k, 1] = n2
+            pair_w[k, 2] = n3
+            pair_w[k, 3] = n4
+            q0, q1, q2, q3 = quads[s, 0], quads[s, 1], quads[s, 2], quads[s, 3]
+            m_p = node_mass[p]
+            m_s = 0.25 * (node_mass[q0] + node_mass[q1] + node_mass[q2] + node_mass[q3])
+            k_pen = beta * min(m_p, m_s) * inv_dt2
+            f_n = -k_pen * g
+            nx, ny, nz = geo[k, GEO_N], geo[k, GEO_N + 1], geo[k, GEO_N + 2]
+            gx, gy, gz = f_n * nx, f_n * ny, f_n * nz
+            if mu > 0.0:
+                vx = v[p, 0] - (n1 * v[q0, 0] + n2 * v[q1, 0] + n3 * v[q2, 0] + n4 * v[q3, 0])
+                vy = v[p, 1] - (n1 * v[q0, 1] + n2 * v[q1, 1] + n3 * v[q2, 1] + n4 * v[q3, 1])
+                vz = v[p, 2] - (n1 * v[q0, 2] + n2 * v[q1, 2] + n3 * v[q2, 2] + n4 * v[q3, 2])
+                vn = vx * nx + vy * ny + vz * nz
+                tx, ty, tz = vx - vn * nx, vy - vn * ny, vz - vn * nz
+                vt = math.sqrt(tx * tx + ty * ty + tz * tz)
+                if vt > 0.0:
+                    m_red = m_p * m_s / (m_p + m_s)
+                    f_t = min(mu * f_n, 0.5 * m_red * vt / dt) / vt
+                    gx -= f_t * tx
+                    gy -= f_t * ty
+                    gz -= f_t * tz
+            pair_f[k, 0] = gx
+            pair_f[k, 1] = gy
+            pair_f[k, 2] = gz
+            pair_e[k] = 0.5 * k_pen * g * g
+            fx += gx
+            fy += gy
+            fz += gz
+        node_f[p, 0] = fx
+        node_f[p, 1] = fy
+        node_f[p, 2] = fz
+
+
+@loop_kernel
+def initial_overlap(x, quads, ply, h_node, h_seg, pair_ptr, pair_seg, geo, keep, overlap):
+    """Initial-overlap allowance o_p = max(0, max over kept pairs of h_p + h_s − d).
+
+    With it the gap g = d − (h_p + h_s − o_p) of every kept pair is ≥ 0 in the
+    configuration x (the deepest pair of each node at exactly 0): overlaps present at
+    the start are removed rather than pushed apart. o_p is kept constant during the
+    run (the plies then contact at their nested distance again after separating).
+
+    Args:
+        x: (n_nodes, 3) initial positions; pair_ptr, pair_seg: candidates at x.
+        geo, keep: scratch as in ``penalty_forces``.
+        overlap: (n_nodes,) written (m).
+    """
+    for p in prange(x.shape[0]):
+        o = 0.0
+        k0, k1 = pair_ptr[p], pair_ptr[p + 1]
+        if k1 > k0:
+            evaluate_node_pairs(p, x, quads, ply, pair_ptr, pair_seg, geo, keep)
+            for k in range(k0, k1):
+                if keep[k] != 0:
+                    o = max(o, h_node[p] + h_seg[pair_seg[k]] - geo[k, GEO_DIST])
+        overlap[p] = o
+
+
+@loop_kernel
+def assemble_contact_forces(
+    quads, pair_ptr, pair_seg, pair_on, pair_f, pair_w, pair_e, node_f,
+    seg_ptr, seg_entry, cursor, out, accumulate,
+):
+    """Nodal contact forces: out[n] (=, or += with ``accumulate``) node_f[n] − Σ N_I f_k
+    over the pairs k whose segment has n as its corner I; the segment side is gathered
+    through a CSR built by a serial counting sort in pair order (no scatter-add).
+
+    Args:
+        quads, pair_ptr, pair_seg, pair_on, pair_f, pair_w, pair_e, node_f: as written
+            by ``penalty_forces``.
+        seg_ptr: (n_nodes + 1,) int64, seg_entry: (4 capacity,) int64, cursor:
+            (n_nodes,) int64: scratch.
+        out: (n_nodes, ≥ 3) columns 0–2 written (or added to).
+        accumulate: add to out instead of overwriting it.
+
+    Returns:
+        (energy, n_active): Σ ½ k g² (J), summed in pair order, and the active pairs.
+    """
+    n_nodes = pair_ptr.shape[0] - 1
+    n_pairs = pair_ptr[n_nodes]
+    for n in range(n_nodes + 1):
+        seg_ptr[n] = 0
+    energy = 0.0
+    n_active = 0
+    for k in range(n_pairs):
+        if pair_on[k] != 0:
+            energy += pair_e[k]
+            n_active += 1
+            s = pair_seg[k]
+            for c in range(4):
+                seg_ptr[quads[s, c] + 1] += 1
+    for n in range(n_nodes):
+        seg_ptr[n + 1] += seg_ptr[n]
+        cursor[n] = seg_ptr[n]
+    for k in range(n_pairs):
+        if pair_on[k] != 0:
+            s = pair_seg[k]
+            for c in range(4):
+                q = quads[s, c]
+                seg_entry[cursor[q]] = 4 * k + c
+                cursor[q] += 1
+    for n in prange(n_nodes):
+        fx, fy, fz = node_f[n, 0], node_f[n, 1], node_f[n, 2]
+        for j in range(seg_ptr[n], seg_ptr[n + 1]):
+            k = seg_entry[j] // 4
+            w = pair_w[k, seg_entry[j] % 4]
+            fx -= w * pair_f[k, 0]
+            fy -= w * pair_f[k, 1]
+            fz -= w * pair_f[k, 2]
+        if accumulate:
+            out[n, 0] += fx
+            out[n, 1] += fy
+            out[n, 2] += fz
+        else:
+            out[n, 0] = fx
+            out[n, 1] = fy
+            out[n, 2] = fz
+    return energy, n_active

@@ -1,0 +1,361 @@
+"""Shell–shell penalty contact: bucket search, node-to-segment forces, driver (MODEL.md §4)."""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from wovenimpact.contact import ShellContact
+from wovenimpact.jit import set_threads
+from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels.contact_broad import bucket_count, find_candidates
+from wovenimpact.materials.metal import MetalParameters
+from wovenimpact.model import Section, build_model
+from wovenimpact.model.mesh import plate_mesh
+from wovenimpact.model.model import node_element_map
+from wovenimpact.state import initial_state
+
+STEEL = MetalParameters(name="steel", kind="elastic", density=7850.0, modulus=210e9, poisson=0.3)
+DT = 1e-7
+BETA = 0.1
+
+
+def plies_model(n_plies=2, side=16e-3, size=1e-3, spacing=0.6e-3, thickness=0.5e-3, quarter=True):
+    mesh = plate_mesh(side, size, plies=n_plies, spacing=spacing, quarter=quarter)
+    model = build_model(mesh.nodes, mesh.quads, {"s": Section(STEEL, thickness=thickness)},
+                        np.zeros(mesh.n_elems, int), ply=mesh.ply)
+    return mesh, model
+
+
+def two_quads_model(thickness=0.2e-3, small=1e-3, big=2e-3, z=0.1e-3):
+    """A big quad [0, big]² at z = 0 (ply 0) and a small one (ply 1) centred over it at z."""
+    c = 0.5 * big
+    h = 0.5 * small
+    nodes = np.array([
+        [0, 0, 0], [big, 0, 0], [big, big, 0], [0, big, 0],
+        [c - h, c - h, z], [c + h, c - h, z], [c + h, c + h, z], [c - h, c + h, z],
+    ], dtype=float)
+    quads = np.array([[0, 1, 2, 3], [4, 5, 6, 7]])
+    model = build_model(nodes, quads, {"s": Section(STEEL, thickness=thickness)}, [0, 0],
+                        ply=[0, 1])
+    return model
+
+
+def contact_forces(contact, model, x, v=None, alive=None, active=None, dt=DT):
+    out = np.zeros((model.n_nodes, 3))
+    v = np.zeros_like(x) if v is None else v
+    alive = np.ones(model.n_elems) if alive is None else alive
+    active = np.ones(model.n_nodes, dtype=np.int8) if active is None else active
+    energy, n_active = contact.forces(x, v, dt, alive, active, out)
+    return out, energy, n_active
+
+
+def moment(x, f):
+    return np.cross(x, f).sum(axis=0)
+
+
+# --- normal penalty force ----------------------------------------------------------------
+
+
+def test_no_force_while_the_gap_is_open():
+    """Mid-planes 0.6 mm apart, offsets 0.25 + 0.25 mm: closing to a gap of 1 nm gives nothing."""
+    mesh, model = plies_model()
+    contact = ShellContact(model, remove_initial_overlap=False)
+    x = model.x0.copy()
+    for z_drop in (0.0, 0.05e-3, 0.1e-3 - 1e-9):
+        x[mesh.node_sets["ply1"], 2] = 0.6e-3 - z_drop
+        f, energy, n = contact_forces(contact, model, x)
+        assert n == 0 and energy == 0.0 and not f.any()
+
+
+def test_pair_force_is_k_times_penetration_equal_and_opposite():
+    """Small quad over a big one, gap −δ: each small-quad node gets k δ along +z with
+    k = β min(m_node, m̄_segment)/Δt²; the big quad's nodes the opposite, split by N_I."""
+    t = 0.2e-3
+    delta = 0.013e-3
+    model = two_quads_model(thickness=t, z=t - delta)
+    contact = ShellContact(model, beta=BETA, remove_initial_overlap=False)
+    f, energy, n = contact_forces(contact, model, model.x0)
+    assert n == 4  # the big quad's corners are beyond the small one's inflated box
+    m_small = model.node_mass[4]
+    m_big = model.node_mass[0]
+    k = BETA * min(m_small, m_big) / DT**2
+    np.testing.assert_allclose(f[4:, 2], k * delta, rtol=1e-12)
+    np.testing.assert_allclose(f[4:, :2], 0.0, atol=1e-12 * k * delta)
+    # the small quad's nodes sit at ξ, η = ±½: the corners share −4 k δ by N_I
+    np.testing.assert_allclose(f[:4, 2], -k * delta, rtol=1e-12)
+    np.testing.assert_allclose(f.sum(axis=0), 0.0, atol=1e-12 * k * delta)
+    assert energy == pytest.approx(4 * 0.5 * k * delta**2, rel=1e-12)
+
+
+def random_overlapping_plies(seed, n_plies=3, amp=0.15e-3):
+    mesh, model = plies_model(n_plies=n_plies, side=12e-3, spacing=0.45e-3)
+    rng = np.random.default_rng(seed)
+    x = model.x0 + rng.uniform(-amp, amp, model.x0.shape)
+    return mesh, model, x, rng
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_forces_sum_to_zero_and_carry_no_moment(seed):
+    """Perturbed, warped, overlapping plies: Σ f = 0 and Σ x × f = 0 (frictionless)."""
+    mesh, model, x, _ = random_overlapping_plies(seed)
+    contact = ShellContact(model, remove_initial_overlap=False)
+    f, energy, n = contact_forces(contact, model, x)
+    assert n > 50 and energy > 0.0
+    scale = np.abs(f).max()
+    np.testing.assert_allclose(f.sum(axis=0), 0.0, atol=1e-12 * scale * model.n_nodes)
+    np.testing.assert_allclose(moment(x, f), 0.0, atol=1e-12 * scale * 6e-3 * model.n_nodes)
+
+
+def test_node_sliding_across_segment_boundaries_feels_a_continuous_force():
+    """A tiny quad (lighter nodes than the plate's) slides along x over a flat ply at a
+    fixed penetration, across element edges and through a vertex: its normal force stays
+    k δ exactly and the plate's nodal reactions change continuously (N_I(ξ, η))."""
+    t = 0.4e-3
+    delta = 0.02e-3
+    mesh = plate_mesh(12e-3, 1e-3, plies=1, quarter=True)  # [0, 6 mm]², 1 mm elements
+    eps = 0.02e-3
+    y0 = 1.5e-3  # mid-row: the plate's nodes stay out of reach of the small quad
+    small = np.array([[0, 0, 0], [eps, 0, 0], [eps, eps, 0], [0, eps, 0]]) + [0, y0, t - delta]
+    nodes = np.vstack([mesh.nodes, small])
+    quads = np.vstack([mesh.quads, mesh.n_nodes + np.arange(4)])
+    ply = np.append(mesh.ply, 1)
+    model = build_model(nodes, quads, {"s": Section(STEEL, thickness=t)}, np.zeros(len(quads), int),
+                        ply=ply)
+    contact = ShellContact(model, remove_initial_overlap=False)
+    k = BETA * model.node_mass[-1] / DT**2
+    xs = np.linspace(1.2e-3, 3.8e-3, 261)  # crosses x = 2 mm and 3 mm
+    plate_f = []
+    for sx in xs:
+        x = model.x0.copy()
+        x[-4:, 0] += sx
+        f, _, n = contact_forces(contact, model, x)
+        assert n == 4
+        np.testing.assert_allclose(f[-4:, 2], k * delta, rtol=1e-12)
+        plate_f.append(f[: mesh.n_nodes, 2].copy())
+    jumps = np.abs(np.diff(np.array(plate_f), axis=0)).max()
+    # |∂N_I/∂x| ≤ 1/size: a step Δx moves a plate node's share of 4kδ by ≤ 4kδ Δx/size
+    assert jumps <= 4 * (xs[1] - xs[0]) / 1e-3 * k * delta * 1.0001
+
+
+# --- broad phase against brute force ------------------------------------------------------
+
+
+def brute_force_candidates(x, quads, ply, seg_on, node_on, h_node, h_seg, margin, self_contact,
+                           node_ptr, node_elem):
+    pairs = set()
+    lo = x[quads].min(axis=1)
+    hi = x[quads].max(axis=1)
+    for p in np.flatnonzero(node_on):
+        for s in np.flatnonzero(seg_on):
+            r = h_seg[s] + h_node[p] + margin
+            if not (np.all(lo[s] - r <= x[p]) and np.all(x[p] <= hi[s] + r)):
+                continue
+            excluded = False
+            for e in node_elem[node_ptr[p]:node_ptr[p + 1]]:
+                if e == s or (ply[e] == ply[s] and (
+                        not self_contact or np.intersect1d(quads[e], quads[s]).size)):
+                    excluded = True
+                    break
+            if not excluded:
+                pairs.add((int(p), int(s)))
+    return pairs
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    n_plies=st.integers(1, 3),
+    amp=st.floats(0.0, 1.5),
+    h=st.floats(0.0, 0.6),
+    margin=st.floats(0.0, 0.3),
+    self_contact=st.booleans(),
+    dead=st.floats(0.0, 0.5),
+)
+def test_bucket_search_equals_brute_force(seed, n_plies, amp, h, margin, self_contact, dead):
+    """Random (possibly tangled) plies, offsets, margins, eroded elements and inactive
+    nodes: the hashed-grid search finds exactly the brute-force O(N·M) pairs."""
+    rng = np.random.default_rng(seed)
+    size = 1e-3
+    mesh = plate_mesh(4e-3, size, plies=n_plies, spacing=0.5e-3, quarter=True)
+    x = mesh.nodes + rng.uniform(-amp * size, amp * size, mesh.nodes.shape)
+    ne, nn = mesh.n_elems, mesh.n_nodes
+    h_seg = rng.uniform(0.0, h * size, ne)
+    h_node = rng.uniform(0.0, h * size, nn)
+    seg_on = (rng.uniform(size=ne) >= dead).astype(np.int8)
+    node_on = (rng.uniform(size=nn) >= dead / 2).astype(np.int8)
+    ptr, elem, _ = node_element_map(mesh.quads, nn)
+    args = (x, mesh.quads, mesh.ply, seg_on, node_on, h_node, h_seg, margin * size, 0.0,
+            self_contact, ptr, elem, np.zeros((ne, 6)), np.zeros((ne, 3), np.int64),
+            np.zeros(bucket_count(ne) + 1, np.int64), np.zeros(ne, np.int64),
+            np.zeros(nn + 1, np.int64))
+    n, *_ = find_candidates(*args, np.zeros(0, np.int64))  # no capacity: counts only
+    pair_seg = np.full(n, -1, np.int64)
+    pair_ptr = args[-1]
+    n2, *_ = find_candidates(*args, pair_seg)
+    assert n2 == n and pair_ptr[-1] == n
+    nodes = np.repeat(np.arange(nn), np.diff(pair_ptr))
+    found = list(zip(nodes.tolist(), pair_seg.tolist()))
+    assert len(found) == len(set(found))  # no duplicates
+    expect = brute_force_candidates(x, mesh.quads, mesh.ply, seg_on, node_on, h_node, h_seg,
+                                    margin * size, self_contact, ptr, elem)
+    assert set(found) == expect
+
+
+def test_buffers_grow_on_overflow():
+    mesh, model, x, _ = random_overlapping_plies(0)
+    small = ShellContact(model, remove_initial_overlap=False, capacity=4)
+    ref = ShellContact(model, remove_initial_overlap=False)
+    f1, e1, n1 = contact_forces(small, model, x)
+    f2, e2, n2 = contact_forces(ref, model, x)
+    assert small.grow_count == 1 and small.capacity >= small.n_pairs
+    assert n1 == n2 and e1 == e2 and f1.tobytes() == f2.tobytes()
+
+
+# --- initial overlap, erosion, friction ---------------------------------------------------
+
+
+def test_initial_overlap_is_removed_not_pushed_apart():
+    """Thesis casing plies: 0.4998 mm shells 0.2499 mm apart. No force at t = 0, the
+    allowance is the overlap, and pushing further gives k δ again."""
+    t, spacing = 0.4998e-3, 0.2499e-3
+    mesh, model = plies_model(n_plies=3, spacing=spacing, thickness=t)
+    contact = ShellContact(model)
+    f, energy, n = contact_forces(contact, model, model.x0)
+    assert n == 0 and energy == 0.0 and not f.any()
+    np.testing.assert_allclose(contact.overlap, t - spacing, rtol=1e-12)
+    pushed = ShellContact(model, remove_initial_overlap=False)
+    assert contact_forces(pushed, model, model.x0)[2] > 0  # without it, the plies repel
+    x = model.x0.copy()
+    delta = 1e-6
+    x[mesh.node_sets["ply2"], 2] -= delta
+    f, energy, n = contact_forces(contact, model, x)
+    assert n > 0
+    centre = mesh.node_sets["ply2"][len(mesh.node_sets["ply2"]) // 2]
+    k = BETA * model.node_mass[centre] / DT**2  # interior node, interior segments
+    assert f[centre, 2] == pytest.approx(2 * k * delta, rel=1e-9)  # own pass + reaction
+
+
+def test_eroded_segments_and_inactive_nodes_give_no_force():
+    t, delta = 0.5e-3, 0.05e-3
+    mesh, model = plies_model(spacing=t - delta, thickness=t)
+    contact = ShellContact(model, remove_initial_overlap=False)
+    state = initial_state(model)
+    f, _, n = contact_forces(contact, model, state.x, alive=state.elem[:, S.E_ALIVE],
+                             active=state.node_active)
+    assert n > 0
+    # erode ply 0: its elements leave the surface and its nodes become inactive
+    state.elem[mesh.elem_sets["ply0"], S.E_ALIVE] = 0.0
+    state.node_active[mesh.node_sets["ply0"]] = 0
+    f, energy, n = contact_forces(contact, model, state.x, alive=state.elem[:, S.E_ALIVE],
+                                  active=state.node_active)
+    assert n == 0 and energy == 0.0 and not f.any()
+
+
+def test_node_over_an_eroded_element_falls_through():
+    """A ply-1 node above the centre of one ply-0 element: contact while the element
+    lives; none once it is eroded (the neighbours' rounded edges are out of reach)."""
+    t, delta = 0.5e-3, 0.05e-3
+    mesh, model = plies_model(spacing=t - delta, thickness=t)
+    contact = ShellContact(model, remove_initial_overlap=False)
+    x = model.x0.copy()
+    x[mesh.node_sets["ply1"], :2] += 0.5e-3  # ply-1 nodes over ply-0 element centres
+    p = mesh.node_sets["ply1"][2 * 9 + 2]  # node (i, j) = (2, 2) of the 9 × 9 grid
+    e = mesh.elem_sets["ply0"][2 * 8 + 2]  # element (2, 2) of ply 0, centre (2.5, 2.5) mm
+    np.testing.assert_allclose(x[p, :2], model.x0[model.quads[e]].mean(axis=0)[:2])
+    alive = np.ones(model.n_elems)
+    f_live = contact_forces(contact, model, x, alive=alive)[0]
+    alive[e] = 0.0
+    f_dead = contact_forces(contact, model, x, alive=alive)[0]
+    k = BETA * model.node_mass[p] / DT**2
+    assert f_live[p, 2] >= k * delta * (1 - 1e-9)
+    # what is left on p is the reaction of ply-0 nodes pushing on p's own segments
+    own = f_live[p, 2] - f_dead[p, 2]
+    assert own == pytest.approx(k * delta, rel=1e-9)
+
+
+@pytest.mark.parametrize("speed", [1e-3, 50.0])
+def test_friction_is_bounded_by_mu_normal_and_opposes_sliding(speed):
+    """The small quad slides along +x on the big one: f_t = −min(μ f_n, ½ m_red v/Δt)."""
+    t, delta, mu = 0.2e-3, 0.013e-3, 0.3
+    model = two_quads_model(thickness=t, z=t - delta)
+    contact = ShellContact(model, friction=mu, remove_initial_overlap=False)
+    v = np.zeros((model.n_nodes, 3))
+    v[4:, 0] = speed
+    f, _, n = contact_forces(contact, model, model.x0, v=v)
+    assert n == 4
+    fn, ft = f[4:, 2], f[4:, 0]
+    assert np.all(fn > 0) and np.all(ft < 0)  # opposes the sliding
+    assert np.all(np.abs(ft) <= mu * fn * (1 + 1e-12))
+    m_s, m_b = model.node_mass[4], model.node_mass[0]
+    cap = 0.5 * (m_s * m_b / (m_s + m_b)) * speed / DT
+    np.testing.assert_allclose(-ft, min(mu * fn[0], cap), rtol=1e-12)
+    np.testing.assert_allclose(f.sum(axis=0), 0.0, atol=1e-12 * fn.max())
+    # frictionless by default: no tangential force at all
+    plain = ShellContact(model, remove_initial_overlap=False)
+    assert not contact_forces(plain, model, model.x0, v=v)[0][:, :2].any()
+
+
+# --- determinism and a dynamic collision --------------------------------------------------
+
+
+@pytest.mark.skipif(numba.config.NUMBA_NUM_THREADS < 2, reason="needs 2 threads")
+def test_forces_are_bitwise_identical_with_one_and_two_threads():
+    mesh, model, x, rng = random_overlapping_plies(7, n_plies=4)
+    v = rng.normal(0.0, 10.0, x.shape)
+    results = []
+    try:
+        for threads in (1, 2, 1):
+            set_threads(threads)
+            contact = ShellContact(model, friction=0.2, remove_initial_overlap=False)
+            f, energy, n = contact_forces(contact, model, x, v=v)
+            results.append((f.tobytes(), energy, n))
+    finally:
+        set_threads(numba.config.NUMBA_NUM_THREADS)
+    assert results[0] == results[1] == results[2]
+
+
+def test_two_free_plies_collide_and_rebound():
+    """Two plies of free nodes (no shell forces) approach at ±V and collide through the
+    contact forces alone, stepped by central differences (leapfrog, kinetic energy
+    ½ m v^{n−1/2}·v^{n+1/2} at whole steps): momentum is conserved to rounding, the
+    energy (kinetic + contact) never grows and ends within 3 % of the start, the
+    penetration stays a small fraction of the offsets and each ply rebounds at ≈ ∓V."""
+    t, V = 0.5e-3, 20.0
+    mesh, model = plies_model(spacing=t + 0.05e-3, thickness=t)
+    contact = ShellContact(model, remove_initial_overlap=False)
+    dt = 2e-8
+    x = model.x0.copy()
+    v = np.zeros_like(x)
+    top = mesh.node_sets["ply1"]
+    bot = mesh.node_sets["ply0"]
+    v[top, 2] = -V
+    v[bot, 2] = V
+    m = model.node_mass[:, None]
+    p0 = (m * v).sum(axis=0)
+    ke0 = 0.5 * (m * v * v).sum()
+    f = np.zeros_like(x)
+    alive = np.ones(model.n_elems)
+    active = np.ones(model.n_nodes, dtype=np.int8)
+    worst = 0.0
+    energies = []
+    contacts = 0
+    for _ in range(200):
+        x += dt * v
+        energy, n_active = contact.forces(x, v, dt, alive, active, f)
+        v_new = v + dt * f / m
+        energies.append(0.5 * (m * v * v_new).sum() + energy)
+        v = v_new
+        worst = min(worst, (x[top, 2] - x[bot, 2]).min() - t)
+        contacts += n_active > 0
+    assert 0 < contacts < 20 and n_active == 0  # a short collision, then apart
+    np.testing.assert_allclose((m * v).sum(axis=0), p0, atol=1e-12 * np.abs(m * V).sum())
+    assert max(energies) <= ke0 * (1 + 1e-12)
+    assert 0.97 * ke0 <= energies[-1]
+    assert -0.01 * t < worst < 0.0
+    m_top = model.node_mass[top]
+    assert (m_top * v[top, 2]).sum() / m_top.sum() == pytest.approx(V, rel=0.02)
+    assert np.all(v[top, 2] > 0.9 * V) and np.all(v[bot, 2] < -0.9 * V)

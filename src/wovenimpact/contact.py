@@ -141,9 +141,10 @@ class ShellContact:
         self.seg_on = np.zeros(ne, dtype=np.int8)
         self.node_on = np.zeros(nn, dtype=np.int8)
         self.box = np.zeros((ne, 6))
-        self.seg_cell = np.zeros((ne, 3), dtype=np.int64)
         self.bucket_ptr = np.zeros(bucket_count(ne) + 1, dtype=np.int64)
         self.bucket_seg = np.zeros(ne, dtype=np.int64)
+        self.bucket_cell = np.zeros((ne, 3), dtype=np.int64)
+        self.bucket_box = np.zeros((ne, 6))
         self.pair_ptr = np.zeros(nn + 1, dtype=np.int64)
         self.seg_ptr = np.zeros(nn + 1, dtype=np.int64)
         self.cursor = np.zeros(nn, dtype=np.int64)
@@ -184,7 +185,8 @@ class ShellContact:
             n, l0, l1, l2 = find_candidates(
                 x, self.quads, self.ply, self.seg_on, self.node_on, self.h_node, self.h_seg,
                 self.margin, 0.0, self.self_contact, self.node_ptr, self.node_elem, self.box,
-                self.seg_cell, self.bucket_ptr, self.bucket_seg, self.pair_ptr, self.pair_seg,
+                self.bucket_ptr, self.bucket_seg, self.bucket_cell, self.bucket_box,
+                self.pair_ptr, self.pair_seg,
             )
             if n <= self.capacity:
                 break

@@ -189,8 +189,8 @@ def test_bucket_search_equals_brute_force(seed, n_plies, amp, h, margin, self_co
     node_on = (rng.uniform(size=nn) >= dead / 2).astype(np.int8)
     ptr, elem, _ = node_element_map(mesh.quads, nn)
     args = (x, mesh.quads, mesh.ply, seg_on, node_on, h_node, h_seg, margin * size, 0.0,
-            self_contact, ptr, elem, np.zeros((ne, 6)), np.zeros((ne, 3), np.int64),
-            np.zeros(bucket_count(ne) + 1, np.int64), np.zeros(ne, np.int64),
+            self_contact, ptr, elem, np.zeros((ne, 6)), np.zeros(bucket_count(ne) + 1, np.int64),
+            np.zeros(ne, np.int64), np.zeros((ne, 3), np.int64), np.zeros((ne, 6)),
             np.zeros(nn + 1, np.int64))
     n, *_ = find_candidates(*args, np.zeros(0, np.int64))  # no capacity: counts only
     pair_seg = np.full(n, -1, np.int64)

@@ -4,7 +4,10 @@ A clamped square plate, pre-stretched 2 % in-plane (so fabric yarns carry tensio
 the crossover solve does real work) and set moving with a smooth transverse velocity
 field, is stepped with one thread and with two. Prints one line per case with the
 share of time per stage; ``--json`` prints {"cases": [{"name", "elements", "threads",
-"ns_per_element_cycle", "shares"}]}. ``--sizes 10000,100000`` chooses plate sizes.
+"ns_per_element_cycle", "shares"}]}. ``--sizes=10000,100000`` chooses plate sizes,
+``--kinds=fabric`` the plates, ``--threads=2`` the thread counts and ``--steps=N`` the
+timed steps per case (20). The threading layer is printed first (``NUMBA_THREADING_LAYER``
+overrides the default of :mod:`wovenimpact.jit`).
 """
 
 from __future__ import annotations
@@ -74,15 +77,25 @@ def measure(kind: str, n_elements: int, threads: int, steps: int = 20) -> dict:
 
 def main() -> None:
     sizes = DEFAULT_SIZES
+    kinds = ("elastic", "fabric")
+    thread_counts = sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)})
+    steps = 20
     for arg in sys.argv[1:]:
         if arg.startswith("--sizes="):
             sizes = tuple(int(s) for s in arg.split("=", 1)[1].split(","))
-    top = min(2, numba.config.NUMBA_NUM_THREADS)
+        elif arg.startswith("--kinds="):
+            kinds = tuple(arg.split("=", 1)[1].split(","))
+        elif arg.startswith("--threads="):
+            thread_counts = [int(s) for s in arg.split("=", 1)[1].split(",")]
+        elif arg.startswith("--steps="):
+            steps = int(arg.split("=", 1)[1])
     cases = []
-    for kind in ("elastic", "fabric"):
+    for kind in kinds:
         for n in sizes:
-            for threads in sorted({1, top}):
-                cases.append(measure(kind, n, threads))
+            for threads in thread_counts:
+                cases.append(measure(kind, n, threads, steps))
+                if len(cases) == 1 and "--json" not in sys.argv:
+                    print(f"threading layer: {numba.threading_layer()}", flush=True)
                 if "--json" not in sys.argv:
                     c = cases[-1]
                     shares = ", ".join(f"{k} {v:.0%}" for k, v in c["shares"].items())

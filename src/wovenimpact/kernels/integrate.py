@@ -11,13 +11,22 @@ terms (a deterministic reduction). The kinetic energy at t^n is the leapfrog for
 for a linear system at constant Δt (the quantity central differences conserve);
 ½ M ((v^{n−1/2} + v^{n+1/2})/2)² misreads modes near the stability limit by up
 to (ωΔt/2)².
+
+``gather_and_update`` is the explicit step's one pass over the nodes: each node
+gathers its internal force (``gather.node_force_sum``), then takes the update of
+``update_node``; it also counts nodes left at a non-finite position, so the
+caller checks one integer instead of scanning x.
 """
 
 from __future__ import annotations
 
+import math
+
+import numpy as np
 from numba import prange
 
-from wovenimpact.jit import kernel, loop_kernel
+from wovenimpact.jit import inline_kernel, kernel, loop_kernel
+from wovenimpact.kernels.gather import node_force_sum
 
 FIXED = 1
 PRESCRIBED = 2
@@ -32,81 +41,132 @@ def smooth_step(t, ramp_time):
     return xi * xi * xi * (10.0 - 15.0 * xi + 6.0 * xi * xi)
 
 
+@inline_kernel
+def update_node(
+    n, mass, inertia, bc_code, bc_velocity, body_accel, amplitude, dt_old, dt_mid, dt_new,
+    f_int, f_int_old, f_ext_old, live, x, v, omega, node_active, f_ext, w_int, w_ext, ke,
+    ke_eroded,
+):
+    """Central-difference update of node n (in place: x, v, omega, node_active; written:
+    f_ext[n], w_int[n], w_ext[n], ke[n], ke_eroded[n]). ``live``: its live elements
+    (0 → the node is eroded now); dt_mid = ½(Δt^{n−1/2} + Δt^{n+1/2}). The arguments
+    are those of :func:`gather_and_update`.
+    """
+    # the sums accumulate in locals (stored once: the arrays may alias as far as the
+    # compiler knows, so += on them goes through memory); same order as ever
+    if node_active[n] == 0:
+        w_int[n] = 0.0
+        w_ext[n] = 0.0
+        ke[n] = 0.0
+        ke_eroded[n] = 0.0
+        for d in range(6):
+            f_ext[n, d] = 0.0
+        return
+    m = mass[n]
+    inert = inertia[n]
+    # work over [x^{n−1}, x^n]: displacement Δt^{n−1/2} v^{n−1/2}
+    wi = 0.0
+    for d in range(6):
+        vel = v[n, d] if d < 3 else omega[n, d - 3]
+        du = dt_old * vel
+        wi += 0.5 * (f_int_old[n, d] + f_int[n, d]) * du
+    w_int[n] = wi
+    we = 0.0
+    if live == 0:
+        # the loads of the last step still did work over [x^{n−1}, x^n]
+        for d in range(6):
+            vel = v[n, d] if d < 3 else omega[n, d - 3]
+            we += 0.5 * f_ext_old[n, d] * dt_old * vel
+        w_ext[n] = we
+        # the node has lost its last element: it leaves the model with its energy
+        e = 0.0
+        for d in range(3):
+            e += 0.5 * m * v[n, d] * v[n, d] + 0.5 * inert * omega[n, d] * omega[n, d]
+            v[n, d] = 0.0
+            omega[n, d] = 0.0
+        ke[n] = 0.0
+        ke_eroded[n] = e
+        node_active[n] = 0
+        for d in range(6):
+            f_ext[n, d] = 0.0
+        return
+    k = 0.0
+    for d in range(6):
+        m_d = m if d < 3 else inert
+        old = v[n, d] if d < 3 else omega[n, d - 3]
+        load = m_d * body_accel[n, d] if d < 3 else 0.0
+        code = bc_code[n, d]
+        if code == FIXED:
+            new = 0.0
+        elif code == PRESCRIBED:
+            new = bc_velocity[n, d] * amplitude
+        else:
+            new = old + dt_mid * (load - f_int[n, d]) / m_d
+        if code != 0 and dt_mid > 0.0:
+            # reaction R with m (v_new − v_old)/Δt^n = load + R − f_int
+            ext = m_d * (new - old) / dt_mid + f_int[n, d]
+        else:
+            ext = load
+        f_ext[n, d] = ext
+        we += 0.5 * (f_ext_old[n, d] + ext) * dt_old * old
+        k += 0.5 * m_d * old * new
+        if d < 3:
+            v[n, d] = new
+            x[n, d] += dt_new * new
+        else:
+            omega[n, d - 3] = new
+    w_ext[n] = we
+    ke[n] = k
+    ke_eroded[n] = 0.0
+
+
 @loop_kernel
-def central_difference_update(
+def gather_and_update(
+    node_ptr, node_elem, node_corner, blocks, alive,
     mass, inertia, bc_code, bc_velocity, body_accel, amplitude, dt_old, dt_new,
-    f_int, f_int_old, f_ext_old, live_count, x, v, omega, node_active,
+    f_int, f_int_old, f_ext_old, x, v, omega, node_active,
     f_ext, w_int, w_ext, ke, ke_eroded,
 ):
-    """Advance every active node by one step (in place: x, v, omega, node_active).
+    """Gather the internal forces of every node and advance it by one step.
 
     Args:
+        node_ptr, node_elem, node_corner: CSR map (Model).
+        blocks: (n_elems, 4, 6) element corner forces and moments at x^n.
+        alive: (n_elems,) uint8, 1 for a live element (written by the force kernel).
         mass, inertia, bc_code, bc_velocity, body_accel: Model arrays.
         amplitude: prescribed-velocity amplitude at t^{n+1/2}.
         dt_old, dt_new: Δt^{n−1/2}, Δt^{n+1/2}.
-        f_int: (n, 6) internal forces at x^n; f_int_old, f_ext_old: at x^{n−1}.
-        live_count: (n,) live elements per node (0 → the node is eroded now).
+        f_int: (n, 6) written: internal forces at x^n (gathered from blocks).
+        f_int_old, f_ext_old: internal and external forces at x^{n−1}.
+        x, v, omega, node_active: advanced in place.
         (Kinetic energy of the node: ½ m v^{n−1/2} · v^{n+1/2}, see the module docstring.)
         f_ext: (n, 6) written: body forces plus reactions at x^n.
         w_int, w_ext, ke, ke_eroded: (n,) written: per-node internal and external
             work increments over [x^{n−1}, x^n], kinetic energy at t^n, and kinetic
             energy removed with nodes eroded this step.
+
+    Returns:
+        the number of nodes whose position x^{n+1} is not finite (0 when all is well).
     """
     nn = x.shape[0]
     dt_mid = 0.5 * (dt_old + dt_new)
-    for n in prange(nn):
-        w_int[n] = 0.0
-        w_ext[n] = 0.0
-        ke[n] = 0.0
-        ke_eroded[n] = 0.0
-        if node_active[n] == 0:
-            for d in range(6):
-                f_ext[n, d] = 0.0
-            continue
-        m = mass[n]
-        inert = inertia[n]
-        # work over [x^{n−1}, x^n]: displacement Δt^{n−1/2} v^{n−1/2}
-        for d in range(6):
-            vel = v[n, d] if d < 3 else omega[n, d - 3]
-            du = dt_old * vel
-            w_int[n] += 0.5 * (f_int_old[n, d] + f_int[n, d]) * du
-        if live_count[n] == 0:
-            # the loads of the last step still did work over [x^{n−1}, x^n]
-            for d in range(6):
-                vel = v[n, d] if d < 3 else omega[n, d - 3]
-                w_ext[n] += 0.5 * f_ext_old[n, d] * dt_old * vel
-            # the node has lost its last element: it leaves the model with its energy
-            e = 0.0
-            for d in range(3):
-                e += 0.5 * m * v[n, d] * v[n, d] + 0.5 * inert * omega[n, d] * omega[n, d]
-                v[n, d] = 0.0
-                omega[n, d] = 0.0
-            ke_eroded[n] = e
-            node_active[n] = 0
-            for d in range(6):
-                f_ext[n, d] = 0.0
-            continue
-        for d in range(6):
-            m_d = m if d < 3 else inert
-            old = v[n, d] if d < 3 else omega[n, d - 3]
-            load = m_d * body_accel[n, d] if d < 3 else 0.0
-            code = bc_code[n, d]
-            if code == FIXED:
-                new = 0.0
-            elif code == PRESCRIBED:
-                new = bc_velocity[n, d] * amplitude
-            else:
-                new = old + dt_mid * (load - f_int[n, d]) / m_d
-            if code != 0 and dt_mid > 0.0:
-                # reaction R with m (v_new − v_old)/Δt^n = load + R − f_int
-                ext = m_d * (new - old) / dt_mid + f_int[n, d]
-            else:
-                ext = load
-            f_ext[n, d] = ext
-            w_ext[n] += 0.5 * (f_ext_old[n, d] + ext) * dt_old * old
-            ke[n] += 0.5 * m_d * old * new
-            if d < 3:
-                v[n, d] = new
-                x[n, d] += dt_new * new
-            else:
-                omega[n, d - 3] = new
+    n_bad = 0
+    for i in prange(nn):
+        n = np.uint64(i)
+        f0, f1, f2, f3, f4, f5, live = node_force_sum(
+            n, node_ptr, node_elem, node_corner, blocks, alive
+        )
+        f_int[n, 0] = f0
+        f_int[n, 1] = f1
+        f_int[n, 2] = f2
+        f_int[n, 3] = f3
+        f_int[n, 4] = f4
+        f_int[n, 5] = f5
+        update_node(
+            n, mass, inertia, bc_code, bc_velocity, body_accel, amplitude, dt_old, dt_mid,
+            dt_new, f_int, f_int_old, f_ext_old, live, x, v, omega, node_active, f_ext,
+            w_int, w_ext, ke, ke_eroded,
+        )
+        if not (math.isfinite(x[n, 0]) and math.isfinite(x[n, 1]) and math.isfinite(x[n, 2])):
+            n_bad += 1
+    return n_bad

@@ -528,23 +528,29 @@ def shell_force(
 @loop_kernel
 def internal_force_for_shells(
     x, v, omega, dt, quads, elem_section, sections, mat_kind, mat_params, area0, ref_grad,
-    el_in, el_out, m_in, m_out, blocks, status, eroded_now, dt_erode,
+    el_in, el_out, m_in, m_out, blocks, status, eroded_now, alive, dt_erode,
 ):
     """``shell_force`` for every element (prange; each element writes its own rows).
 
     Args: positions/velocities/spins (n_nodes, 3); dt; Model arrays; element and
     material state in/out; blocks (n_elems, 4, 6) written; status, eroded_now
-    (n_elems,) written; dt_erode: an element whose own stable step L_e/c_e falls
-    below it is eroded (crushed or collapsed elements, e.g. fabric with one yarn
-    family broken; 0 disables).
+    (n_elems,) written; alive (n_elems,) uint8 written: 1 for an element alive at
+    the end of the step (a compact copy of ``el_out[:, E_ALIVE]`` for the node
+    kernels); dt_erode: an element whose own stable step L_e/c_e falls below it is
+    eroded (crushed or collapsed elements, e.g. fabric with one yarn family
+    broken; 0 disables).
 
     Returns:
-        (n_failed, n_eroded): elements with a non-OK status, and elements eroded
-        this step (integer counts: exact, so the same for any thread count).
+        (n_failed, n_eroded, dt_min): elements with a non-OK status, elements
+        eroded this step (integer counts: exact, so the same for any thread count),
+        and min_e ``el_out[e, E_DT]`` (inf if every element is eroded; a minimum is
+        exact in any order, so also the same for any thread count; meaningful only
+        when n_failed is 0).
     """
     ne = quads.shape[0]
     n_failed = 0
     n_eroded = 0
+    dt_min = math.inf
     for e in prange(ne):
         st, er = shell_force(
             np.uint64(e), x, v, omega, dt, quads, area0, ref_grad, np.uint64(elem_section[e]),
@@ -557,7 +563,9 @@ def internal_force_for_shells(
             er = 1
         status[e] = st
         eroded_now[e] = er
+        alive[e] = 1 if el_out[e, E_ALIVE] != 0.0 else 0
+        dt_min = min(dt_min, el_out[e, E_DT])
         if st != EL_OK:
             n_failed += 1
         n_eroded += er
-    return n_failed, n_eroded
+    return n_failed, n_eroded, dt_min

@@ -1,12 +1,18 @@
 """One explicit step, reading like the algorithm (docs/theory.md §3; thesis ch. 4.1).
 
     1. element forces at x^n: corotational shells, material update F^{n−1} → F^n,
-       bending/shear/hourglass rates over Δt^{n−1/2}          (kernels.shell)
+       bending/shear/hourglass rates over Δt^{n−1/2}; min_e L_e/c_e  (kernels.shell)
     2. nodal forces gathered through the node → element map    (kernels.gather)
     3. stable step Δt^{n+1/2} = α min_e L_e / c_e               (eq. 4.8–4.11)
     4. central differences for v^{n+1/2}, x^{n+1}; reactions;   (kernels.integrate)
        work and kinetic energy
     5. bookkeeping: erosion, energies, time
+
+Stages 2 and 4 are one pass over the nodes (``gather_and_update``) and the
+minimum of stage 3 comes out of the force kernel, so a step launches two
+parallel kernels and scans no per-element or per-node array in NumPy, except the
+deterministic per-node energy sums; the failure checks read counters the
+kernels return and look for the culprit only when one is non-zero.
 
 Contact and rigid bodies will enter as extra force stages between 2 and 4.
 ``step`` mutates the State in place (its arrays swap with the Workspace's
@@ -24,7 +30,7 @@ import numpy as np
 from wovenimpact.errors import SimulationError
 from wovenimpact.kernels import shell_layout as S
 from wovenimpact.kernels.gather import gather_nodal_forces
-from wovenimpact.kernels.integrate import central_difference_update, smooth_step
+from wovenimpact.kernels.integrate import gather_and_update, smooth_step
 from wovenimpact.kernels.shell import internal_force_for_shells
 from wovenimpact.state import (
     ERODED_INTERNAL,
@@ -53,6 +59,7 @@ class Workspace:
     blocks: np.ndarray
     status: np.ndarray
     eroded_now: np.ndarray
+    alive: np.ndarray
     f_int: np.ndarray
     f_ext: np.ndarray
     live: np.ndarray
@@ -60,6 +67,8 @@ class Workspace:
     w_ext: np.ndarray
     ke: np.ndarray
     ke_eroded: np.ndarray
+    dt_min: float = math.inf  # min_e L_e/c_e of the last element stage
+    n_eroded: int = 0  # elements eroded in the last element stage
     profile: bool = False
     timings: dict = field(default_factory=dict)
 
@@ -76,19 +85,20 @@ class Workspace:
         return cls(
             elem=np.empty_like(state.elem), mat=np.empty_like(state.mat),
             blocks=np.zeros((ne, 4, 6)), status=np.zeros(ne, dtype=np.int32),
-            eroded_now=np.zeros(ne, dtype=np.int32), f_int=np.zeros((n, 6)),
+            eroded_now=np.zeros(ne, dtype=np.int32), alive=np.zeros(ne, dtype=np.uint8),
+            f_int=np.zeros((n, 6)),
             f_ext=np.zeros((n, 6)), live=np.zeros(n, dtype=np.int64), w_int=np.zeros(n),
             w_ext=np.zeros(n), ke=np.zeros(n), ke_eroded=np.zeros(n),
         )
 
 
-def element_forces(model, state: State, ws: Workspace) -> None:
-    """Stages 1–2: element forces at x^n and their nodal sums (into ws)."""
-    t0 = time.perf_counter()
-    n_failed, _ = internal_force_for_shells(
+def shell_forces(model, state: State, ws: Workspace) -> None:
+    """Stage 1: element forces at x^n into ws (blocks, element and material state,
+    alive bytes, dt_min, n_eroded); stops naming the first failed element."""
+    n_failed, ws.n_eroded, ws.dt_min = internal_force_for_shells(
         state.x, state.v, state.omega, state.dt, model.quads, model.elem_section,
         model.sections, model.mat_kind, model.mat_params, model.area0, model.ref_grad,
-        state.elem, ws.elem, state.mat, ws.mat, ws.blocks, ws.status, ws.eroded_now,
+        state.elem, ws.elem, state.mat, ws.mat, ws.blocks, ws.status, ws.eroded_now, ws.alive,
         model.erode_dt_fraction * state.dt_first / model.alpha,
     )
     if n_failed:
@@ -99,23 +109,34 @@ def element_forces(model, state: State, ws: Workspace) -> None:
             f"{state.step}: {STATUS_TEXT.get(int(ws.status[e]), 'unknown failure')}"
             + (f"; {bad.size} elements in this state" if bad.size > 1 else "")
         )
+
+
+def element_forces(model, state: State, ws: Workspace) -> None:
+    """Stages 1–2: element forces at x^n and their nodal sums (into ws)."""
+    t0 = time.perf_counter()
+    shell_forces(model, state, ws)
     t0 = ws.tick("shell forces", t0)
-    gather_nodal_forces(model.node_ptr, model.node_elem, model.node_corner, ws.blocks, ws.elem,
+    gather_nodal_forces(model.node_ptr, model.node_elem, model.node_corner, ws.blocks, ws.alive,
                         ws.f_int, ws.live)
     ws.tick("gather", t0)
 
 
 def stable_step(model, state: State, ws: Workspace, dt_cap: float) -> float:
-    """Stage 3: Δt = α min_e L_e/c_e (eq. 4.8), at most dt_cap; stops on collapse."""
-    dt_el = ws.elem[:, S.E_DT]
-    e = int(np.argmin(dt_el))
-    dt = min(model.alpha * float(dt_el[e]), dt_cap)
+    """Stage 3: Δt = α min_e L_e/c_e (eq. 4.8), at most dt_cap; stops on collapse.
+
+    The minimum is the force kernel's (``ws.dt_min``); the governing element is
+    looked up only for an error message.
+    """
+    dt = min(model.alpha * ws.dt_min, dt_cap)
     if not math.isfinite(dt) or dt <= 0.0:
+        dt_el = ws.elem[:, S.E_DT]
+        e = int(np.argmin(dt_el))
         raise SimulationError(
             f"no stable time step at t = {state.t:.6e} s (element {e}: {dt_el[e]!r}); "
             "every element eroded, or a non-finite state"
         )
     if state.dt_first > 0.0 and dt < DT_COLLAPSE * state.dt_first:
+        e = int(np.argmin(ws.elem[:, S.E_DT]))
         raise SimulationError(
             f"time step collapsed at t = {state.t:.6e} s: Δt = {dt:.3e} s is below "
             f"{DT_COLLAPSE:g} of the first step ({state.dt_first:.3e} s), governed by element "
@@ -126,19 +147,21 @@ def stable_step(model, state: State, ws: Workspace, dt_cap: float) -> float:
 
 def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     """Advance ``state`` from t^n to t^{n+1} in place (stages 1–5 of the module docstring)."""
-    element_forces(model, state, ws)
     t0 = time.perf_counter()
+    shell_forces(model, state, ws)
+    t0 = ws.tick("shell forces", t0)
     dt_new = stable_step(model, state, ws, dt_cap)
     t0 = ws.tick("stable step", t0)
     amplitude = smooth_step(state.t + 0.5 * dt_new, model.ramp_time)
-    central_difference_update(
+    n_bad = gather_and_update(
+        model.node_ptr, model.node_elem, model.node_corner, ws.blocks, ws.alive,
         model.node_mass, model.node_inertia, model.bc_code, model.bc_velocity, model.body_accel,
-        amplitude, state.dt, dt_new, ws.f_int, state.f_int, state.f_ext, ws.live,
+        amplitude, state.dt, dt_new, ws.f_int, state.f_int, state.f_ext,
         state.x, state.v, state.omega, state.node_active, ws.f_ext,
         ws.w_int, ws.w_ext, ws.ke, ws.ke_eroded,
     )
-    t0 = ws.tick("integrate", t0)
-    if not np.isfinite(state.x).all():
+    t0 = ws.tick("gather + integrate", t0)
+    if n_bad:
         n = int(np.flatnonzero(~np.isfinite(state.x).all(axis=1))[0])
         raise SimulationError(f"node {n} has a non-finite position at t = {state.t:.6e} s")
     en = state.energy
@@ -146,7 +169,7 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     en[W_EXT] += float(np.sum(ws.w_ext))
     en[KINETIC] = float(np.sum(ws.ke))
     en[ERODED_KINETIC] += float(np.sum(ws.ke_eroded))
-    if ws.eroded_now.any():
+    if ws.n_eroded:
         gone = ws.eroded_now != 0
         en[ERODED_INTERNAL] += float(np.sum(
             state.elem[gone, S.E_U_MEMB] + state.elem[gone, S.E_U_BEND] + state.elem[gone, S.E_U_HG]

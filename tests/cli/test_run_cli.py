@@ -212,11 +212,12 @@ def test_impactor_is_placed_with_its_mass_and_velocity(tmp_path):
     spec, base = load_case(case)
     compiled = compile_case(spec, base)
     p, st = compiled.model.body_params[0], compiled.state.bodies[0]
-    assert p[RB.BP_MASS] == pytest.approx(1.1e-3)
+    assert p[RB.BP_MASS] == pytest.approx(0.25 * 1.1e-3)  # quarter model: a quarter body
+    assert p[RB.BP_AXIAL_ONLY] == 1.0
     assert st[RB.B_V:RB.B_V + 3] == pytest.approx([0.0, 0.0, -120.0])
     # centre of mass half a length behind the tip, along +z (the tail is behind)
     assert st[RB.B_X + 2] == pytest.approx(1e-3 + 0.5 * 5.72e-3)
-    ke = 0.5 * 1.1e-3 * 120.0**2
+    ke = 0.5 * 0.25 * 1.1e-3 * 120.0**2
     assert compiled.state.energy[5] == pytest.approx(ke + 0.5 * compiled.model.node_mass @ (
         np.sum(compiled.state.v**2, axis=1)))
 

@@ -34,7 +34,8 @@ BP_TIP = 3  # distance from the nose tip to the centre of mass along the axis (m
 BP_BETA = 4  # penalty factor β of k = β m_node / Δt²
 BP_REACH = 5  # radius of a sphere about the tip enclosing the body (m)
 BP_NPTS = 6  # number of profile points used in Model.body_profiles
-N_BODY_PARAM = 7
+BP_AXIAL_ONLY = 7  # 1: the body moves along its axis only (symmetry planes through it)
+N_BODY_PARAM = 8
 
 
 @kernel

@@ -144,8 +144,15 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
                                 density=im.density)
         except InputError as err:
             raise InputError(f"impactor: {err}") from None
+        quarter = isinstance(spec.mesh, PlateMeshSpec) and spec.mesh.quarter
+        if quarter and (abs(im.position[0]) > 1e-12 or abs(im.position[1]) > 1e-12
+                        or abs(im.direction[0]) > 0 or abs(im.direction[1]) > 0):
+            raise InputError("impactor: in a quarter model the impactor must sit on the "
+                             "symmetry axis (position x = y = 0) and travel along z")
+        # a quarter model carries a quarter of the impactor, which moves along its axis
         bodies.append(RigidBody(geometry, tip=im.position, direction=im.direction,
-                                speed=im.velocity, mass=im.mass, beta=im.contact_stiffness))
+                                speed=im.velocity, mass=im.mass, beta=im.contact_stiffness,
+                                fraction=0.25 if quarter else 1.0, axial_only=quarter))
     used = {s: i for i, s in enumerate(dict.fromkeys(elem_sections))}
     model = build_model(
         mesh.nodes, mesh.quads, {s: sections[s] for s in used},

@@ -164,6 +164,10 @@ class RigidBody:
         speed: initial speed along ``direction`` (m/s).
         mass: if given, the mass (kg) the density is scaled to.
         beta: penalty factor of the node contact stiffness k = β m_node/Δt².
+        fraction: the share of the body in the model (0.25 in a quarter model: mass
+            and inertia are scaled by it).
+        axial_only: the body translates along its axis only, without rotating (a
+            body cut by symmetry planes through its axis).
     """
 
     impactor: Impactor
@@ -172,14 +176,15 @@ class RigidBody:
     speed: float = 0.0
     mass: float | None = None
     beta: float = 0.1
+    fraction: float = 1.0
+    axial_only: bool = False
 
     def pack(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(parameter row, profile polyline, initial state row) for the Model/State."""
         imp = self.impactor
         m, zc, i_a, i_t = imp.mass_properties()
-        if self.mass is not None:
-            scale = self.mass / m
-            m, i_a, i_t = m * scale, i_a * scale, i_t * scale
+        scale = (1.0 if self.mass is None else self.mass / m) * self.fraction
+        m, i_a, i_t = m * scale, i_a * scale, i_t * scale
         travel = np.asarray(self.direction, dtype=float)
         travel = travel / np.linalg.norm(travel)
         axis = -travel  # body axis: tip → tail
@@ -192,7 +197,8 @@ class RigidBody:
         reach = float(np.max(np.hypot(profile[:, 0], profile[:, 1])))
         params = np.zeros(RB.N_BODY_PARAM)
         params[[RB.BP_MASS, RB.BP_I_AXIAL, RB.BP_I_TRANS, RB.BP_TIP, RB.BP_BETA, RB.BP_REACH,
-                RB.BP_NPTS]] = (m, i_a, i_t, zc, self.beta, reach, len(profile))
+                RB.BP_NPTS, RB.BP_AXIAL_ONLY]] = (m, i_a, i_t, zc, self.beta, reach,
+                                                 len(profile), float(self.axial_only))
         state = np.zeros(RB.N_BODY_STATE)
         state[RB.B_X:RB.B_X + 3] = np.asarray(self.tip, dtype=float) + zc * axis
         state[RB.B_V:RB.B_V + 3] = self.speed * travel

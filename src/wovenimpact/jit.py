@@ -11,21 +11,61 @@ entities, ``prange``-parallel). Flags:
 - ``error_model="numpy"``: division by zero gives inf/NaN (detected by the
   caller) instead of raising inside a parallel loop.
 
-Threading: Numba's OpenMP layer busy-waits, which collapses throughput on a
-shared 2-core machine, so unless the user chose a layer with the environment
-variable ``NUMBA_THREADING_LAYER`` we use ``workqueue``. The thread count is the
+Threading: the default layer is TBB (the ``tbb`` wheel, a dependency on x86-64
+Linux and Windows), then ``workqueue`` if TBB does not load. A step launches two
+parallel kernels, and what a launch costs and what idle workers do decided it
+(2 cores, measured; fabric plate, ns per element-cycle, 2 threads, idle / with
+the other core running a busy loop):
+
+- ``workqueue``: ~125 µs per launch even on 1 thread (8 % of a 10k-element step);
+  10k 260 / 474, 100k 254 / 460; 1 thread 10k 488.
+- ``tbb``: ~1–2 µs per launch, workers sleep soon when idle; 10k 236 / 450, 100k
+  249 / 462; 1 thread 10k 454.
+- ``omp`` as shipped: ~1–2 µs per launch, but idle workers spin for a while before
+  sleeping, which fights whatever else runs on a shared 2-core machine: 10k 229 /
+  790, 100k 251 / 508.
+- ``omp`` with ``OMP_WAIT_POLICY=passive``: 10k 255 / 456, 100k 251 / 464. As good
+  as TBB, but GNU OpenMP is not fork-safe: a process pool forked after a parallel
+  kernel ran (``wovenimpact sweep``) aborts. So it is not the default; with
+  ``NUMBA_THREADING_LAYER=omp`` the wait policy defaults to passive here.
+
+The ``tbb`` wheel puts ``libtbb`` in the environment's ``lib/``, where a venv's
+loader does not look; it is loaded from there before Numba asks for it. Whatever
+the user set wins: a layer in ``NUMBA_THREADING_LAYER``, a wait policy in
+``OMP_WAIT_POLICY``, ``GOMP_SPINCOUNT`` or ``KMP_BLOCKTIME``. The thread count is the
 user's (``NUMBA_NUM_THREADS`` or :func:`set_threads`). ``WOVENIMPACT_SERIAL=1``
 compiles loop kernels without ``parallel`` (debugging, profiling).
 """
 
 from __future__ import annotations
 
+import ctypes
 import os
+import sys
 
 import numba
 
+
+def _preload_tbb() -> None:
+    """Load the ``tbb`` wheel's libtbb from <env>/lib so Numba's TBB layer finds it."""
+    for prefix in dict.fromkeys((sys.prefix, sys.base_prefix)):
+        for name in ("libtbb.so.12", "libtbb.12.dylib"):
+            path = os.path.join(prefix, "lib", name)
+            if os.path.exists(path):
+                try:
+                    ctypes.CDLL(path, mode=ctypes.RTLD_GLOBAL)
+                except OSError:
+                    continue
+                return
+
+
 if "NUMBA_THREADING_LAYER" not in os.environ:
-    numba.config.THREADING_LAYER = "workqueue"
+    _preload_tbb()
+    numba.config.THREADING_LAYER_PRIORITY = ["tbb", "workqueue", "omp"]
+    numba.config.THREADING_LAYER = "default"  # the first of the priority list that loads
+if not any(k in os.environ for k in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT", "KMP_BLOCKTIME")):
+    os.environ["OMP_WAIT_POLICY"] = "passive"  # idle OpenMP workers sleep at once
+    os.environ["KMP_BLOCKTIME"] = "0"  # the same for Intel's runtime
 
 JIT_FLAGS = dict(cache=True, fastmath=False, error_model="numpy", nogil=True)
 PARALLEL = os.environ.get("WOVENIMPACT_SERIAL", "0") not in ("1", "true", "yes")

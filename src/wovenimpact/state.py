@@ -18,16 +18,18 @@ from wovenimpact.kernels import shell_layout as S
 
 # indices of State.energy (J)
 W_INT = 0  # work of the internal forces (membrane, bending, shear, hourglass)
-W_EXT = 1  # work of external forces, body forces and support reactions
+W_EXT = 1  # work of external forces, body forces, support reactions and contact on nodes
 KINETIC = 2  # kinetic energy at the last whole step (translational + rotational)
 ERODED_KINETIC = 3  # kinetic energy of nodes left without any element
 ERODED_INTERNAL = 4  # stored energy of elements at their erosion
 KINETIC0 = 5  # kinetic energy at t = 0 (nodes and rigid bodies)
 BODY_KINETIC = 6  # kinetic energy of the rigid bodies at the last whole step
 CONTACT_WORK = 7  # work of the contact forces on nodes and bodies (−penalty energy)
-N_ENERGY = 8
+NODE_CONTACT_WORK = 8  # the part of W_EXT done by contact forces on the nodes
+N_ENERGY = 9
 ENERGY_NAMES = ("internal_work", "external_work", "kinetic", "eroded_kinetic",
-                "eroded_internal", "initial_kinetic", "body_kinetic", "contact_work")
+                "eroded_internal", "initial_kinetic", "body_kinetic", "contact_work",
+                "node_contact_work")
 
 
 @dataclass
@@ -49,6 +51,7 @@ class State:
         energy: (N_ENERGY,) accumulators (indices in this module).
         dt_first: the first stable step (s), reference of the Δt-collapse check.
         bodies: (n_bodies, N_BODY_STATE) rigid impactors (kernels.rigid_body layout).
+        f_contact: (n_nodes, 3) contact forces on the nodes at x^n (for their work).
     """
 
     t: float
@@ -65,6 +68,7 @@ class State:
     energy: np.ndarray
     dt_first: float = 0.0
     bodies: np.ndarray = field(default_factory=lambda: np.zeros((0, RB.N_BODY_STATE)))
+    f_contact: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
     def copy(self) -> State:
         return State(**{f.name: (getattr(self, f.name).copy() if isinstance(
@@ -124,7 +128,8 @@ def initial_state(model, velocity=None, angular_velocity=None) -> State:
     energy[KINETIC0] = ke + ke_b
     return State(t=0.0, step=0, dt=0.0, x=model.x0.copy(), v=v, omega=w, elem=elem, mat=mat,
                  f_int=np.zeros((n, 6)), f_ext=np.zeros((n, 6)),
-                 node_active=np.ones(n, dtype=np.int8), energy=energy, bodies=bodies)
+                 node_active=np.ones(n, dtype=np.int8), energy=energy, bodies=bodies,
+                 f_contact=np.zeros((n, 3)))
 
 
 def rigid_rotation_velocity(x: np.ndarray, omega, centre=(0.0, 0.0, 0.0)) -> np.ndarray:

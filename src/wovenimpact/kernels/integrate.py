@@ -43,9 +43,9 @@ def smooth_step(t, ramp_time):
 
 @inline_kernel
 def update_node(
-    n, mass, inertia, bc_code, bc_velocity, body_accel, amplitude, dt_old, dt_mid, dt_new,
-    f_int, f_int_old, f_ext_old, live, x, v, omega, node_active, f_ext, w_int, w_ext, ke,
-    ke_eroded,
+    n, mass, inertia, bc_code, bc_velocity, body_accel, f_con, amplitude, dt_old, dt_mid,
+    dt_new, f_int, f_int_old, f_ext_old, live, x, v, omega, node_active, f_ext, w_int, w_ext,
+    ke, ke_eroded,
 ):
     """Central-difference update of node n (in place: x, v, omega, node_active; written:
     f_ext[n], w_int[n], w_ext[n], ke[n], ke_eroded[n]). ``live``: its live elements
@@ -94,7 +94,7 @@ def update_node(
     for d in range(6):
         m_d = m if d < 3 else inert
         old = v[n, d] if d < 3 else omega[n, d - 3]
-        load = m_d * body_accel[n, d] if d < 3 else 0.0
+        load = m_d * body_accel[n, d] + f_con[n, d] if d < 3 else 0.0
         code = bc_code[n, d]
         if code == FIXED:
             new = 0.0
@@ -123,7 +123,7 @@ def update_node(
 @loop_kernel
 def gather_and_update(
     node_ptr, node_elem, node_corner, blocks, alive,
-    mass, inertia, bc_code, bc_velocity, body_accel, amplitude, dt_old, dt_new,
+    mass, inertia, bc_code, bc_velocity, body_accel, f_con, amplitude, dt_old, dt_new,
     f_int, f_int_old, f_ext_old, x, v, omega, node_active,
     f_ext, w_int, w_ext, ke, ke_eroded,
 ):
@@ -134,6 +134,7 @@ def gather_and_update(
         blocks: (n_elems, 4, 6) element corner forces and moments at x^n.
         alive: (n_elems,) uint8, 1 for a live element (written by the force kernel).
         mass, inertia, bc_code, bc_velocity, body_accel: Model arrays.
+        f_con: (n, 3) contact forces at x^n (external loads of the shells).
         amplitude: prescribed-velocity amplitude at t^{n+1/2}.
         dt_old, dt_new: Δt^{n−1/2}, Δt^{n+1/2}.
         f_int: (n, 6) written: internal forces at x^n (gathered from blocks).
@@ -163,8 +164,8 @@ def gather_and_update(
         f_int[n, 4] = f4
         f_int[n, 5] = f5
         update_node(
-            n, mass, inertia, bc_code, bc_velocity, body_accel, amplitude, dt_old, dt_mid,
-            dt_new, f_int, f_int_old, f_ext_old, live, x, v, omega, node_active, f_ext,
+            n, mass, inertia, bc_code, bc_velocity, body_accel, f_con, amplitude, dt_old,
+            dt_mid, dt_new, f_int, f_int_old, f_ext_old, live, x, v, omega, node_active, f_ext,
             w_int, w_ext, ke, ke_eroded,
         )
         if not (math.isfinite(x[n, 0]) and math.isfinite(x[n, 1]) and math.isfinite(x[n, 2])):

@@ -24,7 +24,8 @@ B_X = 0  # centre of mass (3)
 B_V = 3  # velocity (3)
 B_R = 6  # rotation matrix body → global (9, row-major)
 B_W = 15  # body-frame angular velocity (3)
-N_BODY_STATE = 18
+B_F = 18  # contact force on the body at the last whole step (3, for its work)
+N_BODY_STATE = 21
 
 # static parameters of a body (Model.body_params)
 BP_MASS = 0  # m (kg)

@@ -31,8 +31,12 @@ from wovenimpact.errors import SimulationError
 from wovenimpact.kernels import shell_layout as S
 from wovenimpact.kernels.gather import gather_nodal_forces
 from wovenimpact.kernels.integrate import gather_and_update, smooth_step
+from wovenimpact.solver.contact_stage import ContactBuffers, advance_bodies, contact_forces
 from wovenimpact.kernels.shell import internal_force_for_shells
 from wovenimpact.state import (
+    BODY_KINETIC,
+    CONTACT_WORK,
+    NODE_CONTACT_WORK,
     ERODED_INTERNAL,
     ERODED_KINETIC,
     KINETIC,
@@ -67,6 +71,7 @@ class Workspace:
     w_ext: np.ndarray
     ke: np.ndarray
     ke_eroded: np.ndarray
+    contact: object = None  # solver.contact_stage.ContactBuffers
     dt_min: float = math.inf  # min_e L_e/c_e of the last element stage
     n_eroded: int = 0  # elements eroded in the last element stage
     profile: bool = False
@@ -89,6 +94,7 @@ class Workspace:
             f_int=np.zeros((n, 6)),
             f_ext=np.zeros((n, 6)), live=np.zeros(n, dtype=np.int64), w_int=np.zeros(n),
             w_ext=np.zeros(n), ke=np.zeros(n), ke_eroded=np.zeros(n),
+            contact=ContactBuffers.for_model(model),
         )
 
 
@@ -152,11 +158,19 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     t0 = ws.tick("shell forces", t0)
     dt_new = stable_step(model, state, ws, dt_cap)
     t0 = ws.tick("stable step", t0)
+    cb = ws.contact
+    resultants = contact_forces(model, state, cb, dt_new)
+    # work of the contact forces on the nodes over [x^{n−1}, x^n] (trapezoid), before
+    # the velocities move on
+    w_con_nodes = 0.0
+    if resultants or cb.shells is not None:
+        w_con_nodes = 0.5 * float(np.sum((state.f_contact + cb.f_con) * state.v)) * state.dt
+    t0 = ws.tick("contact", t0)
     amplitude = smooth_step(state.t + 0.5 * dt_new, model.ramp_time)
     n_bad = gather_and_update(
         model.node_ptr, model.node_elem, model.node_corner, ws.blocks, ws.alive,
         model.node_mass, model.node_inertia, model.bc_code, model.bc_velocity, model.body_accel,
-        amplitude, state.dt, dt_new, ws.f_int, state.f_int, state.f_ext,
+        cb.f_con, amplitude, state.dt, dt_new, ws.f_int, state.f_int, state.f_ext,
         state.x, state.v, state.omega, state.node_active, ws.f_ext,
         ws.w_int, ws.w_ext, ws.ke, ws.ke_eroded,
     )
@@ -164,7 +178,12 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     if n_bad:
         n = int(np.flatnonzero(~np.isfinite(state.x).all(axis=1))[0])
         raise SimulationError(f"node {n} has a non-finite position at t = {state.t:.6e} s")
+    ke_bodies, w_con_bodies = advance_bodies(model, state, resultants, state.dt, dt_new)
+    state.f_contact[:] = cb.f_con
     en = state.energy
+    en[BODY_KINETIC] = ke_bodies
+    en[CONTACT_WORK] += w_con_nodes + w_con_bodies
+    en[NODE_CONTACT_WORK] += w_con_nodes
     en[W_INT] += float(np.sum(ws.w_int))
     en[W_EXT] += float(np.sum(ws.w_ext))
     en[KINETIC] = float(np.sum(ws.ke))
@@ -198,22 +217,29 @@ def advance(model, state: State, ws: Workspace, t_stop: float, max_steps: int | 
 def energy_balance(model, state: State) -> dict[str, float]:
     """Energies (J) at the last whole step and the balance error.
 
-    total = kinetic + internal work + eroded kinetic − external work, which the
-    exact solution keeps at the initial kinetic energy; ``drift`` is total minus
-    its initial value, ``error_fraction`` the drift over the largest energy in play.
+    total = kinetic (nodes + impactors) + internal work + eroded kinetic − external
+    work − work of the contact forces (= + contact energy, the penalty springs' energy
+    and what sliding dissipated), which the exact solution keeps at the initial kinetic
+    energy; ``drift`` is total minus its initial value, ``error_fraction`` the drift
+    over the largest energy in play.
     """
     en = state.energy
     stored = float(np.sum(state.elem[:, S.E_U_MEMB] + state.elem[:, S.E_U_BEND]))
     hourglass = float(np.sum(state.elem[:, S.E_U_HG]))
-    total = en[KINETIC] + en[W_INT] + en[ERODED_KINETIC] - en[W_EXT]
+    external = en[W_EXT] - en[NODE_CONTACT_WORK]
+    contact = -en[CONTACT_WORK]
+    kinetic = en[KINETIC] + en[BODY_KINETIC]
+    total = kinetic + en[W_INT] + en[ERODED_KINETIC] - external + contact
     drift = total - en[KINETIC0]
-    scale = max(en[KINETIC0], abs(en[W_EXT]), abs(en[W_INT]), en[KINETIC], 1e-300)
+    scale = max(en[KINETIC0], abs(external), abs(en[W_INT]), kinetic, 1e-300)
     return {
         "kinetic_J": float(en[KINETIC]),
+        "impactor_kinetic_J": float(en[BODY_KINETIC]),
         "internal_work_J": float(en[W_INT]),
         "stored_J": stored,
         "hourglass_J": hourglass,
-        "external_work_J": float(en[W_EXT]),
+        "external_work_J": float(external),
+        "contact_energy_J": float(contact),
         "eroded_kinetic_J": float(en[ERODED_KINETIC]),
         "eroded_internal_J": float(en[ERODED_INTERNAL]),
         "total_J": float(total),

@@ -1,0 +1,97 @@
+"""Contact stage of the step: impactors on shells, and shells on shells (MODEL.md §4).
+
+Called between the element stage and the node update. It fills ``ws.f_con`` (the
+contact forces on the nodes at x^n, external loads of the shells) and the resultant
+force and torque on each rigid body, then advances the bodies by central differences
+(kernels.rigid_body). Penalty stiffnesses k = β m/Δt² use the step about to be taken,
+so contact never limits the stable step (ω Δt ≤ √(2β) per contact spring).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from wovenimpact.kernels import rigid_body as RB
+from wovenimpact.kernels.contact_rigid import rigid_contact_forces
+from wovenimpact.kernels.rigid_body import advance_body
+
+
+@dataclass
+class ContactBuffers:
+    """Preallocated arrays of the contact stage of one Model."""
+
+    f_con: np.ndarray  # (n, 3) total contact force per node
+    f_body: np.ndarray  # (n, 3) contact force of one body on each node
+    e_body: np.ndarray  # (n,) penalty energy per node (one body)
+    shells: object | None  # ShellContact driver, if plies can touch each other
+    shell_energy: float = 0.0
+    shell_pairs: int = 0
+
+    @classmethod
+    def for_model(cls, model, shell_contact: bool = True, friction: float = 0.0,
+                  beta: float = 0.1) -> ContactBuffers:
+        n = model.n_nodes
+        shells = None
+        if shell_contact and np.unique(model.ply).size > 1:
+            from wovenimpact.contact import ShellContact
+
+            shells = ShellContact(model, beta=beta, friction=friction)
+        return cls(np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n), shells)
+
+
+def body_frame(state_row, params):
+    """(tip position, unit axis tip → tail) of a body at x^n."""
+    axis = state_row[RB.B_R:RB.B_R + 9].reshape(3, 3)[:, 0]
+    tip = state_row[RB.B_X:RB.B_X + 3] - params[RB.BP_TIP] * axis
+    return tip, axis
+
+
+def contact_forces(model, state, cb: ContactBuffers, dt: float) -> list[tuple[np.ndarray, np.ndarray]]:
+    """Contact forces on the nodes (into cb.f_con) and (force, torque) on every body."""
+    cb.f_con[:] = 0.0
+    resultants = []
+    k_node = None
+    for b in range(model.body_params.shape[0]):
+        p = model.body_params[b]
+        row = state.bodies[b]
+        if k_node is None:
+            k_node = p[RB.BP_BETA] * model.node_mass / (dt * dt)
+        tip, axis = body_frame(row, p)
+        prof = model.body_profiles[b, : int(p[RB.BP_NPTS])]
+        rigid_contact_forces(
+            state.x, state.node_active, model.node_offset, k_node, tip, axis,
+            np.ascontiguousarray(prof[:, 0]), np.ascontiguousarray(prof[:, 1]),
+            p[RB.BP_REACH] + float(model.node_offset.max()), cb.f_body, cb.e_body,
+        )
+        cb.f_con += cb.f_body
+        force = -cb.f_body.sum(axis=0)
+        arm = state.x - row[RB.B_X:RB.B_X + 3]
+        torque = -np.cross(arm, cb.f_body).sum(axis=0)
+        if p[RB.BP_AXIAL_ONLY]:
+            force = (force @ axis) * axis
+            torque = np.zeros(3)
+        resultants.append((force, torque))
+    if cb.shells is not None:
+        alive = state.elem[:, 21]  # shell_layout.E_ALIVE
+        cb.shell_energy, cb.shell_pairs = cb.shells.forces(
+            state.x, state.v, dt, alive, state.node_active, cb.f_con, accumulate=True)
+    return resultants
+
+
+def advance_bodies(model, state, resultants, dt_old: float, dt_new: float) -> tuple[float, float]:
+    """Advance every body; returns (their kinetic energy at t^n, the work of the contact
+    forces on them over [t^{n−1}, t^n], trapezoid rule)."""
+    ke = 0.0
+    work = 0.0
+    for b, (force, torque) in enumerate(resultants):
+        p = model.body_params[b]
+        row = state.bodies[b]
+        du = dt_old * row[RB.B_V:RB.B_V + 3]
+        work += 0.5 * float((row[RB.B_F:RB.B_F + 3] + force) @ du)
+        row[RB.B_F:RB.B_F + 3] = force
+        ke += advance_body(row, p[RB.BP_MASS], p[RB.BP_I_AXIAL], p[RB.BP_I_TRANS],
+                           np.ascontiguousarray(force), np.ascontiguousarray(torque),
+                           dt_old, dt_new)
+    return ke, work

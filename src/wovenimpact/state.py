@@ -119,10 +119,10 @@ def initial_state(model, velocity=None, angular_velocity=None) -> State:
     bodies = model.body_state0.copy()
     ke_b = 0.0
     for b, p in zip(bodies, model.body_params):
-        w = b[RB.B_W:RB.B_W + 3]
+        spin = b[RB.B_W:RB.B_W + 3]
         inertia = np.array([p[RB.BP_I_AXIAL], p[RB.BP_I_TRANS], p[RB.BP_I_TRANS]])
         ke_b += 0.5 * p[RB.BP_MASS] * float(b[RB.B_V:RB.B_V + 3] @ b[RB.B_V:RB.B_V + 3])
-        ke_b += 0.5 * float(w @ (inertia * w))
+        ke_b += 0.5 * float(spin @ (inertia * spin))
     energy[KINETIC] = ke
     energy[BODY_KINETIC] = ke_b
     energy[KINETIC0] = ke + ke_b

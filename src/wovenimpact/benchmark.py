@@ -1,0 +1,95 @@
+"""Cost of the explicit step: ns per element-cycle for elastic and fabric shell plates
+(``wovenimpact bench``, ``make bench`` → benchmarks/bench_shell.py).
+
+A clamped square plate, pre-stretched 2 % in-plane (so fabric yarns carry tension and
+the crossover solve does real work) and set moving with a smooth transverse velocity
+field, is stepped with one thread and with two. Prints one line per case with the
+share of time per stage; ``--json`` prints {"cases": [{"name", "elements", "threads",
+"ns_per_element_cycle", "shares"}]}. ``--sizes=10000,100000`` chooses plate sizes,
+``--kinds=fabric`` the plates, ``--threads=2`` the thread counts and ``--steps=N`` the
+timed steps per case (20). The threading layer is printed first (``NUMBA_THREADING_LAYER``
+overrides the default of :mod:`wovenimpact.jit`).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numba
+import numpy as np
+
+from pathlib import Path
+
+from wovenimpact.jit import set_threads
+from wovenimpact.materials.metal import MetalParameters
+from wovenimpact.model import BoundaryConditions, Section, build_model
+from wovenimpact.model.mesh import plate_mesh
+from wovenimpact.solver import Workspace, step
+from wovenimpact.spec import load_material
+from wovenimpact.state import initial_state
+
+DEFAULT_SIZES = (10_000, 100_000, 400_000)
+REFERENCE_FABRIC = Path(__file__).resolve().parents[2] / "examples" / "materials" / "kevlar_thesis.toml"
+
+
+def plate_model(kind: str, n_elements: int):
+    per_edge = int(round(math.sqrt(n_elements)))
+    size = 0.94e-3
+    mesh = plate_mesh(per_edge * size, size)
+    if kind == "fabric":
+        fabric = load_material(REFERENCE_FABRIC)
+        sec = Section(fabric, bending_modulus=1e9, transverse_shear_modulus=3.28e9)
+    else:
+        steel = MetalParameters(name="steel", kind="elastic", density=7850.0, modulus=210e9,
+                                poisson=0.3)
+        sec = Section(steel, thickness=1e-3)
+    bc = BoundaryConditions(mesh.n_nodes).fix(mesh.node_sets["edge_outer"])
+    model = build_model(mesh.nodes, mesh.quads, {"s": sec}, np.zeros(mesh.n_elems, int), bcs=bc)
+    half = 0.5 * per_edge * size
+    r = np.linalg.norm(mesh.nodes[:, :2], axis=1) / half
+    v0 = np.zeros((mesh.n_nodes, 3))
+    v0[:, 2] = -50.0 * np.clip(1.0 - r, 0.0, None) ** 2
+    st = initial_state(model, velocity=v0)
+    st.x[:, :2] *= 1.02
+    return model, st
+
+
+def measure(kind: str, n_elements: int, threads: int, steps: int = 20) -> dict:
+    set_threads(threads)
+    model, st = plate_model(kind, n_elements)
+    ws = Workspace.for_model(model, st)
+    for _ in range(3):  # compile and warm up
+        step(model, st, ws)
+    ws.profile = True
+    ws.timings.clear()
+    t0 = time.perf_counter()
+    for _ in range(steps):
+        step(model, st, ws)
+    wall = time.perf_counter() - t0
+    total = sum(ws.timings.values())
+    return {
+        "name": f"{kind}_plate",
+        "elements": model.n_elems,
+        "threads": threads,
+        "ns_per_element_cycle": wall / (steps * model.n_elems) * 1e9,
+        "shares": {k: v / total for k, v in ws.timings.items()},
+    }
+
+
+def run_cases(kinds, sizes, thread_counts, steps: int = 20, report=None) -> list[dict]:
+    """Measure every (kind, size, threads) case; ``report(case)`` after each one."""
+    cases = []
+    for kind in kinds:
+        for n in sizes:
+            for threads in thread_counts:
+                cases.append(measure(kind, n, threads, steps))
+                if report is not None:
+                    report(cases[-1])
+    return cases
+
+
+def case_line(c: dict) -> str:
+    shares = ", ".join(f"{k} {v:.0%}" for k, v in c["shares"].items())
+    return (f"{c['name']:>14} {c['elements']:>7} elements, {c['threads']} thread(s): "
+            f"{c['ns_per_element_cycle']:7.1f} ns per element-cycle  ({shares})")

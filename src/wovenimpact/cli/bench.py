@@ -1,0 +1,29 @@
+"""``wovenimpact bench``: ns per element-cycle of the explicit step (elastic and fabric plates)."""
+
+from __future__ import annotations
+
+import json
+
+import numba
+import typer
+
+from wovenimpact.cli.app import app, console
+
+
+@app.command("bench")
+def bench(
+    sizes: str = typer.Option("10000,100000,400000", help="Plate sizes (elements), comma-separated."),
+    kinds: str = typer.Option("elastic,fabric", help="Plates to run: elastic, fabric."),
+    threads: str = typer.Option(None, help="Thread counts, comma-separated (default: 1 and 2)."),
+    steps: int = typer.Option(20, min=1, help="Timed steps per case."),
+    as_json: bool = typer.Option(False, "--json", help='Print {"cases": [...]} as one JSON object.'),
+) -> None:
+    """Time the explicit step on square plates; prints ns per element-cycle and stage shares."""
+    from wovenimpact.benchmark import case_line, run_cases
+
+    counts = ([int(t) for t in threads.split(",")] if threads
+              else sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)}))
+    cases = run_cases(kinds.split(","), [int(s) for s in sizes.split(",")], counts, steps,
+                      report=None if as_json else (lambda c: console.print(case_line(c))))
+    if as_json:
+        typer.echo(json.dumps({"cases": cases}))

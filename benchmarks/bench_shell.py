@@ -30,12 +30,12 @@ def main() -> None:
         elif arg.startswith("--steps="):
             steps = int(arg.split("=", 1)[1])
     quiet = "--json" in sys.argv
-    if not quiet:
-        print(f"threading layer: {numba.config.THREADING_LAYER}", flush=True)
     cases = run_cases(kinds, sizes, thread_counts, steps,
                       report=None if quiet else (lambda c: print(case_line(c), flush=True)))
     if quiet:
-        print(json.dumps({"cases": cases}))
+        print(json.dumps({"cases": cases, "threading_layer": numba.threading_layer()}))
+    else:
+        print(f"threading layer: {numba.threading_layer()}")
 
 
 if __name__ == "__main__":

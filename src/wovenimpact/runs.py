@@ -29,6 +29,13 @@ from wovenimpact.io.fields import FieldWriter
 from wovenimpact.io.history import History
 from wovenimpact.kernels import shell_layout as S
 from wovenimpact.model.compile import CompiledCase, compile_case
+from wovenimpact.quantities import (
+    impactor_row,
+    ply_deflections,
+    ply_energies,
+    residual_velocity,
+    symmetry_factor,
+)
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.spec.case import load_case
 from wovenimpact.state import KINETIC0, State
@@ -39,14 +46,26 @@ HISTORY_COLUMNS = (
     "eroded_internal_energy_J", "energy_error_fraction", "max_displacement_m",
     "eroded_elements",
 )
+IMPACT_COLUMNS = ("impactor_velocity_m_per_s", "impactor_displacement_m", "contact_force_N",
+                  "impactor_kinetic_energy_J", "contact_energy_J")
 DEFAULT_OUTPUTS = {"history": 1000, "field": 20, "checkpoint": 10}  # per run, if not given
 
 
+def history_columns(model) -> tuple[str, ...]:
+    """history.csv columns: energies etc., plus the impactor's if there is one. Energies
+    are of the modelled part (a quarter of the problem in a quarter model)."""
+    return HISTORY_COLUMNS + (IMPACT_COLUMNS if model.body_params.shape[0] else ())
+
+
 def history_row(model, state: State) -> dict:
-    """One history.csv row of ``state`` (columns :data:`HISTORY_COLUMNS`)."""
+    """One history.csv row of ``state`` (columns :func:`history_columns`)."""
     eb = energy_balance(model, state)
     disp = np.sqrt(np.max(np.sum((state.x - model.x0) ** 2, axis=1)))
-    return {
+    impact = {}
+    if model.body_params.shape[0]:
+        impact = {**impactor_row(model, state), "impactor_kinetic_energy_J":
+                  eb["impactor_kinetic_J"], "contact_energy_J": eb["contact_energy_J"]}
+    return {**impact, 
         "time_s": float(state.t), "step": int(state.step), "dt_s": float(state.dt),
         "kinetic_energy_J": eb["kinetic_J"], "internal_work_J": eb["internal_work_J"],
         "stored_energy_J": eb["stored_J"], "hourglass_energy_J": eb["hourglass_J"],
@@ -128,7 +147,7 @@ def run_spec(
     digest = model.digest()
     run = spec.run
     ckpt_dir = out / "checkpoints"
-    history = History(HISTORY_COLUMNS)
+    history = History(history_columns(model))
     if restart:
         last = latest_checkpoint(ckpt_dir)
         if last is None:
@@ -176,21 +195,42 @@ def run_spec(
         progress(state, run.end_time)
     history.write_csv(out / "history.csv")
     save_checkpoint(ckpt_dir, state, digest)
-    summary = summarise(spec, compiled, state, wall, state.step - steps0, max_error)
-    from wovenimpact.io.plots import energy_plot
+    summary = summarise(spec, compiled, state, wall, state.step - steps0, max_error,
+                        history.arrays())
+    from wovenimpact.io.plots import deflection_plot, energy_plot, impactor_plot
 
-    energy_plot(history.arrays(), out / "plots" / "energy.png", title=spec.case.name)
+    h = history.arrays()
+    energy_plot(h, out / "plots" / "energy.png", title=spec.case.name)
+    deflection_plot(model, state, out / "plots" / "ply_deflection.png", title=spec.case.name)
+    if "impactor_velocity_m_per_s" in h:
+        impactor_plot(h, out / "plots" / "impactor.png", title=spec.case.name)
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n")
     return summary
 
 
 def summarise(spec, compiled: CompiledCase, state: State, wall: float, steps: int,
-              max_error: float) -> dict:
-    """The numbers a user wants from a finished run (summary.json)."""
+              max_error: float, h: dict) -> dict:
+    """The numbers a user wants from a finished run (summary.json). Energies here are
+    of the whole problem (× ``symmetry_factor`` in symmetric models)."""
     model = compiled.model
     eb = energy_balance(model, state)
     cycles = steps * model.n_elems
-    return {
+    factor = symmetry_factor(model)
+    impact = {}
+    if model.body_params.shape[0]:
+        ke0 = factor * float(h["impactor_kinetic_energy_J"][0])
+        ke1 = factor * eb["impactor_kinetic_J"]
+        per_ply = ply_energies(model, state)
+        impact = {
+            **residual_velocity(h),
+            "initial_velocity_m_per_s": float(h["impactor_velocity_m_per_s"][0]),
+            "absorbed_energy_J": ke0 - ke1,
+            "absorbed_energy_per_ply_J": per_ply,
+            "max_deflection_m": max(ply_deflections(model, state)),
+            "max_deflection_per_ply_m": ply_deflections(model, state),
+            "peak_contact_force_N": float(np.max(h["contact_force_N"])),
+        }
+    return {**impact,
         "case": spec.case.name,
         "end_time_s": float(state.t),
         "steps": int(state.step),
@@ -201,12 +241,13 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, steps: in
         "wall_time_s": wall,
         "element_cycles": int(cycles),
         "ns_per_element_cycle": wall / cycles * 1e9 if cycles else None,
-        "kinetic_energy_J": eb["kinetic_J"],
-        "initial_kinetic_energy_J": float(state.energy[KINETIC0]),
-        "internal_work_J": eb["internal_work_J"],
-        "external_work_J": eb["external_work_J"],
-        "hourglass_energy_J": eb["hourglass_J"],
+        "kinetic_energy_J": factor * eb["kinetic_J"],
+        "initial_kinetic_energy_J": factor * float(state.energy[KINETIC0]),
+        "internal_work_J": factor * eb["internal_work_J"],
+        "external_work_J": factor * eb["external_work_J"],
+        "hourglass_energy_J": factor * eb["hourglass_J"],
         "eroded_elements": int(np.sum(state.elem[:, S.E_ALIVE] == 0.0)),
         "energy_error_fraction": float(max_error),
+        "symmetry_factor": factor,
         "max_displacement_m": float(np.sqrt(np.max(np.sum((state.x - model.x0) ** 2, axis=1)))),
     }

@@ -227,3 +227,23 @@ def test_impactor_overlapping_the_plies_is_an_error(tmp_path):
     result = CliRunner().invoke(app, ["run", str(case), "--out", str(tmp_path / "o")])
     assert result.exit_code == 2
     assert "impactor.position" in result.output and "overlaps" in result.output
+
+
+def test_impact_run_reports_outcome_velocity_and_energies(tmp_path):
+    """A small plate struck by the FSP at 120 m/s for 15 µs: the history carries the
+    impactor columns, the summary the outcome fields, and the energy balance holds."""
+    text = CASE.replace('[[initial_velocity]]\nvelocity = ["0 m/s", "0 m/s", "-60 m/s"]\n'
+                        'radius = "1.5 mm"\n', "") + IMPACTOR.replace("{z}", "0.4 mm")
+    case = write_case(tmp_path, text=text, end="15 us")
+    out = tmp_path / "out"
+    summary = run_case(case, out)
+    for key in ("residual_velocity_m_per_s", "perforated", "max_deflection_m",
+                "energy_error_fraction", "absorbed_energy_J", "absorbed_energy_per_ply_J",
+                "wall_time_s", "element_cycles", "ns_per_element_cycle"):
+        assert key in summary
+    header = (out / "history.csv").read_text().splitlines()[0]
+    assert "impactor_velocity_m_per_s" in header and "contact_force_N" in header
+    assert summary["peak_contact_force_N"] > 0.0
+    assert 0.0 < summary["absorbed_energy_J"] < 0.5 * 1.1e-3 * 120.0**2
+    assert summary["energy_error_fraction"] < 0.02
+    assert (out / "plots" / "impactor.png").exists() and (out / "plots" / "ply_deflection.png").exists()

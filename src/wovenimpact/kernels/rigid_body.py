@@ -36,7 +36,8 @@ BP_BETA = 4  # penalty factor β of k = β m_node / Δt²
 BP_REACH = 5  # radius of a sphere about the tip enclosing the body (m)
 BP_NPTS = 6  # number of profile points used in Model.body_profiles
 BP_AXIAL_ONLY = 7  # 1: the body moves along its axis only (symmetry planes through it)
-N_BODY_PARAM = 8
+BP_FRACTION = 8  # share of the body in the model (0.25 in a quarter model)
+N_BODY_PARAM = 9
 
 
 @kernel

@@ -197,8 +197,9 @@ class RigidBody:
         reach = float(np.max(np.hypot(profile[:, 0], profile[:, 1])))
         params = np.zeros(RB.N_BODY_PARAM)
         params[[RB.BP_MASS, RB.BP_I_AXIAL, RB.BP_I_TRANS, RB.BP_TIP, RB.BP_BETA, RB.BP_REACH,
-                RB.BP_NPTS, RB.BP_AXIAL_ONLY]] = (m, i_a, i_t, zc, self.beta, reach,
-                                                 len(profile), float(self.axial_only))
+                RB.BP_NPTS, RB.BP_AXIAL_ONLY, RB.BP_FRACTION]] = (
+            m, i_a, i_t, zc, self.beta, reach, len(profile), float(self.axial_only),
+            self.fraction)
         state = np.zeros(RB.N_BODY_STATE)
         state[RB.B_X:RB.B_X + 3] = np.asarray(self.tip, dtype=float) + zc * axis
         state[RB.B_V:RB.B_V + 3] = self.speed * travel

@@ -48,7 +48,8 @@ def residual_velocity(h: dict, quiet_time: float = QUIET_TIME) -> dict:
       the speed it bounced back with is reported as ``rebound_velocity_m_per_s``;
     - perforated: still moving forward, and the contact force has been zero for the
       last ``quiet_time``; residual = its final velocity;
-    - undecided: still moving forward and still (or recently) in contact: run longer.
+    - undecided: still moving forward and still (or recently) in contact: run longer;
+    - no contact: the impactor never touched anything (e.g. through a hole).
     """
     t = h["time_s"]
     v = h["impactor_velocity_m_per_s"]
@@ -58,7 +59,10 @@ def residual_velocity(h: dict, quiet_time: float = QUIET_TIME) -> dict:
         return {"outcome": "stopped", "perforated": False, "residual_velocity_m_per_s": 0.0,
                 "rebound_velocity_m_per_s": max(0.0, -v_end)}
     touching = np.flatnonzero(np.abs(f) > 0.0)
-    quiet = t[-1] - (t[touching[-1]] if touching.size else t[0])
+    if not touching.size:
+        return {"outcome": "no contact", "perforated": True, "residual_velocity_m_per_s": v_end,
+                "rebound_velocity_m_per_s": 0.0}
+    quiet = t[-1] - t[touching[-1]]
     if touching.size and quiet >= quiet_time:
         return {"outcome": "perforated", "perforated": True, "residual_velocity_m_per_s": v_end,
                 "rebound_velocity_m_per_s": 0.0}

@@ -247,3 +247,18 @@ def test_impact_run_reports_outcome_velocity_and_energies(tmp_path):
     assert 0.0 < summary["absorbed_energy_J"] < 0.5 * 1.1e-3 * 120.0**2
     assert summary["energy_error_fraction"] < 0.02
     assert (out / "plots" / "impactor.png").exists() and (out / "plots" / "ply_deflection.png").exists()
+
+
+def test_pre_perforated_ply_lets_the_impactor_through_untouched(tmp_path):
+    """A hole wider than the impactor (elements eroded at t = 0): no contact, the impactor
+    keeps its velocity exactly, the eroded elements and their orphaned nodes stay out."""
+    text = CASE.replace('[[initial_velocity]]\nvelocity = ["0 m/s", "0 m/s", "-60 m/s"]\n'
+                        'radius = "1.5 mm"\n', "") + IMPACTOR.replace("{z}", "0.4 mm") + (
+        '\n[[initial_erosion]]\nradius = "4 mm"\n')
+    case = write_case(tmp_path, text=text, end="20 us")
+    summary = run_case(case, tmp_path / "out")
+    assert summary["outcome"] == "no contact" and summary["perforated"]
+    assert summary["residual_velocity_m_per_s"] == pytest.approx(120.0, rel=1e-12)
+    assert summary["peak_contact_force_N"] == 0.0
+    assert summary["eroded_elements"] > 0
+    assert summary["energy_error_fraction"] < 1e-9

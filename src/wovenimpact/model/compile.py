@@ -82,6 +82,31 @@ def node_set(mesh: Mesh, name: str, key: str) -> np.ndarray:
     return np.asarray(mesh.node_sets[name], dtype=np.int64)
 
 
+def erode_at_start(model: Model, state: State, er, key: str) -> None:
+    """Erode the elements whose centroid lies within er.radius of the line through
+    er.centre along er.cylinder_axis (a hole through the plies); nodes left without a
+    live element leave the model."""
+    from wovenimpact.kernels import shell_layout as S
+
+    centroid = model.x0[model.quads].mean(axis=1)
+    axis = np.asarray(er.cylinder_axis, dtype=float)
+    axis = axis / np.linalg.norm(axis)
+    rel = centroid - np.asarray(er.centre)
+    radial = rel - np.outer(rel @ axis, axis)
+    hit = np.linalg.norm(radial, axis=1) <= er.radius
+    if er.plies is not None:
+        hit &= np.isin(model.ply, er.plies)
+    if not hit.any():
+        raise InputError(f"{key}: no element centroid lies within {er.radius:g} m of the axis "
+                         "through centre (and in the given plies)")
+    state.elem[hit, S.E_ALIVE] = 0.0
+    live = np.zeros(model.n_nodes, dtype=bool)
+    live[model.quads[state.elem[:, S.E_ALIVE] != 0.0].ravel()] = True
+    state.node_active[~live] = 0
+    state.v[~live] = 0.0
+    state.omega[~live] = 0.0
+
+
 def check_impactor_clearance(model: Model) -> None:
     """Every node must start outside each impactor by at least its contact offset."""
     n = model.n_nodes
@@ -182,4 +207,6 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     w[model.bc_code[:, 3:] == 1] = 0.0
     check_impactor_clearance(model)
     state = initial_state(model, velocity=v, angular_velocity=w)
+    for i, er in enumerate(spec.initial_erosion):
+        erode_at_start(model, state, er, f"initial_erosion[{i}]")
     return CompiledCase(model=model, state=state, mesh=mesh, materials=materials)

@@ -28,6 +28,8 @@ Schema (see README and examples/cases/)::
     [impactor]        shape = sphere | cylinder, radius, length, nose, nose_length, fillet,
                       density | mass, position (nose tip), direction, velocity,
                       contact_stiffness (penalty factor β of k = β m / Δt²)
+    [[initial_erosion]]  centre, radius, plies?: elements eroded at t = 0 (a hole: centroid
+                      within radius of the axis through centre along cylinder_axis)
     [run]             end_time, field_interval, history_interval, checkpoint_interval,
                       alpha, erode_dt_fraction, threads
 """
@@ -199,6 +201,17 @@ class ImpactorSpec(BaseModel):
         return self
 
 
+class InitialErosionSpec(BaseModel):
+    """``[[initial_erosion]]``: elements eroded at t = 0 (a pre-perforated ply): those
+    whose centroid lies within ``radius`` of ``centre`` (in the given plies, default all)."""
+
+    model_config = STRICT
+    centre: tuple[Coordinate, Coordinate, Coordinate] = (0.0, 0.0, 0.0)
+    radius: Length
+    plies: list[int] | None = None
+    cylinder_axis: tuple[float, float, float] | None = (0.0, 0.0, 1.0)
+
+
 class CaseSpec(BaseModel):
     """A whole case file."""
 
@@ -212,6 +225,7 @@ class CaseSpec(BaseModel):
     initial_velocity: list[InitialVelocitySpec] = []
     body_force: BodyForceSpec | None = None
     impactor: ImpactorSpec | None = None
+    initial_erosion: list[InitialErosionSpec] = []
     run: RunSpec
 
 

@@ -12,7 +12,8 @@ import numpy as np
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as S
 
-QUIET_TIME = 10e-6  # contact force must have been zero this long to call a perforation
+QUIET_TIME = 10e-6  # contact must have been light this long to call a perforation
+LIGHT_CONTACT = 0.01  # "light": below this fraction of the peak contact force
 
 
 def symmetry_factor(model) -> float:
@@ -46,8 +47,9 @@ def residual_velocity(h: dict, quiet_time: float = QUIET_TIME) -> dict:
 
     - stopped: the impactor's velocity along its travel reached zero; residual 0, and
       the speed it bounced back with is reported as ``rebound_velocity_m_per_s``;
-    - perforated: still moving forward, and the contact force has been zero for the
-      last ``quiet_time``; residual = its final velocity;
+    - perforated: still moving forward, and the contact force has stayed below 1 % of
+      its peak for the last ``quiet_time`` (torn yarns may still rub the shank);
+      residual = its final velocity;
     - undecided: still moving forward and still (or recently) in contact: run longer;
     - no contact: the impactor never touched anything (e.g. through a hole).
     """
@@ -62,8 +64,10 @@ def residual_velocity(h: dict, quiet_time: float = QUIET_TIME) -> dict:
     if not touching.size:
         return {"outcome": "no contact", "perforated": True, "residual_velocity_m_per_s": v_end,
                 "rebound_velocity_m_per_s": 0.0}
-    quiet = t[-1] - t[touching[-1]]
-    if touching.size and quiet >= quiet_time:
+    # rubbing of torn yarns on the shank is not an engagement: below 1 % of the peak
+    engaged = np.flatnonzero(np.abs(f) > LIGHT_CONTACT * np.max(np.abs(f)))
+    quiet = t[-1] - t[engaged[-1]]
+    if quiet >= quiet_time:
         return {"outcome": "perforated", "perforated": True, "residual_velocity_m_per_s": v_end,
                 "rebound_velocity_m_per_s": 0.0}
     return {"outcome": "undecided (still in contact: run longer)", "perforated": False,

@@ -262,3 +262,22 @@ def test_pre_perforated_ply_lets_the_impactor_through_untouched(tmp_path):
     assert summary["peak_contact_force_N"] == 0.0
     assert summary["eroded_elements"] > 0
     assert summary["energy_error_fraction"] < 1e-9
+
+
+def test_design_plies_finds_the_pack_that_stops_the_impactor(tmp_path):
+    """Real runs on a small plate struck at 60 m/s: the answer N is a pack that stopped
+    the impactor, bracketed by a run of N − 1 plies that it perforated."""
+    text = CASE.replace('[[initial_velocity]]\nvelocity = ["0 m/s", "0 m/s", "-60 m/s"]\n'
+                        'radius = "1.5 mm"\n', "").replace(
+        'section = "fabric"', 'section = "fabric"\nplies = 1\nspacing = "0.4992 mm"') + (
+        IMPACTOR.replace("{z}", "0.4 mm").replace('"120 m/s"', '"60 m/s"'))
+    case = write_case(tmp_path, text=text, end="150 us")
+    result = CliRunner().invoke(app, ["design", "plies", str(case), "--out", str(tmp_path / "d"),
+                                      "--json"])
+    assert result.exit_code == 0, result.output
+    answer = json.loads(result.stdout.strip().splitlines()[-1])
+    n = answer["plies_to_stop"]
+    assert answer["runs"][str(n)] == "stopped"
+    assert n == 1 or answer["runs"][str(n - 1)] == "perforated"
+    assert answer["areal_mass_kg_per_m2"] == pytest.approx(n * 0.4775, rel=1e-3)
+    print(f"\ndesign search: {n} plies stop it; runs {answer['runs']}")

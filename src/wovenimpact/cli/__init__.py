@@ -1,6 +1,6 @@
 """Command-line interface: ``wovenimpact COMMAND``. One module per command."""
 
-from wovenimpact.cli import bench, calibrate, element_test, run, sweep  # noqa: F401  (register commands)
+from wovenimpact.cli import bench, calibrate, design, element_test, run, sweep  # noqa: F401  (register commands)
 from wovenimpact.cli.app import app
 
 

@@ -1,0 +1,36 @@
+"""``wovenimpact design plies CASE.toml``: the fewest plies that stop the impactor."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from wovenimpact.cli.app import app, emit, fail
+from wovenimpact.errors import InputError
+
+design_app = typer.Typer(help="Design searches by actual runs.", no_args_is_help=True)
+app.add_typer(design_app, name="design")
+
+
+@design_app.command("plies")
+def plies(
+    case: Path = typer.Argument(..., help="Plate-impact case (mesh.kind = 'plate', [impactor])."),
+    out: Path = typer.Option(None, "--out", help="Where the runs go (default: out/design_<case>)."),
+    workers: int = typer.Option(2, "--workers", min=1, help="Runs in parallel."),
+    start: int = typer.Option(None, "--start", min=1, help="First ply count to try (default: the case's)."),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
+) -> None:
+    """Search the number of plies (doubling, then bisection) and print the answer with
+    the areal mass of the pack."""
+    from wovenimpact.studies.design import design_plies
+
+    try:
+        result = design_plies(case, out or Path("out") / f"design_{case.stem}", workers=workers,
+                              start=start)
+    except InputError as err:
+        fail(str(err))
+    shown = dict(result)
+    if not as_json:
+        shown["runs"] = ", ".join(f"{k}: {v}" for k, v in result["runs"].items())
+    emit(shown, as_json, f"{case.name}: plies to stop the impactor")

@@ -1,0 +1,125 @@
+"""Design search: the fewest plies that stop the impactor, by actual runs.
+
+``design_plies`` takes a plate-impact case (``mesh.kind = "plate"`` with an
+``[impactor]``), re-runs it with N plies (the impactor keeps its clearance above the
+top ply) and searches N: first by doubling until a pack stops the impactor, then by
+bisection between the largest pack that is perforated and the smallest that stops it.
+Each round runs its candidates in parallel (local processes). An ``undecided`` run
+(still in contact at the end time) stops the search with advice to run longer.
+"""
+
+from __future__ import annotations
+
+import copy
+import tomllib
+from collections.abc import Callable
+from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
+
+from wovenimpact.errors import InputError
+from wovenimpact.units import to_si
+
+MAX_PLIES = 64
+
+
+def search_plies(stops: Callable[[list[int]], dict[int, bool]], start: int = 1,
+                 max_plies: int = MAX_PLIES) -> tuple[int, dict[int, bool]]:
+    """Smallest N ≥ 1 with stops(N), assuming more plies never do worse.
+
+    ``stops`` evaluates a batch of ply counts (in parallel) and returns N → stopped.
+    Returns (N, every evaluation made).
+    """
+    seen: dict[int, bool] = {}
+    lo, hi = 0, None  # lo: largest known perforated (0: none), hi: smallest known stopped
+    n = max(1, start)
+    while hi is None:
+        batch = [k for k in (n, 2 * n) if k <= max_plies and k not in seen]
+        if not batch:
+            raise InputError(f"no pack of up to {max_plies} plies stops the impactor")
+        seen.update(stops(batch))
+        for k in sorted(seen):
+            if seen[k] and (hi is None or k < hi):
+                hi = k
+            if not seen[k]:
+                lo = max(lo, k)
+        n *= 4
+    while hi - lo > 1:
+        third = max(1, (hi - lo) // 3)
+        batch = sorted({k for k in (lo + third, hi - third) if lo < k < hi and k not in seen})
+        if not batch:
+            batch = [(lo + hi) // 2]
+        seen.update(stops(batch))
+        for k in batch:
+            if seen[k]:
+                hi = min(hi, k)
+            else:
+                lo = max(lo, k)
+    return hi, seen
+
+
+def _case_with_plies(doc: dict, n: int) -> dict:
+    """The case document with n plies; the impactor keeps its clearance above the top ply."""
+    d = copy.deepcopy(doc)
+    mesh = d.get("mesh", {})
+    if mesh.get("kind") != "plate" or "impactor" not in d:
+        raise InputError("design plies needs a plate case (mesh.kind = 'plate') with an [impactor]")
+    n0 = int(mesh.get("plies", 1))
+    spacing = to_si(mesh.get("spacing", "0 m"), "length", "mesh.spacing", ge=0)
+    if n > 1 and spacing <= 0:
+        raise InputError("mesh.spacing: give the distance between plies to vary their number")
+    pos = d["impactor"]["position"]
+    z = to_si(pos[2], "length", "impactor.position[2]")
+    pos[2] = f"{(z + (n - n0) * spacing) * 1e3!r} mm"
+    mesh["plies"] = n
+    if n > 1:
+        mesh["spacing"] = f"{spacing * 1e3!r} mm"
+    return d
+
+
+def _run_one(doc: dict, base: str, out: str) -> str:
+    from wovenimpact.runs import run_spec
+    from wovenimpact.spec.case import case_from_dict
+
+    summary = run_spec(case_from_dict(doc, source=out), base, out, threads=1)
+    return summary["outcome"]
+
+
+def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
+                 start: int | None = None) -> dict:
+    """Fewest plies that stop the impactor of a plate-impact case; runs in out_dir/plies_N."""
+    path = Path(case_path)
+    try:
+        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, tomllib.TOMLDecodeError) as err:
+        raise InputError(f"{path}: cannot read the case ({err})") from None
+    base = str(path.resolve().parent)
+    out = Path(out_dir)
+    outcomes: dict[int, str] = {}
+
+    def stops(batch: list[int]) -> dict[int, bool]:
+        docs = [_case_with_plies(doc, n) for n in batch]
+        with ProcessPoolExecutor(max_workers=max(1, min(workers, len(batch)))) as pool:
+            results = list(pool.map(_run_one, docs, [base] * len(batch),
+                                    [str(out / f"plies_{n}") for n in batch]))
+        for n, r in zip(batch, results):
+            outcomes[n] = r
+            if r.startswith("undecided"):
+                raise InputError(f"{n} plies: the impactor is still in contact at run.end_time; "
+                                 "lengthen the run and search again")
+        return {n: r == "stopped" for n, r in zip(batch, results)}
+
+    n0 = int(doc.get("mesh", {}).get("plies", 1))
+    plies, _ = search_plies(stops, start=start or n0)
+    from wovenimpact.model.compile import compile_case
+    from wovenimpact.spec.case import case_from_dict
+
+    spec = case_from_dict(_case_with_plies(doc, plies), source=str(path))
+    model = compile_case(spec, Path(base)).model
+    areal = float(model.sections[model.elem_section[0], 2])  # shell_layout.C_AREAL_MASS
+    side = spec.mesh.side
+    return {
+        "plies_to_stop": plies,
+        "areal_mass_kg_per_m2": plies * areal,
+        "pack_mass_kg": plies * areal * side * side,
+        "runs": {str(k): v for k, v in sorted(outcomes.items())},
+    }

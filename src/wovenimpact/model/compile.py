@@ -8,6 +8,8 @@ the case key that is wrong.
 
 from __future__ import annotations
 
+import copy
+import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -21,7 +23,7 @@ from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels.contact_rigid import rigid_contact_forces
 from wovenimpact.model.model import BoundaryConditions, Model, RigidBody, Section, build_model
 from wovenimpact.spec.case import DOFS, AbaqusMeshSpec, CaseSpec, PlateMeshSpec
-from wovenimpact.spec.material import load_material
+from wovenimpact.spec.material import load_material, material_from_dict
 from wovenimpact.state import State, initial_state, rigid_rotation_velocity
 
 SYMMETRY_AXIS = {"symmetry_x": 0, "symmetry_y": 1, "symmetry_z": 2}
@@ -42,6 +44,33 @@ def _material_path(base: Path, name: str, rel: str) -> Path:
     if not path.is_file():
         raise InputError(f"materials.{name}: file {rel!r} not found (looked for {path})")
     return path
+
+
+def _merge(into: dict, new: dict, where: str) -> None:
+    """Replace entries of ``into`` by those of ``new``, recursing into tables."""
+    for k, v in new.items():
+        if isinstance(v, dict):
+            if not isinstance(into.get(k), dict):
+                raise InputError(f"{where}.{k}: the material file has no table {k!r}")
+            _merge(into[k], v, f"{where}.{k}")
+        else:
+            into[k] = v
+
+
+def load_case_material(base: Path, name: str, ref):
+    """A case's material: its file, with the case's ``set`` values merged in."""
+    if isinstance(ref, str):
+        return load_material(_material_path(base, name, ref))
+    path = _material_path(base, name, ref.file)
+    try:
+        doc = tomllib.loads(path.read_text(encoding="utf-8"))
+    except tomllib.TOMLDecodeError as err:
+        raise InputError(f"{path}: not valid TOML: {err}") from None
+    if ref.set:
+        if not isinstance(doc.get("material"), dict):
+            raise InputError(f"{path}: no [material] table")
+        _merge(doc["material"], copy.deepcopy(ref.set), f"materials.{name}.set")
+    return material_from_dict(doc, source=f"{path} (with materials.{name}.set)")
 
 
 def make_mesh(spec: CaseSpec, base: Path) -> tuple[Mesh, list[str]]:
@@ -137,7 +166,7 @@ def check_impactor_clearance(model: Model) -> None:
 def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     """Build the Model and the State at t = 0 of a case (paths relative to ``base``)."""
     base = Path(base)
-    materials = {n: load_material(_material_path(base, n, rel)) for n, rel in spec.materials.items()}
+    materials = {n: load_case_material(base, n, ref) for n, ref in spec.materials.items()}
     sections = {
         name: Section(
             material=materials[s.material], thickness=s.thickness,

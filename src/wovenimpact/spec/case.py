@@ -11,7 +11,8 @@ together, one line each, naming the key::
 Schema (see README and examples/cases/)::
 
     [case]            name, description
-    [materials]       NAME = "path/to/material.toml"   (relative to the case file)
+    [materials]       NAME = "path/to/material.toml"   (relative to the case file), or
+                      NAME = { file = "...", set = { warp = { crimp = "0.06" } } }
     [sections.NAME]   material, thickness?, bending_modulus?, bending_poisson?,
                       transverse_shear_modulus?, shear_factor?, hourglass?, areal_mass?,
                       points? (1: resultant section; odd n ≥ 3: n Simpson points)
@@ -212,12 +213,22 @@ class InitialErosionSpec(BaseModel):
     cylinder_axis: tuple[float, float, float] | None = (0.0, 0.0, 1.0)
 
 
+class MaterialRef(BaseModel):
+    """``[materials.NAME]`` as a table: a material file and values that replace some of
+    its entries (same layout as the file's ``[material]`` table, units included), e.g.
+    ``set = { warp = { crimp = "0.06" }, compaction = { a = "0.15 mm" } }``."""
+
+    model_config = STRICT
+    file: str = Field(min_length=1)
+    set: dict[str, Any] = {}
+
+
 class CaseSpec(BaseModel):
     """A whole case file."""
 
     model_config = STRICT
     case: CaseInfo
-    materials: dict[str, str] = Field(min_length=1)
+    materials: dict[str, str | MaterialRef] = Field(min_length=1)
     sections: dict[str, SectionSpec] = Field(min_length=1)
     mesh: PlateMeshSpec | AbaqusMeshSpec = Field(discriminator="kind")
     boundary: list[BoundarySpec] = []

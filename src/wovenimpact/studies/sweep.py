@@ -69,11 +69,15 @@ class Variant:
 
 
 def set_dotted(doc: dict, key: str, value: Any) -> None:
-    """doc["a"]["b"][0]["c"] = value for key "a.b.0.c" (list items by index); the key
-    must exist in the base case except for its last part (a new optional key)."""
+    """doc["a"]["b"][0]["c"] = value for key "a.b.0.c" (list items by index). Missing
+    tables under a ``set`` table (material overrides) are created; elsewhere the key must
+    exist in the base case except for its last part (a new optional key)."""
     parts = key.split(".")
     node: Any = doc
     for i, part in enumerate(parts[:-1]):
+        overrides = "set" in parts[:i] or (part == "set" and parts[0] == "materials")
+        if isinstance(node, dict) and part not in node and overrides:
+            node[part] = {}
         try:
             node = node[int(part)] if isinstance(node, list) else node[part]
         except (KeyError, IndexError, ValueError):

@@ -1,6 +1,14 @@
 """Command-line interface: ``wovenimpact COMMAND``. One module per command."""
 
-from wovenimpact.cli import bench, calibrate, design, element_test, run, sweep  # noqa: F401  (register commands)
+from wovenimpact.cli import (  # noqa: F401  (register commands)
+    ballistics,
+    bench,
+    calibrate,
+    design,
+    element_test,
+    run,
+    sweep,
+)
 from wovenimpact.cli.app import app
 
 

@@ -1,0 +1,80 @@
+"""``wovenimpact ballistics``: V50 and plies-to-stop from a sweep's results.csv."""
+
+from __future__ import annotations
+
+import csv
+import json
+from pathlib import Path
+
+import typer
+
+from wovenimpact.cli.app import app, emit, fail
+from wovenimpact.errors import InputError
+from wovenimpact.units import to_si
+
+ballistics_app = typer.Typer(help="Ballistic fits of sweep results.", no_args_is_help=True)
+app.add_typer(ballistics_app, name="ballistics")
+
+
+def _rows(results: Path) -> list[dict]:
+    try:
+        with results.open(newline="", encoding="utf-8") as fh:
+            rows = [r for r in csv.DictReader(fh) if r.get("status") == "done"]
+    except OSError as err:
+        raise InputError(f"{results}: cannot read ({err.strerror})") from None
+    if not rows or "residual_velocity_m_per_s" not in rows[0]:
+        raise InputError(f"{results}: no finished runs with residual_velocity_m_per_s "
+                         "(list it in the study's metrics)")
+    return rows
+
+
+def _column(rows, key: str, results: Path) -> list[str]:
+    if key not in rows[0]:
+        raise InputError(f"{results}: no column {key!r}; columns: {list(rows[0])}")
+    return [r[key] for r in rows]
+
+
+@ballistics_app.command("v50")
+def v50(
+    results: Path = typer.Argument(..., help="results.csv of a velocity sweep."),
+    key: str = typer.Option("impactor.velocity", help="Parameter column of the striking velocity."),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
+) -> None:
+    """Lambert–Jonas fit V_r = a (V_s^p − V50^p)^(1/p) of residual against striking velocity."""
+    from wovenimpact.studies.ballistics import lambert_jonas_fit
+
+    try:
+        rows = _rows(results)
+        vs = [to_si(json.loads(v) if v.startswith('"') else v, "velocity", key)
+              for v in _column(rows, key, results)]
+        vr = [float(r["residual_velocity_m_per_s"]) for r in rows]
+        fit = lambert_jonas_fit(vs, vr)
+    except InputError as err:
+        fail(str(err))
+    emit({"v50_m_per_s": fit.v_bl, "a": fit.a, "p": fit.p, "rms_m_per_s": fit.rms,
+          "runs": len(vs)}, as_json, f"{results}: Lambert–Jonas")
+
+
+@ballistics_app.command("plies")
+def plies(
+    results: Path = typer.Argument(..., help="results.csv of a sweep over mesh.plies."),
+    key: str = typer.Option("mesh.plies", help="Parameter column of the number of plies."),
+    as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
+) -> None:
+    """Quadratic regression of residual velocity against plies (thesis eq. 7.1 method)."""
+    from wovenimpact.studies.ballistics import quadratic_ply_regression
+
+    try:
+        rows = _rows(results)
+        n = [float(v) for v in _column(rows, key, results)]
+        vr = [float(r["residual_velocity_m_per_s"]) for r in rows]
+        perforated = [(a, b) for a, b in zip(n, vr) if b > 0]
+        reg = quadratic_ply_regression(*zip(*perforated)) if len(perforated) >= 3 else None
+        if reg is None:
+            raise InputError(f"{results}: the regression needs three perforated ply counts, got "
+                             f"{len(perforated)} (the others stopped the impactor)")
+    except InputError as err:
+        fail(str(err))
+    c2, c1, c0 = reg.coefficients
+    emit({"c2": c2, "c1": c1, "c0": c0, "r2": reg.r2, "plies_to_stop": reg.plies_to_stop,
+          "root": reg.root}, as_json, f"{results}: V_r(N) = c2 N² + c1 N + c0")

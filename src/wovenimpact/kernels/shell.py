@@ -19,7 +19,8 @@ positions x^n and the half-step velocities v^{n−1/2}, ω^{n−1/2}:
    r C_m A Σb², r 16 D Σb² and r D A Σb² (membrane, w, θ), each the order of the
    physical energy of a smooth field with the same nodal values;
 5. the element's stable step L_e / c_e, L_e = A / max edge (eq. 4.9–4.11), c_e from
-   the current membrane tangent and the transverse-shear wave speed.
+   the current membrane tangent and the transverse-shear wave speed, and no more than
+   the rotational bound 2 √(I/k_θ) of its corners' spins.
 
 ``shell_force`` is one element; ``internal_force_for_shells`` loops over all of them
 in parallel, each writing only its own rows, so results do not depend on threads.
@@ -519,6 +520,14 @@ def shell_force(
         edge2 = max(edge2, dx * dx + dy * dy + dz * dz)
     c2 = max(c_memb, kgt) / mu
     dt_e = area / math.sqrt(edge2 * c2)
+    # rotations: a corner's spin against this element's transverse-shear and bending
+    # stiffness, k_θ = A (k G t/4 + D Σb²), with the rotary inertia the element lumped
+    # on it, I = ¼ μ A0 max(t²/12, A0/8); ω Δt ≤ 2 needs Δt ≤ 2 √(I/k_θ). In an element
+    # that has stretched far beyond its reference size (a broken yarn family) this,
+    # not the membrane, governs.
+    inertia = 0.25 * mu * a0 * max(thick * thick / 12.0, a0 / 8.0)
+    k_rot = area * (0.25 * kgt + d_b * bb)
+    dt_e = min(dt_e, 2.0 * math.sqrt(inertia / k_rot))
     el_out[e, E_DT] = dt_e
     if not math.isfinite(fsum + dt_e):
         return EL_NAN, 0

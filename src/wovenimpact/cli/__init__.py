@@ -8,6 +8,7 @@ from wovenimpact.cli import (  # noqa: F401  (register commands)
     element_test,
     run,
     sweep,
+    validate,
 )
 from wovenimpact.cli.app import app
 

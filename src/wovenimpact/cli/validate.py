@@ -1,0 +1,28 @@
+"""``wovenimpact validate``: rerun the chapter-7 cases and studies, rewrite docs/validation.md."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import typer
+
+from wovenimpact.cli.app import app, console, fail
+from wovenimpact.errors import InputError
+
+
+@app.command("validate")
+def validate(
+    work: Path = typer.Option(Path("out/validation"), "--work", help="Where the runs go (resumed)."),
+    report: Path = typer.Option(None, "--report", help="Report path (default: docs/validation.md)."),
+    study: list[str] = typer.Option(None, "--study", help="Only these studies (repeatable)."),
+    workers: int = typer.Option(2, "--workers", min=1, help="Runs in parallel."),
+) -> None:
+    """Run (or resume) the example cases and thesis studies; write the validation report."""
+    from wovenimpact.studies.validation import ROOT, STUDIES, run_validation
+
+    try:
+        path = run_validation(work, report or ROOT / "docs" / "validation.md",
+                              studies=tuple(study) if study else STUDIES, workers=workers)
+    except InputError as err:
+        fail(str(err))
+    console.print(f"validation report: {path}")

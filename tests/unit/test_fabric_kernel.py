@@ -303,6 +303,19 @@ def test_broken_fill_lets_the_warp_decrimp_and_unload(kevlar):
     assert st_[L.S_TENSION] == 0.0 and st_[L.S_ALIVE] == 1.0
 
 
+@pytest.mark.parametrize("fill_stretch, eroded", [(1.5, False), (1.99, False), (2.01, True)])
+def test_broken_family_stretched_past_the_limit_erodes_the_point(kevlar, fill_stretch, eroded):
+    """Nothing holds a point together across broken yarns: once the broken family is
+    stretched past erode_broken_stretch (2 by default) the point erodes."""
+    p = kevlar.to_array()
+    state = initial_state(kevlar)[0]
+    state[L.S_DAMAGE + 1] = 1.0  # fill broken
+    out = update_points(p, np.eye(2), np.diag([1.0, fill_stretch]), state).state[0]
+    assert (out[L.S_ALIVE] == 0.0) == eroded
+    if eroded:
+        assert out[L.S_DAMAGE] == 1.0 and out[L.S_DAMAGE + 1] == 1.0
+
+
 def test_both_yarns_broken_erodes_the_point(kevlar):
     p = kevlar.to_array()
     state = initial_state(kevlar)[0]

@@ -40,6 +40,7 @@ from wovenimpact.kernels.fabric_layout import (
     P_COMP_B,
     P_E,
     P_ELL0,
+    P_ERODE_STRETCH,
     P_FAILURE,
     P_FRAME,
     P_G1,
@@ -532,7 +533,15 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
     s_out[i, S_TENSION] = t_w
     s_out[i, S_TENSION + 1] = t_f
     s_out[i, S_ITER] = iters
-    if d_w >= 1.0 and d_f >= 1.0:  # eroded (theory §1.4)
+    # eroded (theory §1.4): both families broken, or a broken family stretched beyond
+    # P_ERODE_STRETCH (the element is a sliver held by nothing across the break)
+    lim = p[m, P_ERODE_STRETCH]
+    if lim > 0.0 and ((d_w >= 1.0 and lam_w > lim) or (d_f >= 1.0 and lam_f > lim)):
+        d_w = 1.0
+        d_f = 1.0
+        s_out[i, S_DAMAGE] = 1.0
+        s_out[i, S_DAMAGE + 1] = 1.0
+    if d_w >= 1.0 and d_f >= 1.0:
         clear_eroded_point(s_out, i)
         return STATUS_OK, 0.0, 0.0, 0.0, 0.0
 

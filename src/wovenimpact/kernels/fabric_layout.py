@@ -31,7 +31,8 @@ P_SHEAR = 25  # shear option: SHEAR_TRUE or SHEAR_THESIS
 P_FRAME = 26  # frame option: FRAME_FIBRE or FRAME_GREEN_NAGHDI
 P_FAILURE = 27  # failure option: FAILURE_INSTANT or FAILURE_PROGRESSIVE
 P_AREAL_MASS = 28  # μ, areal mass (kg/m²) — derived or measured
-N_PARAM = 29
+P_ERODE_STRETCH = 29  # erode once a broken family is stretched past this (—), 0: never
+N_PARAM = 30
 
 HOMOG_VIRIAL = 0
 HOMOG_THESIS = 1

@@ -58,6 +58,9 @@ class FabricOptions:
     frame: Literal["fibre", "green-naghdi"] = "fibre"
     failure: Literal["instant", "progressive"] = "instant"
     softening_strain: float = 0.0  # Δε_s (—), used with failure = "progressive"
+    # a point whose broken family is stretched beyond this erodes (0: only when both
+    # families are broken); nothing holds the element together across broken yarns
+    erode_broken_stretch: float = 2.0
 
 
 @dataclass(frozen=True)
@@ -181,6 +184,7 @@ class FabricParameters:
             o.failure
         ]
         p[L.P_AREAL_MASS] = self.areal_mass
+        p[L.P_ERODE_STRETCH] = o.erode_broken_stretch
         return p
 
 

@@ -91,6 +91,8 @@ class OptionsSpec(BaseModel):
     frame: Literal["fibre", "green-naghdi"] = "fibre"
     failure: Literal["instant", "progressive"] = "instant"
     softening_strain: quantity("dimensionless", gt=0, example="0.01") | None = None
+    # erode a point once a broken yarn family is stretched past this (0: never)
+    erode_broken_stretch: quantity("dimensionless", ge=0, example="2.0") = 2.0
 
 
 class FabricSpec(BaseModel):
@@ -287,6 +289,7 @@ def _fabric_parameters(
         frame=o.frame,
         failure=o.failure,
         softening_strain=o.softening_strain if o.failure == "progressive" else 0.0,
+        erode_broken_stretch=o.erode_broken_stretch,
     )
     return FabricParameters(
         warp=families["warp"],

@@ -9,7 +9,6 @@ the case key that is wrong.
 from __future__ import annotations
 
 import copy
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -23,6 +22,7 @@ from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels.contact_rigid import rigid_contact_forces
 from wovenimpact.model.model import BoundaryConditions, Model, RigidBody, Section, build_model
 from wovenimpact.spec.case import DOFS, AbaqusMeshSpec, CaseSpec, PlateMeshSpec
+from wovenimpact.spec.fields import read_toml
 from wovenimpact.spec.material import load_material, material_from_dict
 from wovenimpact.state import State, initial_state, rigid_rotation_velocity
 
@@ -62,10 +62,7 @@ def load_case_material(base: Path, name: str, ref):
     if isinstance(ref, str):
         return load_material(_material_path(base, name, ref))
     path = _material_path(base, name, ref.file)
-    try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
-    except tomllib.TOMLDecodeError as err:
-        raise InputError(f"{path}: not valid TOML: {err}") from None
+    doc = read_toml(path, "material file")
     if ref.set:
         if not isinstance(doc.get("material"), dict):
             raise InputError(f"{path}: no [material] table")

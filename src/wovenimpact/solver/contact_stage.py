@@ -14,6 +14,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from wovenimpact.kernels import rigid_body as RB
+from wovenimpact.kernels.shell_layout import E_ALIVE
 from wovenimpact.kernels.contact_rigid import rigid_contact_forces
 from wovenimpact.kernels.rigid_body import advance_body
 
@@ -67,14 +68,15 @@ def contact_forces(model, state, cb: ContactBuffers, dt: float) -> list[tuple[np
         )
         cb.f_con += cb.f_body
         force = -cb.f_body.sum(axis=0)
-        arm = state.x - row[RB.B_X:RB.B_X + 3]
-        torque = -np.cross(arm, cb.f_body).sum(axis=0)
-        if p[RB.BP_AXIAL_ONLY]:
+        if p[RB.BP_AXIAL_ONLY]:  # symmetry planes through the axis: no torque, no drift
             force = (force @ axis) * axis
             torque = np.zeros(3)
+        else:
+            arm = state.x - row[RB.B_X:RB.B_X + 3]
+            torque = -np.cross(arm, cb.f_body).sum(axis=0)
         resultants.append((force, torque))
     if cb.shells is not None:
-        alive = state.elem[:, 21]  # shell_layout.E_ALIVE
+        alive = state.elem[:, E_ALIVE]
         cb.shell_energy, cb.shell_pairs = cb.shells.forces(
             state.x, state.v, dt, alive, state.node_active, cb.f_con, accumulate=True)
     return resultants

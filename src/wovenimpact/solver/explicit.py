@@ -164,7 +164,8 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     # the velocities move on
     w_con_nodes = 0.0
     if resultants or cb.shells is not None:
-        w_con_nodes = 0.5 * float(np.sum((state.f_contact + cb.f_con) * state.v)) * state.dt
+        # vdot flattens views: no temporary array in the step
+        w_con_nodes = 0.5 * (np.vdot(state.f_contact, state.v) + np.vdot(cb.f_con, state.v)) * state.dt
     t0 = ws.tick("contact", t0)
     amplitude = smooth_step(state.t + 0.5 * dt_new, model.ramp_time)
     n_bad = gather_and_update(

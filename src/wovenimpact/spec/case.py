@@ -38,7 +38,6 @@ Schema (see README and examples/cases/)::
 from __future__ import annotations
 
 import dataclasses
-import tomllib
 from pathlib import Path
 from typing import Any, Literal
 
@@ -51,6 +50,7 @@ from wovenimpact.spec.fields import (
     input_error,
     problems_from_validation,
     quantity,
+    read_toml,
 )
 
 Length = quantity("length", gt=0, example="0.94 mm")
@@ -290,12 +290,5 @@ def load_case(path: str | Path) -> tuple[CaseSpec, Path]:
     """Read and validate a case file; returns the spec and the file's directory
     (material and mesh paths in the case are relative to it)."""
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as err:
-        raise InputError(f"{path}: cannot read the case file ({err.strerror})") from None
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise InputError(f"{path}: not valid TOML: {err}") from None
+    doc = read_toml(path, "case file")
     return case_from_dict(doc, source=str(path)), path.resolve().parent

@@ -10,9 +10,11 @@ turns a pydantic ``ValidationError`` into :class:`Problem` records, and
 
 from __future__ import annotations
 
+import tomllib
 import types
 import typing
 from dataclasses import dataclass
+from pathlib import Path
 from typing import Annotated, Any
 
 from pydantic import BaseModel, BeforeValidator, ConfigDict, ValidationError
@@ -97,6 +99,20 @@ class Problem:
             extra.append(f"valid: {self.valid}")
         tail = f" ({'; '.join(extra)})" if extra else ""
         return f"{source}: {self.path}: {self.what}{tail}"
+
+
+def read_toml(path, what: str) -> dict:
+    """The parsed TOML document at ``path``; an InputError naming the file and ``what``
+    it is ("case file", "material file", …) if it cannot be read or parsed."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as err:
+        raise InputError(f"{path}: cannot read the {what} ({err.strerror})") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise InputError(f"{path}: not valid TOML: {err}") from None
 
 
 def input_error(problems: list[Problem], source: str) -> InputError:

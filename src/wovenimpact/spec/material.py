@@ -21,7 +21,6 @@ family; h_i0 solves eq. (5.5) for ℓ_i0 and the crimp c_i unless given.
 from __future__ import annotations
 
 import math
-import tomllib
 import warnings
 from pathlib import Path
 from typing import Any, Literal
@@ -41,6 +40,7 @@ from wovenimpact.spec.fields import (
     problems_from_validation,
     quantity,
     raise_problems,
+    read_toml,
 )
 
 WIDTH_TOLERANCE = 1e-3  # width may exceed the yarn pitch by 0.1 %: rounding of printed tables
@@ -181,15 +181,7 @@ def load_material(path: str | Path) -> FabricParameters | MetalParameters:
         InputError: unreadable file, invalid TOML, or any invalid entry (all listed).
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as err:
-        raise InputError(f"{path}: cannot read the material file ({err.strerror})") from None
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise InputError(f"{path}: not valid TOML: {err}") from None
-    return material_from_dict(doc, source=str(path))
+    return material_from_dict(read_toml(path, "material file"), source=str(path))
 
 
 def material_from_dict(

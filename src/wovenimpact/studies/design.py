@@ -11,12 +11,13 @@ Each round runs its candidates in parallel (local processes). An ``undecided`` r
 from __future__ import annotations
 
 import copy
-import tomllib
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from wovenimpact.errors import InputError
+from wovenimpact.kernels.shell_layout import C_AREAL_MASS
+from wovenimpact.spec.fields import read_toml
 from wovenimpact.units import to_si
 
 MAX_PLIES = 64
@@ -88,10 +89,7 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
                  start: int | None = None) -> dict:
     """Fewest plies that stop the impactor of a plate-impact case; runs in out_dir/plies_N."""
     path = Path(case_path)
-    try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
-    except (OSError, tomllib.TOMLDecodeError) as err:
-        raise InputError(f"{path}: cannot read the case ({err})") from None
+    doc = read_toml(path, "case file")
     base = str(path.resolve().parent)
     out = Path(out_dir)
     outcomes: dict[int, str] = {}
@@ -115,7 +113,7 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
 
     spec = case_from_dict(_case_with_plies(doc, plies), source=str(path))
     model = compile_case(spec, Path(base)).model
-    areal = float(model.sections[model.elem_section[0], 2])  # shell_layout.C_AREAL_MASS
+    areal = float(model.sections[model.elem_section[0], C_AREAL_MASS])
     side = spec.mesh.side
     return {
         "plies_to_stop": plies,

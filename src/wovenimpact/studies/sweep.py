@@ -29,7 +29,6 @@ import hashlib
 import io
 import itertools
 import json
-import tomllib
 import traceback
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
@@ -40,7 +39,7 @@ from pydantic import BaseModel, Field, ValidationError
 
 from wovenimpact.errors import InputError
 from wovenimpact.io.atomic import atomic_write_text
-from wovenimpact.spec.fields import STRICT, input_error, problems_from_validation
+from wovenimpact.spec.fields import STRICT, input_error, problems_from_validation, read_toml
 
 
 class StudyInfo(BaseModel):
@@ -104,21 +103,13 @@ def variant_id(values: dict) -> str:
 def load_study(path: str | Path) -> tuple[StudyInfo, list[Variant], Path]:
     """Read a study file; returns its header, its variants and the base case's directory."""
     path = Path(path)
-    try:
-        doc = tomllib.loads(path.read_text(encoding="utf-8"))
-    except OSError as err:
-        raise InputError(f"{path}: cannot read the study file ({err.strerror})") from None
-    except tomllib.TOMLDecodeError as err:
-        raise InputError(f"{path}: not valid TOML: {err}") from None
+    doc = read_toml(path, "study file")
     try:
         spec = StudyFile.model_validate(doc)
     except ValidationError as err:
         raise input_error(problems_from_validation(err, StudyFile), str(path)) from None
     case_path = (path.parent / spec.study.case).resolve()
-    try:
-        base_doc = tomllib.loads(case_path.read_text(encoding="utf-8"))
-    except OSError as err:
-        raise InputError(f"study.case: cannot read {case_path} ({err.strerror})") from None
+    base_doc = read_toml(case_path, "case file named by study.case")
     keys = list(spec.parameters)
     columns = [spec.parameters[k] for k in keys]
     if spec.study.combine == "zip":

@@ -35,13 +35,18 @@ the user set wins: a layer in ``NUMBA_THREADING_LAYER``, a wait policy in
 ``OMP_WAIT_POLICY``, ``GOMP_SPINCOUNT`` or ``KMP_BLOCKTIME``. The thread count is the
 user's (``NUMBA_NUM_THREADS`` or :func:`set_threads`). ``WOVENIMPACT_SERIAL=1``
 compiles loop kernels without ``parallel`` (debugging, profiling).
+
+Cache: compiled kernels go to ``~/.cache/wovenimpact/numba/<digest of the kernel
+sources>`` (``NUMBA_CACHE_DIR`` overrides), so editing any kernel invalidates them all.
 """
 
 from __future__ import annotations
 
 import ctypes
+import hashlib
 import os
 import sys
+from pathlib import Path
 
 import numba
 
@@ -66,6 +71,27 @@ if "NUMBA_THREADING_LAYER" not in os.environ:
 if not any(k in os.environ for k in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT", "KMP_BLOCKTIME")):
     os.environ["OMP_WAIT_POLICY"] = "passive"  # idle OpenMP workers sleep at once
     os.environ["KMP_BLOCKTIME"] = "0"  # the same for Intel's runtime
+
+def _kernel_source_digest() -> str:
+    """SHA-256 (16 hex digits) of every kernel module's source.
+
+    Numba's on-disk cache is keyed on each function's own file: a kernel that inlines a
+    function from another module (shell_force → fabric_point) keeps running the old
+    callee after that module changes. Keying the cache directory on all kernel sources
+    makes any kernel edit recompile everything once.
+    """
+    h = hashlib.sha256()
+    for f in sorted((Path(__file__).parent / "kernels").glob("*.py")):
+        h.update(f.name.encode() + f.read_bytes())
+    h.update(Path(__file__).read_bytes())
+    return h.hexdigest()[:16]
+
+
+if "NUMBA_CACHE_DIR" not in os.environ:
+    numba.config.CACHE_DIR = str(
+        Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
+        / "wovenimpact" / "numba" / _kernel_source_digest()
+    )
 
 JIT_FLAGS = dict(cache=True, fastmath=False, error_model="numpy", nogil=True)
 PARALLEL = os.environ.get("WOVENIMPACT_SERIAL", "0") not in ("1", "true", "yes")

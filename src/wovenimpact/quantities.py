@@ -14,6 +14,7 @@ from wovenimpact.kernels import shell_layout as S
 
 QUIET_TIME = 10e-6  # contact must have been light this long to call a perforation
 LIGHT_CONTACT = 0.01  # "light": below this fraction of the peak contact force
+STEADY_VELOCITY = 1e-3  # or the velocity changed by less than this fraction over it
 
 
 def symmetry_factor(model) -> float:
@@ -47,8 +48,9 @@ def residual_velocity(h: dict, quiet_time: float = QUIET_TIME) -> dict:
 
     - stopped: the impactor's velocity along its travel reached zero; residual 0, and
       the speed it bounced back with is reported as ``rebound_velocity_m_per_s``;
-    - perforated: still moving forward, and the contact force has stayed below 1 % of
-      its peak for the last ``quiet_time`` (torn yarns may still rub the shank);
+    - perforated: still moving forward, and for the last ``quiet_time`` the contact force
+      has stayed below 1 % of its peak or the velocity has changed by less than 0.1 %
+      (torn yarns may still rub the shank; debris may strike it from behind);
       residual = its final velocity;
     - undecided: still moving forward and still (or recently) in contact: run longer;
     - no contact: the impactor never touched anything (e.g. through a hole).
@@ -64,10 +66,17 @@ def residual_velocity(h: dict, quiet_time: float = QUIET_TIME) -> dict:
     if not touching.size:
         return {"outcome": "no contact", "perforated": True, "residual_velocity_m_per_s": v_end,
                 "rebound_velocity_m_per_s": 0.0}
-    # rubbing of torn yarns on the shank is not an engagement: below 1 % of the peak
-    engaged = np.flatnonzero(np.abs(f) > LIGHT_CONTACT * np.max(np.abs(f)))
+    # rubbing of torn yarns on the shank is not an engagement: below 1 % of the peak,
+    # or too little to change the velocity (by 0.1 %) over the quiet time; nor is debris
+    # striking it from behind (a force along the travel, f < 0)
+    engaged = np.flatnonzero(f > LIGHT_CONTACT * np.max(np.abs(f)))
+    if not engaged.size:
+        engaged = touching
     quiet = t[-1] - t[engaged[-1]]
-    if quiet >= quiet_time:
+    window = t >= t[-1] - quiet_time
+    steady = (t[-1] - t[0] >= quiet_time
+              and np.ptp(v[window]) <= STEADY_VELOCITY * abs(v_end))
+    if quiet >= quiet_time or steady:
         return {"outcome": "perforated", "perforated": True, "residual_velocity_m_per_s": v_end,
                 "rebound_velocity_m_per_s": 0.0}
     return {"outcome": "undecided (still in contact: run longer)", "perforated": False,

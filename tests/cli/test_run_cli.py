@@ -271,7 +271,7 @@ def test_design_plies_finds_the_pack_that_stops_the_impactor(tmp_path):
                         'radius = "1.5 mm"\n', "").replace(
         'section = "fabric"', 'section = "fabric"\nplies = 1\nspacing = "0.4992 mm"') + (
         IMPACTOR.replace("{z}", "0.4 mm").replace('"120 m/s"', '"60 m/s"'))
-    case = write_case(tmp_path, text=text, end="150 us")
+    case = write_case(tmp_path, text=text, end="300 us")
     result = CliRunner().invoke(app, ["design", "plies", str(case), "--out", str(tmp_path / "d"),
                                       "--json"])
     assert result.exit_code == 0, result.output

@@ -201,8 +201,10 @@ def test_height_solver_converges_with_small_residuals(lam_w, lam_f, gamma, scale
 
     fw, ff, tw, tf = forces(q(hw), q(hf))
     fc = max(fw, ff)
-    # absolute floor: the force of a yarn stretched by a few ulps of the heights (≈ 1e-11 N)
-    floor = 4 * float(max(k_w, k_f)) * np.spacing(s_total)
+    # absolute floor: the force of a yarn stretched by a few ulps of its length, the
+    # round-off of L − L0 in the kernel's double precision (≈ 1e-11 N; ulps of the
+    # heights, which are shorter, missed a falsifying case: T = 3.5e-12 N vs 0)
+    floor = 4 * float(max(k_w, k_f)) * np.spacing(float(max(lt0_w, lt0_f)))
     if fc > floor:  # yarns in contact (not both slack)
         RESIDUALS.append(float(abs(fw - ff) / fc))
     assert abs(fw - ff) <= RESIDUAL_TOL * fc + floor, "equilibrium residual"

@@ -255,3 +255,28 @@ def contact_masks(elem_alive, elem_part, node_active, node_part, seg_on, node_on
         seg_on[e] = 1 if (elem_alive[e] != 0 and elem_part[e] != 0) else 0
     for n in prange(node_on.shape[0]):
         node_on[n] = 1 if (node_active[n] != 0 and node_part[n] != 0) else 0
+
+
+@kernel
+def candidates_still_valid(x, x_search, node_on, node_on_search, seg_on, seg_on_search,
+                           skin):
+    """Whether the candidates of a search at x_search with margin m + skin still hold
+    every pair of a search at x with margin m (Verlet-list reuse).
+
+    A segment's box moves by at most d = max over the nodes and axes of
+    |x − x_search|, a node by at most d, so a pair inside the inflated box now was
+    inside it, inflated by 2d more, at the search: valid while 2d ≤ skin. The masks
+    must also be unchanged (an eroded segment or a deactivated node leaves the lists).
+    Serial with an early exit: one pass over the nodes at most.
+    """
+    for e in range(seg_on.shape[0]):
+        if seg_on[e] != seg_on_search[e]:
+            return False
+    half = 0.5 * skin
+    for p in range(x.shape[0]):
+        if node_on[p] != node_on_search[p]:
+            return False
+        for d in range(3):
+            if abs(x[p, d] - x_search[p, d]) > half:
+                return False
+    return True

@@ -162,19 +162,40 @@ def shape_functions(xi, eta):
 
 
 @kernel
-def evaluate_node_pairs(p, x, quads, ply, pair_ptr, pair_seg, geo, keep):
+def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, pair_ptr, pair_seg, geo,
+                        keep):
     """Project node p on each of its candidate segments and keep the closest per group.
 
     Writes, for k in pair_ptr[p] … pair_ptr[p + 1] − 1: geo[k] = (ξ, η, d, n_x, n_y,
     n_z, side) with d = |p − x_c|, n the unit contact normal pointing from the
     segment to the node, side = ±1 the node's side of the surface normal; keep[k] = 1
     for the closest candidate of each (ply, side) group, else 0.
+
+    A candidate whose node is outside the segment's box inflated by h_p + h_s +
+    margin at x (the broad phase's test, contact_broad) is passed over (keep 0, side
+    0, d = ∞): a fresh search at x would not have listed it, so candidates kept from
+    an earlier search with a skin (ShellContact) give the same result.
     """
     px, py, pz = x[p, 0], x[p, 1], x[p, 2]
     k0, k1 = pair_ptr[p], pair_ptr[p + 1]
     for k in range(k0, k1):
+        s = pair_seg[k]
+        r = h_node[p] + h_seg[s] + margin
+        q0, q1, q2, q3 = quads[s, 0], quads[s, 1], quads[s, 2], quads[s, 3]
+        outside = False
+        for d in range(3):
+            c = x[p, d]
+            if (c < min(x[q0, d], x[q1, d], x[q2, d], x[q3, d]) - r
+                    or c > max(x[q0, d], x[q1, d], x[q2, d], x[q3, d]) + r):
+                outside = True
+                break
+        if outside:
+            geo[k, GEO_DIST] = math.inf
+            geo[k, GEO_SIDE] = 0.0
+            keep[k] = 0
+            continue
         xi, eta, ox, oy, oz, sx, sy, sz, inside = closest_point_on_quad(
-            px, py, pz, x, quads, pair_seg[k])
+            px, py, pz, x, quads, s)
         rx, ry, rz = px - ox, py - oy, pz - oz
         dn = rx * sx + ry * sy + rz * sz
         side = 1.0 if dn >= 0.0 else -1.0
@@ -192,6 +213,8 @@ def evaluate_node_pairs(p, x, quads, ply, pair_ptr, pair_seg, geo, keep):
         geo[k, GEO_N + 2] = nz
         geo[k, GEO_SIDE] = side
     for k in range(k0, k1):
+        if geo[k, GEO_SIDE] == 0.0:
+            continue
         sk = pair_seg[k]
         best = True
         for j in range(k0, k1):
@@ -207,7 +230,7 @@ def evaluate_node_pairs(p, x, quads, ply, pair_ptr, pair_seg, geo, keep):
 
 @loop_kernel
 def penalty_forces(
-    x, v, quads, ply, node_mass, h_node, h_seg, overlap, beta, mu, dt,
+    x, v, quads, ply, node_mass, h_node, h_seg, margin, overlap, beta, mu, dt,
     pair_ptr, pair_seg, geo, pair_on, pair_f, pair_w, pair_e, node_f,
 ):
     """Penalty (and friction) force of every candidate pair (module docstring).
@@ -215,7 +238,8 @@ def penalty_forces(
     Args:
         x, v: (n_nodes, 3) positions x^n and velocities (v^{n−1/2} in the solver).
         quads, ply: segments and their plies; node_mass: (n_nodes,) lumped masses.
-        h_node, h_seg: node and segment offsets (m); overlap: (n_nodes,) o_p (m).
+        h_node, h_seg: node and segment offsets (m); margin: the search margin m (m);
+        overlap: (n_nodes,) o_p (m).
         beta: penalty scale β; mu: friction coefficient μ (0: frictionless).
         dt: the time step the forces are for (s), > 0.
         pair_ptr, pair_seg: candidates (contact_broad.find_candidates).
@@ -231,7 +255,8 @@ def penalty_forces(
         fx = fy = fz = 0.0
         k0, k1 = pair_ptr[p], pair_ptr[p + 1]
         if k1 > k0:
-            evaluate_node_pairs(p, x, quads, ply, pair_ptr, pair_seg, geo, pair_on)
+            evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, pair_ptr, pair_seg,
+                                geo, pair_on)
         for k in range(k0, k1):
             pair_f[k, 0] = pair_f[k, 1] = pair_f[k, 2] = 0.0
             pair_e[k] = 0.0
@@ -280,7 +305,8 @@ def penalty_forces(
 
 
 @loop_kernel
-def initial_overlap(x, quads, ply, h_node, h_seg, pair_ptr, pair_seg, geo, keep, overlap):
+def initial_overlap(x, quads, ply, h_node, h_seg, margin, pair_ptr, pair_seg, geo, keep,
+                    overlap):
     """Initial-overlap allowance o_p = max(0, max over kept pairs of h_p + h_s − d).
 
     With it the gap g = d − (h_p + h_s − o_p) of every kept pair is ≥ 0 in the
@@ -289,7 +315,8 @@ def initial_overlap(x, quads, ply, h_node, h_seg, pair_ptr, pair_seg, geo, keep,
     run (the plies then contact at their nested distance again after separating).
 
     Args:
-        x: (n_nodes, 3) initial positions; pair_ptr, pair_seg: candidates at x.
+        x: (n_nodes, 3) initial positions; margin: the search margin (m);
+        pair_ptr, pair_seg: candidates at x.
         geo, keep: scratch as in ``penalty_forces``.
         overlap: (n_nodes,) written (m).
     """
@@ -297,7 +324,8 @@ def initial_overlap(x, quads, ply, h_node, h_seg, pair_ptr, pair_seg, geo, keep,
         o = 0.0
         k0, k1 = pair_ptr[p], pair_ptr[p + 1]
         if k1 > k0:
-            evaluate_node_pairs(p, x, quads, ply, pair_ptr, pair_seg, geo, keep)
+            evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, pair_ptr, pair_seg,
+                                geo, keep)
             for k in range(k0, k1):
                 if keep[k] != 0:
                     o = max(o, h_node[p] + h_seg[pair_seg[k]] - geo[k, GEO_DIST])

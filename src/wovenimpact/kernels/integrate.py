@@ -41,6 +41,20 @@ def smooth_step(t, ramp_time):
     return xi * xi * xi * (10.0 - 15.0 * xi + 6.0 * xi * xi)
 
 
+@kernel
+def force_pair_power(f_old, f_new, v):
+    """Σ_a ½ (f_a^{n−1} + f_a^n) · v_a: the trapezoid-rule power of a nodal force over a
+    step, times Δt its work (serial sum, deterministic). A kernel rather than
+    ``np.vdot``: on arrays of more than 10 000 entries OpenBLAS hands vdot to its
+    threads, which then spin between steps and take a core from the element loops
+    (measured: 4 plies at 120 m/s, 56.6 s → 32.9 s wall on 2 cores)."""
+    s = 0.0
+    for a in range(v.shape[0]):
+        for j in range(3):
+            s += (f_old[a, j] + f_new[a, j]) * v[a, j]
+    return 0.5 * s
+
+
 @inline_kernel
 def update_node(
     n, mass, inertia, bc_code, bc_velocity, body_accel, f_con, amplitude, dt_old, dt_mid,

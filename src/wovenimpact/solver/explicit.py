@@ -30,7 +30,7 @@ import numpy as np
 from wovenimpact.errors import SimulationError
 from wovenimpact.kernels import shell_layout as S
 from wovenimpact.kernels.gather import gather_nodal_forces
-from wovenimpact.kernels.integrate import gather_and_update, smooth_step
+from wovenimpact.kernels.integrate import force_pair_power, gather_and_update, smooth_step
 from wovenimpact.solver.contact_stage import ContactBuffers, advance_bodies, contact_forces
 from wovenimpact.kernels.shell import internal_force_for_shells
 from wovenimpact.state import (
@@ -164,8 +164,7 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     # the velocities move on
     w_con_nodes = 0.0
     if resultants or cb.shells is not None:
-        # vdot flattens views: no temporary array in the step
-        w_con_nodes = 0.5 * (np.vdot(state.f_contact, state.v) + np.vdot(cb.f_con, state.v)) * state.dt
+        w_con_nodes = force_pair_power(state.f_contact, cb.f_con, state.v) * state.dt
     t0 = ws.tick("contact", t0)
     amplitude = smooth_step(state.t + 0.5 * dt_new, model.ramp_time)
     n_bad = gather_and_update(

@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import copy
 from collections.abc import Callable
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from wovenimpact.errors import InputError
+from wovenimpact.jit import process_pool
 from wovenimpact.kernels.shell_layout import C_AREAL_MASS
 from wovenimpact.spec.fields import read_toml
 from wovenimpact.units import to_si
@@ -96,7 +96,7 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
 
     def stops(batch: list[int]) -> dict[int, bool]:
         docs = [_case_with_plies(doc, n) for n in batch]
-        with ProcessPoolExecutor(max_workers=max(1, min(workers, len(batch)))) as pool:
+        with process_pool(min(workers, len(batch)), threads=1) as pool:
             results = list(pool.map(_run_one, docs, [base] * len(batch),
                                     [str(out / f"plies_{n}") for n in batch]))
         for n, r in zip(batch, results):

@@ -30,7 +30,6 @@ import io
 import itertools
 import json
 import traceback
-from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -38,6 +37,7 @@ from typing import Any, Literal
 from pydantic import BaseModel, Field, ValidationError
 
 from wovenimpact.errors import InputError
+from wovenimpact.jit import process_pool
 from wovenimpact.io.atomic import atomic_write_text
 from wovenimpact.spec.fields import STRICT, input_error, problems_from_validation, read_toml
 
@@ -191,7 +191,7 @@ def run_study(
             for v, res in zip(todo, client.gather(futures)):
                 results[v.id] = res
     elif todo:
-        with ProcessPoolExecutor(max_workers=max(1, workers)) as pool:
+        with process_pool(workers, threads_per_run) as pool:
             for v, res in zip(todo, pool.map(run_variant, *zip(*args))):
                 results[v.id] = res
     rows = []

@@ -9,6 +9,7 @@ and nothing here is tuned to them.
 
 from __future__ import annotations
 
+import copy
 import json
 import shutil
 from datetime import date
@@ -16,6 +17,7 @@ from pathlib import Path
 
 from wovenimpact.errors import InputError
 from wovenimpact.io.atomic import atomic_write_text
+from wovenimpact.spec.fields import read_toml
 
 ROOT = Path(__file__).resolve().parents[3]
 CASES = ("plies1_100", "plies2_100", "plies4_100", "plies6_100", "plies4_120")
@@ -23,7 +25,7 @@ THESIS_RESIDUAL = {"plies1_100": "82–85", "plies2_100": "58", "plies4_100": "1
                    "plies6_100": "0 (stopped)", "plies4_120": "— (ELVS data, not in text)"}
 STUDIES = ("thesis_velocity", "thesis_plies", "thesis_plate_size", "thesis_crimp",
            "thesis_compaction", "thesis_element_size", "thesis_velocity_v50",
-           "thesis_velocity_v50_2plies")
+           "thesis_velocity_v50_2plies", "hourglass")
 THESIS_STUDY_NOTE = {
     "thesis_velocity": "thesis: 75 / 100 / 125 m/s lose 20 / 15 / 10 m/s on one ply",
     "thesis_plies": "thesis: 1, 2, 4 plies → 82, 58, 18 m/s; 6 plies stop it",
@@ -33,7 +35,100 @@ THESIS_STUDY_NOTE = {
     "thesis_element_size": "thesis: larger elements can be used without loss of accuracy",
     "thesis_velocity_v50": "no thesis figure: V50 of one ply (Lambert–Jonas)",
     "thesis_velocity_v50_2plies": "no thesis figure: V50 of two plies (Lambert–Jonas)",
+    "hourglass": "not in the thesis: sensitivity of the flagship case to the hourglass "
+                 "coefficient r of the one-point shell",
 }
+
+
+# Acceptance of issue 4: the flagship case, and a perforating one, on the 0.94 mm quarter
+# model (reference), the 0.47 mm quarter model and the 0.94 mm full plate.
+CONVERGENCE = (("plies4_120", {}), ("plies2_100", {"impactor.velocity": "250 m/s"}))
+CONVERGENCE_VARIANTS = (("0.94 mm, quarter", "0.94 mm", True),
+                        ("0.47 mm, quarter", "0.47 mm", True),
+                        ("0.94 mm, full plate", "0.94 mm", False))
+
+
+def full_plate(doc: dict) -> dict:
+    """The full-plate version of a quarter-model plate case document: the whole plate,
+    no symmetry conditions (a new document; ``doc`` is not changed)."""
+    doc = copy.deepcopy(doc)
+    doc["mesh"]["quarter"] = False
+    doc["boundary"] = [b for b in doc.get("boundary", [])
+                       if b.get("type") not in ("symmetry_x", "symmetry_y")]
+    return doc
+
+
+def convergence_runs(work: Path, threads: int) -> list[dict]:
+    """Run (or reuse) every CONVERGENCE case in every CONVERGENCE_VARIANTS form; rows with
+    the variant label, the case's summary and the change from the reference form."""
+    from wovenimpact.studies.sweep import finished, run_variant, set_dotted, variant_id
+
+    rows = []
+    for name, changes in CONVERGENCE:
+        path = ROOT / "examples" / "plate_impact" / f"{name}.toml"
+        base_doc = read_toml(path, "case file")
+        for key, value in changes.items():
+            set_dotted(base_doc, key, value)
+        reference = None
+        for label, size, quarter in CONVERGENCE_VARIANTS:
+            doc = copy.deepcopy(base_doc)
+            set_dotted(doc, "mesh.element_size", size)
+            if not quarter:
+                doc = full_plate(doc)
+            values = {"case": name, **changes, "mesh.element_size": size, "quarter": quarter}
+            out = work / "convergence" / variant_id(values)
+            result = finished(out, values) or run_variant(doc, str(path.parent), str(out),
+                                                         values, threads=threads)
+            if result["status"] != "done":
+                raise InputError(f"convergence run {name} ({label}) failed: {result['error']}")
+            reference = reference or result
+            rows.append({"case": name, "changes": changes, "variant": label, **result,
+                         "delta_residual": result["residual_velocity_m_per_s"]
+                         - reference["residual_velocity_m_per_s"],
+                         "delta_rebound": result["rebound_velocity_m_per_s"]
+                         - reference["rebound_velocity_m_per_s"],
+                         "delta_absorbed": result["absorbed_energy_J"]
+                         / reference["absorbed_energy_J"] - 1.0})
+    return rows
+
+
+def convergence_lines(rows: list[dict]) -> list[str]:
+    """The Markdown table of :func:`convergence_runs`."""
+    lines = ["## Mesh and symmetry convergence", "",
+             "Acceptance (issue 4): residual velocity within 5 % or 2 m/s between the 0.94 mm "
+             "and 0.47 mm meshes; quarter and full-plate models within 2 %. Δ is against the "
+             "0.94 mm quarter model.", "",
+             "| case | model | outcome | residual (m/s) | Δ residual | rebound (m/s) | "
+             "Δ rebound | absorbed (J) | Δ absorbed | energy error | wall (s) |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        what = r["case"] + "".join(f", {v}" for v in r["changes"].values())
+        lines.append(
+            f"| {what} | {r['variant']} | {r['outcome']} | "
+            f"{r['residual_velocity_m_per_s']:.2f} | {r['delta_residual']:+.2f} | "
+            f"{r['rebound_velocity_m_per_s']:.2f} | {r['delta_rebound']:+.2f} | "
+            f"{r['absorbed_energy_J']:.3f} | {r['delta_absorbed']:+.1%} | "
+            f"{r['energy_error_fraction']:.1e} | {r['wall_time_s']:.0f} |")
+    return lines + [""]
+
+
+def spread_line(rows: list[dict]) -> str:
+    """One sentence: how far the ballistic answer and the hourglass share move across a
+    study's runs."""
+    done = [r for r in rows if r["status"] == "done"]
+    if not done:
+        return "No run of this study finished."
+
+    def span(key, scale=1.0):
+        vals = [float(r[key]) * scale for r in done]
+        return min(vals), max(vals)
+
+    share = [float(r["hourglass_energy_J"]) / max(float(r["internal_work_J"]), 1e-300)
+             for r in done]
+    rb, ab = span("rebound_velocity_m_per_s"), span("absorbed_energy_J")
+    return (f"Across the {len(done)} runs the rebound velocity spans {rb[0]:.2f}–{rb[1]:.2f} "
+            f"m/s and the absorbed energy {ab[0]:.3f}–{ab[1]:.3f} J, while the hourglass "
+            f"share of the internal work goes from {min(share):.0%} to {max(share):.0%}.")
 
 
 def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "validation.md",
@@ -76,6 +171,7 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
             if (out / "plots" / plot).exists():
                 shutil.copy(out / "plots" / plot, figures / f"{name}_{plot}")
     lines += ["", f"![4 plies at 120 m/s](validation/plies4_120_impactor.png)", ""]
+    lines += convergence_lines(convergence_runs(work, threads=workers))
     for study in studies:
         path = ROOT / "examples" / "studies" / f"{study}.toml"
         if not path.exists():
@@ -101,6 +197,8 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
                           "slowest perforating run."]
             except InputError as err:
                 lines += ["", f"Lambert–Jonas fit not possible: {err}"]
+        if study == "hourglass":
+            lines += ["", spread_line(rows)]
         for png in sorted((work / "studies" / study / "plots").glob("*.png")):
             target = figures / f"{study}_{png.name}"
             shutil.copy(png, target)

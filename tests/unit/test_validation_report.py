@@ -1,0 +1,52 @@
+"""The pieces of docs/validation.md that judge acceptance: full-plate cases, the
+convergence verdicts and the hourglass spread (synthetic summaries, no runs)."""
+
+from wovenimpact.spec.case import case_from_dict
+from wovenimpact.spec.fields import read_toml
+from wovenimpact.studies.validation import ROOT, commentary, full_plate, spread_line
+
+
+def test_full_plate_drops_only_the_symmetry_conditions_and_validates():
+    path = ROOT / "examples" / "plate_impact" / "plies4_120.toml"
+    doc = read_toml(path, "case file")
+    full = full_plate(doc)
+    assert doc["mesh"]["quarter"] is True  # the input is not changed
+    assert full["mesh"]["quarter"] is False
+    assert [b["type"] for b in full["boundary"]] == ["clamped"]
+    spec = case_from_dict(full, source="full plate")
+    assert spec.mesh.quarter is False
+
+
+def _row(variant, residual, rebound, delta_residual=0.0, delta_rebound=0.0):
+    return {"case": "c", "changes": {}, "variant": variant, "outcome": "x",
+            "residual_velocity_m_per_s": residual, "rebound_velocity_m_per_s": rebound,
+            "delta_residual": delta_residual, "delta_rebound": delta_rebound}
+
+
+CASES = {"plies1_100": {"outcome": "stopped", "perforated": False,
+                        "initial_kinetic_energy_J": 5.5}}
+
+
+def test_convergence_verdicts_follow_the_acceptance_limits():
+    # perforating: 100 m/s residual; mesh moves 4.9 (within 5 %), symmetry 2.1 (outside 2 %)
+    rows = [_row("ref", 100.0, 0.0), _row("fine", 104.9, 0.0, 4.9),
+            _row("full", 97.9, 0.0, -2.1)]
+    text = commentary(CASES, rows)[1]
+    assert "residual velocity (100.00 m/s) moves by 4.90 m/s" in text
+    assert "(within 5 % or 2 m/s)" in text and "(outside 2 %)" in text
+    # stopped: the rebound is judged; 10 m/s rebound, mesh 2.5 m/s > max(0.5, 2)
+    rows = [_row("ref", 0.0, 10.0), _row("fine", 0.0, 12.5, 0.0, 2.5),
+            _row("full", 0.0, 10.1, 0.0, 0.1)]
+    text = commentary(CASES, rows)[1]
+    assert "rebound velocity (10.00 m/s) moves by 2.50 m/s" in text
+    assert "(outside 5 % or 2 m/s)" in text and "(within 2 %)" in text
+
+
+def test_spread_line_reports_the_extremes():
+    rows = [{"status": "done", "rebound_velocity_m_per_s": v, "absorbed_energy_J": e,
+             "hourglass_energy_J": h, "internal_work_J": 4.0}
+            for v, e, h in ((23.0, 7.6, 1.0), (24.5, 7.5, 2.0))]
+    rows.append({"status": "failed"})
+    line = spread_line(rows)
+    assert "2 runs" in line and "23.00–24.50 m/s" in line and "7.500–7.600 J" in line
+    assert "from 25% to 50%" in line

@@ -105,6 +105,7 @@ def run_case(
     threads: int | None = None,
     progress: Callable[[State, float], None] | None = None,
     max_steps: int | None = None,
+    overrides=(),
 ) -> dict:
     """Run a case file and write its outputs; returns the summary (also in summary.json).
 
@@ -116,8 +117,9 @@ def run_case(
         progress: called as ``progress(state, end_time)`` about every 0.2 s of wall time.
         max_steps: stop after this many steps of this invocation without final outputs
             (as a crash would; used to test restarts).
+        overrides: ``KEY=VALUE`` changes to the case (``--set``; spec.fields.parse_override).
     """
-    spec, base = load_case(case_path)
+    spec, base = load_case(case_path, overrides)
     return run_spec(spec, base, out_dir, restart=restart, threads=threads, progress=progress,
                     max_steps=max_steps)
 

@@ -281,3 +281,29 @@ def test_design_plies_finds_the_pack_that_stops_the_impactor(tmp_path):
     assert n == 1 or answer["runs"][str(n - 1)] == "perforated"
     assert answer["areal_mass_kg_per_m2"] == pytest.approx(n * 0.4775, rel=1e-3)
     print(f"\ndesign search: {n} plies stop it; runs {answer['runs']}")
+
+
+def test_set_overrides_change_the_case_and_bad_ones_are_named(tmp_path):
+    """--set KEY=VALUE (TOML value or plain text) changes the run; a key the case lacks
+    or a value out of range is an input error naming it."""
+    case = write_case(tmp_path, end="20 us")
+    out = tmp_path / "o"
+    result = CliRunner().invoke(app, [
+        "run", str(case), "--out", str(out), "--json", "--set", "run.end_time=6 us",
+        "--set", 'initial_velocity.0.velocity=["0 m/s", "0 m/s", "-30 m/s"]'])
+    assert result.exit_code == 0, result.output
+    summary = json.loads(result.stdout)
+    assert 6e-6 <= summary["end_time_s"] < 6e-6 + 2 * summary["first_time_step_s"]
+    base = tmp_path / "b"
+    run_case(case, base, overrides=["run.end_time=6 us"])
+
+    def ke0(d):
+        rows = (d / "history.csv").read_text().splitlines()
+        return float(rows[1].split(",")[rows[0].split(",").index("kinetic_energy_J")])
+
+    assert ke0(out) == pytest.approx(ke0(base) / 4.0, rel=1e-12)  # half the speed
+    for bad, words in (("impactor.velocity=100 m/s", "has no 'impactor'"),
+                       ("run.end_time=-1 us", "run.end_time"),
+                       ("run.end_time", "expected KEY=VALUE")):
+        result = CliRunner().invoke(app, ["run", str(case), "--out", str(out), "--set", bad])
+        assert result.exit_code == 2 and words in result.output, result.output

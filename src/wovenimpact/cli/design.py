@@ -15,11 +15,14 @@ app.add_typer(design_app, name="design")
 
 @design_app.command("plies")
 def plies(
-    case: Path = typer.Argument(..., help="Plate-impact case (mesh.kind = 'plate', [impactor])."),
+    case: Path = typer.Argument(..., help="Plate-impact case (a plate mesh and an impactor)."),
     out: Path = typer.Option(None, "--out", help="Where the runs go (default: out/design_<case>)."),
     workers: int = typer.Option(2, "--workers", min=1, help="Runs in parallel."),
     start: int = typer.Option(None, "--start", min=1, help="First ply count to try (default: the case's)."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
+    overrides: list[str] = typer.Option(
+        None, "--set", help="Change a case value: KEY=VALUE with a dotted key, e.g. "
+        "--set 'impactor.velocity=200 m/s' (repeatable)."),
 ) -> None:
     """Search the number of plies (doubling, then bisection) and print the answer with
     the areal mass of the pack."""
@@ -27,7 +30,7 @@ def plies(
 
     try:
         result = design_plies(case, out or Path("out") / f"design_{case.stem}", workers=workers,
-                              start=start)
+                              start=start, overrides=overrides or ())
     except InputError as err:
         fail(str(err))
     shown = dict(result)

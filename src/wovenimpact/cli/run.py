@@ -35,6 +35,9 @@ def run(
     restart: bool = typer.Option(False, "--restart", help="Resume from the last checkpoint in OUT."),
     threads: int = typer.Option(None, "--threads", min=1, help="Kernel threads (default: all)."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object (summary) on stdout."),
+    overrides: list[str] = typer.Option(
+        None, "--set", help="Change a case value: KEY=VALUE with a dotted key, e.g. "
+        "--set 'impactor.velocity=200 m/s' (repeatable)."),
 ) -> None:
     """Run CASE to its end time; write history.csv, summary.json, fields/, plots/, checkpoints/."""
     from wovenimpact.runs import run_case
@@ -58,7 +61,8 @@ def run(
                    eta=eta)
 
     try:
-        summary = run_case(case, out, restart=restart, threads=threads, progress=report)
+        summary = run_case(case, out, restart=restart, threads=threads, progress=report,
+                           overrides=overrides or ())
     except (InputError, MaterialPointError) as err:
         bar.stop()
         fail(str(err))

@@ -47,6 +47,7 @@ from wovenimpact.errors import InputError
 from wovenimpact.spec.fields import (
     STRICT,
     Problem,
+    apply_overrides,
     input_error,
     problems_from_validation,
     quantity,
@@ -286,9 +287,11 @@ def case_from_dict(doc: dict[str, Any], source: str = "<dict>") -> CaseSpec:
     return spec
 
 
-def load_case(path: str | Path) -> tuple[CaseSpec, Path]:
-    """Read and validate a case file; returns the spec and the file's directory
-    (material and mesh paths in the case are relative to it)."""
+def load_case(path: str | Path, overrides=()) -> tuple[CaseSpec, Path]:
+    """Read and validate a case file, with the command line's ``KEY=VALUE`` overrides
+    (``--set``) applied first; returns the spec and the file's directory (material and
+    mesh paths in the case are relative to it)."""
     path = Path(path)
-    doc = read_toml(path, "case file")
-    return case_from_dict(doc, source=str(path)), path.resolve().parent
+    doc = apply_overrides(read_toml(path, "case file"), overrides)
+    source = str(path) + "".join(f" --set {o!r}" for o in overrides or ())
+    return case_from_dict(doc, source=source), path.resolve().parent

@@ -115,6 +115,57 @@ def read_toml(path, what: str) -> dict:
         raise InputError(f"{path}: not valid TOML: {err}") from None
 
 
+def set_dotted(doc: dict, key: str, value: Any, label: str = "parameters") -> None:
+    """doc["a"]["b"][0]["c"] = value for key "a.b.0.c" (list items by index). Missing
+    tables under a ``set`` table (material overrides) are created; elsewhere the key must
+    exist in the base case except for its last part (a new optional key). ``label``
+    names where the key came from in error messages (a study's ``parameters``,
+    ``--set``)."""
+    parts = key.split(".")
+    node: Any = doc
+    for i, part in enumerate(parts[:-1]):
+        overrides = "set" in parts[:i] or (part == "set" and parts[0] == "materials")
+        if isinstance(node, dict) and part not in node and overrides:
+            node[part] = {}
+        try:
+            node = node[int(part)] if isinstance(node, list) else node[part]
+        except (KeyError, IndexError, ValueError):
+            where = ".".join(parts[: i + 1])
+            raise InputError(f"{label} {key!r}: the base case has no {where!r}") from None
+    last = parts[-1]
+    if isinstance(node, list):
+        try:
+            node[int(last)] = value
+        except (IndexError, ValueError):
+            raise InputError(f"{label} {key!r}: no item {last!r} in that list") from None
+    elif isinstance(node, dict):
+        node[last] = value
+    else:
+        raise InputError(f"{label} {key!r}: {'.'.join(parts[:-1])!r} is not a table")
+
+
+def parse_override(text: str) -> tuple[str, Any]:
+    """``KEY=VALUE`` of a command line ``--set``: the dotted key and the value read as a
+    TOML value (``true``, ``3``, ``[0, 0, -1]``, ``"200 m/s"``), else as the plain text
+    (``200 m/s``)."""
+    key, sep, raw = text.partition("=")
+    key, raw = key.strip(), raw.strip()
+    if not sep or not key or not raw:
+        raise InputError(f"--set {text!r}: expected KEY=VALUE, e.g. impactor.velocity=200 m/s")
+    try:
+        return key, tomllib.loads(f"v = {raw}")["v"]
+    except tomllib.TOMLDecodeError:
+        return key, raw
+
+
+def apply_overrides(doc: dict, overrides) -> dict:
+    """``doc`` with each ``KEY=VALUE`` of ``overrides`` set (in place; returned)."""
+    for text in overrides or ():
+        key, value = parse_override(text)
+        set_dotted(doc, key, value, label="--set")
+    return doc
+
+
 def input_error(problems: list[Problem], source: str) -> InputError:
     """One InputError listing every problem, one per line."""
     return InputError("\n".join(p.text(source) for p in problems))

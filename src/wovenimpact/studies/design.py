@@ -17,7 +17,7 @@ from pathlib import Path
 from wovenimpact.errors import InputError
 from wovenimpact.jit import process_pool
 from wovenimpact.kernels.shell_layout import C_AREAL_MASS
-from wovenimpact.spec.fields import read_toml
+from wovenimpact.spec.fields import apply_overrides, read_toml
 from wovenimpact.units import to_si
 
 MAX_PLIES = 64
@@ -86,10 +86,11 @@ def _run_one(doc: dict, base: str, out: str) -> str:
 
 
 def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
-                 start: int | None = None) -> dict:
-    """Fewest plies that stop the impactor of a plate-impact case; runs in out_dir/plies_N."""
+                 start: int | None = None, overrides=()) -> dict:
+    """Fewest plies that stop the impactor of a plate-impact case (with the ``KEY=VALUE``
+    ``overrides`` of ``--set``); runs in out_dir/plies_N."""
     path = Path(case_path)
-    doc = read_toml(path, "case file")
+    doc = apply_overrides(read_toml(path, "case file"), overrides)
     base = str(path.resolve().parent)
     out = Path(out_dir)
     outcomes: dict[int, str] = {}

@@ -39,7 +39,13 @@ from pydantic import BaseModel, Field, ValidationError
 from wovenimpact.errors import InputError
 from wovenimpact.jit import process_pool
 from wovenimpact.io.atomic import atomic_write_text
-from wovenimpact.spec.fields import STRICT, input_error, problems_from_validation, read_toml
+from wovenimpact.spec.fields import (
+    STRICT,
+    input_error,
+    problems_from_validation,
+    read_toml,
+    set_dotted,
+)
 
 
 class StudyInfo(BaseModel):
@@ -65,33 +71,6 @@ class Variant:
     id: str
     values: dict[str, Any]
     document: dict = field(repr=False)
-
-
-def set_dotted(doc: dict, key: str, value: Any) -> None:
-    """doc["a"]["b"][0]["c"] = value for key "a.b.0.c" (list items by index). Missing
-    tables under a ``set`` table (material overrides) are created; elsewhere the key must
-    exist in the base case except for its last part (a new optional key)."""
-    parts = key.split(".")
-    node: Any = doc
-    for i, part in enumerate(parts[:-1]):
-        overrides = "set" in parts[:i] or (part == "set" and parts[0] == "materials")
-        if isinstance(node, dict) and part not in node and overrides:
-            node[part] = {}
-        try:
-            node = node[int(part)] if isinstance(node, list) else node[part]
-        except (KeyError, IndexError, ValueError):
-            where = ".".join(parts[: i + 1])
-            raise InputError(f"parameters.{key!r}: the base case has no {where!r}") from None
-    last = parts[-1]
-    if isinstance(node, list):
-        try:
-            node[int(last)] = value
-        except (IndexError, ValueError):
-            raise InputError(f"parameters.{key!r}: no item {last!r} in that list") from None
-    elif isinstance(node, dict):
-        node[last] = value
-    else:
-        raise InputError(f"parameters.{key!r}: {'.'.join(parts[:-1])!r} is not a table")
 
 
 def variant_id(values: dict) -> str:

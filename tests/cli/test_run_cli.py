@@ -307,3 +307,13 @@ def test_set_overrides_change_the_case_and_bad_ones_are_named(tmp_path):
                        ("run.end_time", "expected KEY=VALUE")):
         result = CliRunner().invoke(app, ["run", str(case), "--out", str(out), "--set", bad])
         assert result.exit_code == 2 and words in result.output, result.output
+
+
+def test_negative_impactor_speed_is_an_error_naming_the_key(tmp_path):
+    """The impactor's speed is a magnitude along ``direction``: a negative one is refused
+    (issue 4's bad-case list: unknown key, missing unit, negative velocity, overlap)."""
+    case = write_case(tmp_path, text=CASE + IMPACTOR.replace("{z}", "0.4 mm"))
+    result = CliRunner().invoke(app, ["run", str(case), "--out", str(tmp_path / "o"),
+                                      "--set", "impactor.velocity=-120 m/s"])
+    assert result.exit_code == 2
+    assert "impactor.velocity" in result.output and "must be > 0" in result.output

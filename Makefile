@@ -30,6 +30,7 @@ test: venv
 bench: venv
 	$(BIN)/python benchmarks/bench_fabric_kernel.py
 	$(BIN)/python benchmarks/bench_shell.py
+	$(BIN)/python benchmarks/bench_contact.py
 
 clean:
 	rm -rf out .pytest_cache

@@ -29,3 +29,13 @@ def test_search_finds_the_smallest_stopping_pack(threshold, start):
 def test_search_gives_up_past_the_limit():
     with pytest.raises(InputError, match="no pack"):
         search_plies(lambda batch: {n: False for n in batch}, max_plies=16)
+
+
+def test_a_larger_pack_that_perforates_is_reported():
+    """Near a ballistic limit the simulated outcome need not be monotonic (measured: 175
+    m/s FSP, 5 and 8 plies stopped it, 7 did not): the answer comes with a warning."""
+    from wovenimpact.studies.design import monotonic_warning
+
+    assert monotonic_warning(5, {1: False, 2: False, 4: False, 5: True, 8: True}) == ""
+    text = monotonic_warning(5, {1: False, 2: False, 4: False, 5: True, 7: False, 8: True})
+    assert text.startswith("7 plies did not stop the impactor although 5 did")

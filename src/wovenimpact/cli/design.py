@@ -6,7 +6,7 @@ from pathlib import Path
 
 import typer
 
-from wovenimpact.cli.app import app, emit, fail
+from wovenimpact.cli.app import app, emit, err_console, fail
 from wovenimpact.errors import InputError
 
 design_app = typer.Typer(help="Design searches by actual runs.", no_args_is_help=True)
@@ -36,4 +36,8 @@ def plies(
     shown = dict(result)
     if not as_json:
         shown["runs"] = ", ".join(f"{k}: {v}" for k, v in result["runs"].items())
+        if not shown["warning"]:
+            del shown["warning"]
     emit(shown, as_json, f"{case.name}: plies to stop the impactor")
+    if result["warning"] and not as_json:
+        err_console.print(f"[bold yellow]warning:[/] {result['warning']}")

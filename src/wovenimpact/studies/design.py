@@ -108,7 +108,7 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
         return {n: r == "stopped" for n, r in zip(batch, results)}
 
     n0 = int(doc.get("mesh", {}).get("plies", 1))
-    plies, _ = search_plies(stops, start=start or n0)
+    plies, seen = search_plies(stops, start=start or n0)
     from wovenimpact.model.compile import compile_case
     from wovenimpact.spec.case import case_from_dict
 
@@ -121,4 +121,17 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
         "areal_mass_kg_per_m2": plies * areal,
         "pack_mass_kg": plies * areal * side * side,
         "runs": {str(k): v for k, v in sorted(outcomes.items())},
+        "warning": monotonic_warning(plies, seen),
     }
+
+
+def monotonic_warning(plies: int, seen: dict[int, bool]) -> str:
+    """"" if every larger pack that ran stopped the impactor, else a warning naming the
+    packs that did not: the search assumes more plies never do worse, and near a
+    ballistic limit the simulated outcome need not be monotonic."""
+    worse = sorted(k for k, stopped in seen.items() if k > plies and not stopped)
+    if not worse:
+        return ""
+    return (f"{', '.join(map(str, worse))} plies did not stop the impactor although "
+            f"{plies} did: the outcome is not monotonic in the plies near this limit; "
+            "take a margin and run the packs around the answer")

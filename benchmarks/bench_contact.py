@@ -94,7 +94,7 @@ def main(argv: list[str]) -> None:
     if "json" in opts:
         print(json.dumps({"cases": cases}))
         return
-    print(f"threading layer: {numba.config.THREADING_LAYER}; best of 5 × {calls} calls")
+    print(f"threading layer: {numba.threading_layer()}; best of 5 × {calls} calls")
     print("ns per node and call: 'search' with a search every call, 'reuse' with the "
           "candidates of the skin kept, 'broad' the search with the skin alone")
     print(f"{'plies':>5} {'thr':>3} {'nodes':>7} {'pairs':>7} {'+skin':>7} {'active':>7} "

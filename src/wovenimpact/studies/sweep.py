@@ -19,6 +19,12 @@ key named, and the others still run), run in ``OUT/runs/<id>/`` and summarised i
 ``OUT/results.csv``. A variant whose ``summary.json`` exists with the same parameters
 is not run again (the study resumes). Runs go to a local process pool by default, or
 to a Dask cluster when a scheduler address is given.
+
+The local pool's workers are spawned (:func:`wovenimpact.jit.process_pool`), so a
+script that calls :func:`run_study` must guard its top level with
+``if __name__ == "__main__":`` (the workers import the main module). On a Dask
+cluster, start the workers with ``NUMBA_NUM_THREADS`` equal to the threads each run
+should use (one by default).
 """
 
 from __future__ import annotations

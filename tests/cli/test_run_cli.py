@@ -281,6 +281,13 @@ def test_design_plies_finds_the_pack_that_stops_the_impactor(tmp_path):
     assert n == 1 or answer["runs"][str(n - 1)] == "perforated"
     assert answer["areal_mass_kg_per_m2"] == pytest.approx(n * 0.4775, rel=1e-3)
     print(f"\ndesign search: {n} plies stop it; runs {answer['runs']}")
+    # a second search reads the finished runs back instead of running them again
+    summaries = sorted((tmp_path / "d").glob("plies_*/summary.json"))
+    stamps = [p.stat().st_mtime_ns for p in summaries]
+    again = CliRunner().invoke(app, ["design", "plies", str(case), "--out", str(tmp_path / "d"),
+                                     "--json"])
+    assert json.loads(again.stdout.strip().splitlines()[-1]) == answer
+    assert [p.stat().st_mtime_ns for p in summaries] == stamps
 
 
 def test_set_overrides_change_the_case_and_bad_ones_are_named(tmp_path):
@@ -317,3 +324,32 @@ def test_negative_impactor_speed_is_an_error_naming_the_key(tmp_path):
                                       "--set", "impactor.velocity=-120 m/s"])
     assert result.exit_code == 2
     assert "impactor.velocity" in result.output and "must be > 0" in result.output
+
+
+def test_design_run_interrupted_by_a_crash_resumes_from_its_checkpoint(tmp_path):
+    """A pack run cut short (checkpoints, no summary) is restarted, not redone: the
+    resumed run takes only the remaining steps and ends with the uninterrupted outcome."""
+    from wovenimpact.spec.fields import read_toml
+    from wovenimpact.studies.design import _case_with_plies, _run_one
+
+    text = CASE.replace('[[initial_velocity]]\nvelocity = ["0 m/s", "0 m/s", "-60 m/s"]\n'
+                        'radius = "1.5 mm"\n', "") + IMPACTOR.replace("{z}", "0.4 mm")
+    case = write_case(tmp_path, text=text, end="12 us")
+    doc = _case_with_plies(read_toml(case, "case file"), 1)
+    whole, cut = tmp_path / "whole", tmp_path / "cut"
+    assert _run_one(doc, str(tmp_path), str(whole)) == "undecided (still in contact: run longer)"
+    a = json.loads((whole / "summary.json").read_text())
+    full_steps = a["steps"]
+    # the crash: the same call, stopped after most of its steps (checkpoints every 4 µs)
+    (cut / "checkpoints").mkdir(parents=True)
+    (cut / "case.json").write_text(json.dumps(doc, sort_keys=True, default=str))
+    from wovenimpact.runs import run_spec
+    from wovenimpact.spec.case import case_from_dict
+
+    run_spec(case_from_dict(doc), tmp_path, cut, max_steps=int(0.8 * full_steps))
+    assert not (cut / "summary.json").exists() and latest_checkpoint(cut / "checkpoints")
+    assert _run_one(doc, str(tmp_path), str(cut)) == "undecided (still in contact: run longer)"
+    resumed = json.loads((cut / "summary.json").read_text())
+    assert resumed["steps"] == full_steps  # same end, restart bitwise (tested above)
+    assert 0 < resumed["element_cycles"] < 0.5 * a["element_cycles"]  # only the rest ran
+    assert resumed["residual_velocity_m_per_s"] == a["residual_velocity_m_per_s"]

@@ -11,6 +11,7 @@ Each round runs its candidates in parallel (local processes). An ``undecided`` r
 from __future__ import annotations
 
 import copy
+import json
 from collections.abc import Callable
 from pathlib import Path
 
@@ -78,10 +79,24 @@ def _case_with_plies(doc: dict, n: int) -> dict:
 
 
 def _run_one(doc: dict, base: str, out: str) -> str:
+    """Outcome of one pack, resuming: a finished run of the same case document is read
+    back, an interrupted one restarts from its last checkpoint (a search survives a
+    crash), anything else runs from the start."""
+    from wovenimpact.io.atomic import atomic_write_text
+    from wovenimpact.io.checkpoint import latest_checkpoint
     from wovenimpact.runs import run_spec
     from wovenimpact.spec.case import case_from_dict
 
-    summary = run_spec(case_from_dict(doc, source=out), base, out, threads=1)
+    out_dir = Path(out)
+    text = json.dumps(doc, sort_keys=True, default=str)
+    same = (out_dir / "case.json").exists() and (out_dir / "case.json").read_text() == text
+    if same and (out_dir / "summary.json").exists():
+        return json.loads((out_dir / "summary.json").read_text())["outcome"]
+    restart = same and latest_checkpoint(out_dir / "checkpoints") is not None
+    out_dir.mkdir(parents=True, exist_ok=True)
+    (out_dir / "summary.json").unlink(missing_ok=True)
+    atomic_write_text(out_dir / "case.json", text)
+    summary = run_spec(case_from_dict(doc, source=out), base, out, threads=1, restart=restart)
     return summary["outcome"]
 
 

@@ -281,13 +281,17 @@ def test_design_plies_finds_the_pack_that_stops_the_impactor(tmp_path):
     assert n == 1 or answer["runs"][str(n - 1)] == "perforated"
     assert answer["areal_mass_kg_per_m2"] == pytest.approx(n * 0.4775, rel=1e-3)
     print(f"\ndesign search: {n} plies stop it; runs {answer['runs']}")
-    # a second search reads the finished runs back instead of running them again
+    # a second search reads the finished runs back instead of running them again, and
+    # --check 1 runs the pack above the answer as well
     summaries = sorted((tmp_path / "d").glob("plies_*/summary.json"))
     stamps = [p.stat().st_mtime_ns for p in summaries]
     again = CliRunner().invoke(app, ["design", "plies", str(case), "--out", str(tmp_path / "d"),
-                                     "--json"])
-    assert json.loads(again.stdout.strip().splitlines()[-1]) == answer
+                                     "--json", "--check", "1"])
+    checked = json.loads(again.stdout.strip().splitlines()[-1])
     assert [p.stat().st_mtime_ns for p in summaries] == stamps
+    assert checked["plies_to_stop"] == n and str(n + 1) in checked["runs"]
+    assert checked["runs"][str(n + 1)] in ("stopped", "perforated")
+    assert (checked["warning"] == "") == (checked["runs"][str(n + 1)] == "stopped")
 
 
 def test_set_overrides_change_the_case_and_bad_ones_are_named(tmp_path):

@@ -19,6 +19,7 @@ def plies(
     out: Path = typer.Option(None, "--out", help="Where the runs go (default: out/design_<case>)."),
     workers: int = typer.Option(2, "--workers", min=1, help="Runs in parallel."),
     start: int = typer.Option(None, "--start", min=1, help="First ply count to try (default: the case's)."),
+    check: int = typer.Option(0, "--check", min=0, help="Also run this many packs just above the answer (a larger pack that perforates is warned of)."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
     overrides: list[str] = typer.Option(
         None, "--set", help="Change a case value: KEY=VALUE with a dotted key, e.g. "
@@ -30,7 +31,7 @@ def plies(
 
     try:
         result = design_plies(case, out or Path("out") / f"design_{case.stem}", workers=workers,
-                              start=start, overrides=overrides or ())
+                              start=start, overrides=overrides or (), check=check)
     except InputError as err:
         fail(str(err))
     shown = dict(result)

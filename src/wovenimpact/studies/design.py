@@ -101,9 +101,13 @@ def _run_one(doc: dict, base: str, out: str) -> str:
 
 
 def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
-                 start: int | None = None, overrides=()) -> dict:
+                 start: int | None = None, overrides=(), check: int = 0) -> dict:
     """Fewest plies that stop the impactor of a plate-impact case (with the ``KEY=VALUE``
-    ``overrides`` of ``--set``); runs in out_dir/plies_N."""
+    ``overrides`` of ``--set``); runs in out_dir/plies_N. ``check`` > 0 also runs the
+    ``check`` packs just above the answer that the search did not run, so that a
+    non-monotonic outcome near the limit shows in the warning."""
+    if isinstance(check, bool) or not isinstance(check, int) or check < 0:
+        raise InputError(f"check = {check!r}; valid: a whole number of packs ≥ 0")
     path = Path(case_path)
     doc = apply_overrides(read_toml(path, "case file"), overrides)
     base = str(path.resolve().parent)
@@ -124,6 +128,9 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
 
     n0 = int(doc.get("mesh", {}).get("plies", 1))
     plies, seen = search_plies(stops, start=start or n0)
+    extra = [k for k in range(plies + 1, plies + 1 + check) if k not in seen]
+    if extra:
+        seen.update(stops(extra))
     from wovenimpact.model.compile import compile_case
     from wovenimpact.spec.case import case_from_dict
 

@@ -17,7 +17,7 @@ from pathlib import Path
 
 from wovenimpact.errors import InputError
 from wovenimpact.io.atomic import atomic_write_text
-from wovenimpact.spec.fields import read_toml
+from wovenimpact.spec.fields import read_toml, set_dotted
 
 ROOT = Path(__file__).resolve().parents[3]
 CASES = ("plies1_100", "plies2_100", "plies4_100", "plies6_100", "plies4_120")
@@ -61,7 +61,7 @@ def full_plate(doc: dict) -> dict:
 def convergence_runs(work: Path, threads: int) -> list[dict]:
     """Run (or reuse) every CONVERGENCE case in every CONVERGENCE_VARIANTS form; rows with
     the variant label, the case's summary and the change from the reference form."""
-    from wovenimpact.studies.sweep import finished, run_variant, set_dotted, variant_id
+    from wovenimpact.studies.sweep import finished, run_variant, variant_id
 
     rows = []
     for name, changes in CONVERGENCE:

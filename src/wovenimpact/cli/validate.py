@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 
 import typer
@@ -13,16 +14,19 @@ from wovenimpact.errors import InputError
 @app.command("validate")
 def validate(
     work: Path = typer.Option(Path("out/validation"), "--work", help="Where the runs go (resumed)."),
-    report: Path = typer.Option(None, "--report", help="Report path (default: docs/validation.md)."),
+    report: Path = typer.Option(None, "--report", help="Report path (default: docs/validation.md; with --study, WORK/validation.md, so that a partial report never replaces the full one)."),
     study: list[str] = typer.Option(None, "--study", help="Only these studies (repeatable)."),
     workers: int = typer.Option(2, "--workers", min=1, help="Runs in parallel."),
 ) -> None:
     """Run (or resume) the example cases and thesis studies; write the validation report."""
     from wovenimpact.studies.validation import ROOT, STUDIES, run_validation
 
+    if report is None:
+        report = work / "validation.md" if study else ROOT / "docs" / "validation.md"
     try:
-        path = run_validation(work, report or ROOT / "docs" / "validation.md",
-                              studies=tuple(study) if study else STUDIES, workers=workers)
+        path = run_validation(work, report,
+                              studies=tuple(study) if study else STUDIES, workers=workers,
+                              log=lambda m: console.print(f"[dim]{time.strftime('%H:%M:%S')}[/] {m}"))
     except InputError as err:
         fail(str(err))
     console.print(f"validation report: {path}")

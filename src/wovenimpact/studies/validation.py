@@ -58,9 +58,14 @@ def full_plate(doc: dict) -> dict:
     return doc
 
 
-def convergence_runs(work: Path, threads: int) -> list[dict]:
+def _quiet(message: str) -> None:
+    """The default progress reporter of this module: says nothing."""
+
+
+def convergence_runs(work: Path, threads: int, log=_quiet) -> list[dict]:
     """Run (or reuse) every CONVERGENCE case in every CONVERGENCE_VARIANTS form; rows with
-    the variant label, the case's summary and the change from the reference form."""
+    the variant label, the case's summary and the change from the reference form.
+    ``log(message)`` is told of each run before it starts."""
     from wovenimpact.studies.sweep import finished, run_variant, variant_id
 
     rows = []
@@ -77,7 +82,11 @@ def convergence_runs(work: Path, threads: int) -> list[dict]:
                 doc = full_plate(doc)
             values = {"case": name, **changes, "mesh.element_size": size, "quarter": quarter}
             out = work / "convergence" / variant_id(values)
-            result = finished(out, values) or run_variant(doc, str(path.parent), str(out),
+            done = finished(out, values)
+            if done is None:
+                log(f"convergence: {name}{''.join(', ' + v for v in changes.values())}, "
+                    f"{label} → {out}")
+            result = done or run_variant(doc, str(path.parent), str(out),
                                                          values, threads=threads)
             if result["status"] != "done":
                 raise InputError(f"convergence run {name} ({label}) failed: {result['error']}")
@@ -213,8 +222,10 @@ def commentary(cases: dict[str, dict], convergence: list[dict]) -> list[str]:
 
 
 def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "validation.md",
-                   studies=STUDIES, workers: int = 2) -> Path:
-    """Run (or resume) everything and write the report; returns its path."""
+                   studies=STUDIES, workers: int = 2, log=_quiet) -> Path:
+    """Run (or resume) everything and write the report; returns its path. ``log(message)``
+    hears of each case, convergence run and study as it starts (the whole takes about
+    half an hour on 2 cores)."""
     from wovenimpact.runs import run_case
     from wovenimpact.studies.ballistics import lambert_jonas_fit
     from wovenimpact.studies.sweep import run_study
@@ -242,6 +253,7 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
         if summary_path.exists():
             s = json.loads(summary_path.read_text())
         else:
+            log(f"case {name} → {out}")
             s = run_case(ROOT / "examples" / "plate_impact" / f"{name}.toml", out)
         cases[name] = s
         hg = s["hourglass_energy_J"] / max(s["internal_work_J"], 1e-300)
@@ -257,13 +269,14 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
               "else ran beside it; the first run of a fresh install includes compilation. "
               "Speed is measured by `make bench`.", "",
               "![4 plies at 120 m/s](validation/plies4_120_impactor.png)", ""]
-    convergence = convergence_runs(work, threads=workers)
+    convergence = convergence_runs(work, threads=workers, log=log)
     lines += convergence_lines(convergence)
     study_rows: dict[str, list[dict]] = {}
     for study in studies:
         path = ROOT / "examples" / "studies" / f"{study}.toml"
         if not path.exists():
             raise InputError(f"no study file {path}")
+        log(f"study {study} → {work / 'studies' / study}")
         rows = run_study(path, work / "studies" / study, workers=workers)
         study_rows[study] = rows
         keys = [k for k in rows[0] if k not in ("id", "status", "error")]

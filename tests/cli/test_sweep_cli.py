@@ -61,11 +61,16 @@ def test_sweep_on_a_dask_cluster_gives_the_local_results(tmp_path: Path):
     study.write_text(STUDY.replace(', ["0 m/s", "0 m/s", "-60"]', ""))
     from wovenimpact.studies.sweep import run_study
 
-    local = run_study(study, tmp_path / "local")
+    heard = {"local": [], "dask": []}
+    local = run_study(study, tmp_path / "local",
+                      progress=lambda d, t, v, r: heard["local"].append((d, t, r["status"])))
     with LocalCluster(n_workers=1, threads_per_worker=1, processes=False,
                       dashboard_address=None) as cluster:
-        remote = run_study(study, tmp_path / "dask", scheduler=cluster.scheduler_address)
+        remote = run_study(study, tmp_path / "dask", scheduler=cluster.scheduler_address,
+                           progress=lambda d, t, v, r: heard["dask"].append((d, t, r["status"])))
     assert [r["status"] for r in remote] == ["done", "done"]
+    # progress hears of each variant as it finishes, on either back end
+    assert heard["local"] == heard["dask"] == [(1, 2, "done"), (2, 2, "done")]
     assert [r["max_displacement_m"] for r in remote] == [r["max_displacement_m"] for r in local]
 
 

@@ -6,9 +6,10 @@ import json
 from pathlib import Path
 
 import typer
+from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from wovenimpact.cli.app import app, console, fail
+from wovenimpact.cli.app import app, console, err_console, fail
 from wovenimpact.errors import InputError
 
 
@@ -24,8 +25,19 @@ def sweep(
     from wovenimpact.studies.sweep import run_study
 
     out_dir = out or Path("out") / study.stem
+    bar = Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
+                   TextColumn("{task.fields[last]}"), TimeElapsedColumn(),
+                   console=err_console, disable=as_json)
+    task = bar.add_task(study.stem, total=None, last="")
+
+    def report(done, total, vid, result):
+        state = result.get("status", "?")
+        bar.update(task, completed=done, total=total, last=f"last: {vid} {state}")
+
     try:
-        rows = run_study(study, out_dir, scheduler=scheduler, workers=workers)
+        with bar:
+            rows = run_study(study, out_dir, scheduler=scheduler, workers=workers,
+                             progress=report)
     except InputError as err:
         fail(str(err))
     failed = [r for r in rows if r["status"] != "done"]

@@ -36,6 +36,7 @@ import io
 import itertools
 import json
 import traceback
+from concurrent.futures import as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal
@@ -151,8 +152,13 @@ def run_study(
     scheduler: str | None = None,
     workers: int = 2,
     threads_per_run: int = 1,
+    progress=None,
 ) -> list[dict]:
-    """Run every variant of a study (resuming), write results.csv and plots; returns the rows."""
+    """Run every variant of a study (resuming), write results.csv and plots; returns the rows.
+
+    ``progress(done, total, variant_id, result)`` is called as each variant finishes
+    (resumed ones count as done from the start)."""
+    progress = progress or (lambda done, total, vid, result: None)
     info, variants, base = load_study(study_path)
     out = Path(out_dir)
     (out / "runs").mkdir(parents=True, exist_ok=True)
@@ -164,6 +170,8 @@ def run_study(
             results[v.id] = {**done, "resumed": True}
         else:
             todo.append(v)
+    if results:
+        progress(len(results), len(variants), "", {"status": "finished earlier"})
     args = [(v.document, str(base), str(out / "runs" / v.id), v.values, threads_per_run)
             for v in todo]
     if todo and scheduler:
@@ -171,14 +179,19 @@ def run_study(
             from distributed import Client
         except ImportError:
             raise InputError("--scheduler needs dask.distributed: pip install 'dask[distributed]'") from None
+        from distributed import as_completed as dask_completed
+
         with Client(scheduler) as client:
-            futures = [client.submit(run_variant, *a, pure=False) for a in args]
-            for v, res in zip(todo, client.gather(futures)):
-                results[v.id] = res
+            futures = {client.submit(run_variant, *a, pure=False): v for a, v in zip(args, todo)}
+            for fut in dask_completed(futures):
+                results[futures[fut].id] = fut.result()
+                progress(len(results), len(variants), futures[fut].id, results[futures[fut].id])
     elif todo:
         with process_pool(workers, threads_per_run) as pool:
-            for v, res in zip(todo, pool.map(run_variant, *zip(*args))):
-                results[v.id] = res
+            futures = {pool.submit(run_variant, *a): v for a, v in zip(args, todo)}
+            for fut in as_completed(futures):
+                results[futures[fut].id] = fut.result()
+                progress(len(results), len(variants), futures[fut].id, results[futures[fut].id])
     rows = []
     for v in variants:
         r = results[v.id]

@@ -357,3 +357,26 @@ def test_design_run_interrupted_by_a_crash_resumes_from_its_checkpoint(tmp_path)
     assert resumed["steps"] == full_steps  # same end, restart bitwise (tested above)
     assert 0 < resumed["element_cycles"] < 0.5 * a["element_cycles"]  # only the rest ran
     assert resumed["residual_velocity_m_per_s"] == a["residual_velocity_m_per_s"]
+
+
+def test_penalty_stiffness_does_not_follow_a_falling_step(tmp_path):
+    """k = β m / max(Δt, Δt_first)²: the same penetration gives the same force when the
+    step falls below the first one, and a quarter of it when the step doubles."""
+    from wovenimpact.kernels import rigid_body as RB
+    from wovenimpact.solver.contact_stage import ContactBuffers, contact_forces
+
+    text = CASE.replace('[[initial_velocity]]\nvelocity = ["0 m/s", "0 m/s", "-60 m/s"]\n'
+                        'radius = "1.5 mm"\n', "") + IMPACTOR.replace("{z}", "0.4 mm")
+    compiled = compile_case(*load_case(write_case(tmp_path, text=text)))
+    model, state = compiled.model, compiled.state
+    state.bodies[0, RB.B_X + 2] -= 0.3e-3  # the flat nose 0.05 mm into the ply's surface
+    state.dt_first = 1e-7
+    cb = ContactBuffers.for_model(model)
+
+    def force(dt):
+        return contact_forces(model, state, cb, dt)[0][0][2]
+
+    f_ref = force(1e-7)
+    assert f_ref > 0.0  # the ply pushes the impactor back up
+    assert force(1e-8) == f_ref
+    assert force(2e-7) == pytest.approx(f_ref / 4.0, rel=1e-12)

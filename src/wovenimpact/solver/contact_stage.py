@@ -50,8 +50,17 @@ def body_frame(state_row, params):
 
 
 def contact_forces(model, state, cb: ContactBuffers, dt: float) -> list[tuple[np.ndarray, np.ndarray]]:
-    """Contact forces on the nodes (into cb.f_con) and (force, torque) on every body."""
+    """Contact forces on the nodes (into cb.f_con) and (force, torque) on every body.
+
+    Penalty stiffness k = β m / Δt_k² with Δt_k = max(Δt, Δt_first): it follows a step
+    that grows (so that ω Δt stays below 2) but not one that falls. When a crushed
+    element cut the step, every spring already compressed stiffened at once and gave
+    its new energy back: 16 plies struck at 200 m/s, the step fell from 1.5e-7 to
+    4.3e-8 s in 0.5 µs, the contact did +20 J of work, the FSP dropped from 144 to 66
+    m/s and the energy error reached 2.7 % by 12 µs (6e-4 with this rule).
+    """
     cb.f_con[:] = 0.0
+    dt = max(dt, state.dt_first)
     resultants = []
     k_node = None
     for b in range(model.body_params.shape[0]):

@@ -32,8 +32,9 @@ def test_search_gives_up_past_the_limit():
 
 
 def test_a_larger_pack_that_perforates_is_reported():
-    """Near a ballistic limit the simulated outcome need not be monotonic (measured: 175
-    m/s FSP, 5 and 8 plies stopped it, 7 did not): the answer comes with a warning."""
+    """Near a ballistic limit the simulated outcome need not be monotonic (seen before
+    the contact-stiffness fix: 175 m/s FSP, 5 and 8 plies stopped it, 7 did not): the
+    answer comes with a warning."""
     from wovenimpact.studies.design import monotonic_warning
 
     assert monotonic_warning(5, {1: False, 2: False, 4: False, 5: True, 8: True}) == ""

@@ -346,7 +346,7 @@ def test_design_run_interrupted_by_a_crash_resumes_from_its_checkpoint(tmp_path)
     full_steps = a["steps"]
     # the crash: the same call, stopped after most of its steps (checkpoints every 4 µs)
     (cut / "checkpoints").mkdir(parents=True)
-    (cut / "case.json").write_text(json.dumps(doc, sort_keys=True, default=str))
+    (cut / "parameters.json").write_text(json.dumps(doc, indent=2, default=str) + "\n")
     from wovenimpact.runs import run_spec
     from wovenimpact.spec.case import case_from_dict
 

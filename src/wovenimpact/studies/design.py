@@ -86,16 +86,19 @@ def _run_one(doc: dict, base: str, out: str) -> str:
     from wovenimpact.io.checkpoint import latest_checkpoint
     from wovenimpact.runs import run_spec
     from wovenimpact.spec.case import case_from_dict
+    from wovenimpact.studies.sweep import finished
 
     out_dir = Path(out)
-    text = json.dumps(doc, sort_keys=True, default=str)
-    same = (out_dir / "case.json").exists() and (out_dir / "case.json").read_text() == text
-    if same and (out_dir / "summary.json").exists():
-        return json.loads((out_dir / "summary.json").read_text())["outcome"]
-    restart = same and latest_checkpoint(out_dir / "checkpoints") is not None
+    done = finished(out_dir, doc)  # the sweep's test: same parameters.json, a summary
+    if done is not None:
+        return done["outcome"]
+    params = out_dir / "parameters.json"
+    text = json.dumps(doc, indent=2, default=str) + "\n"
+    restart = (params.exists() and json.loads(params.read_text()) == json.loads(text)
+               and latest_checkpoint(out_dir / "checkpoints") is not None)
     out_dir.mkdir(parents=True, exist_ok=True)
     (out_dir / "summary.json").unlink(missing_ok=True)
-    atomic_write_text(out_dir / "case.json", text)
+    atomic_write_text(params, text)
     summary = run_spec(case_from_dict(doc, source=out), base, out, threads=1, restart=restart)
     return summary["outcome"]
 

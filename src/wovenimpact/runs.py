@@ -142,10 +142,9 @@ def run_spec(
     out.mkdir(parents=True, exist_ok=True)
     n_threads = threads or spec.run.threads
     if n_threads is not None:
-        from wovenimpact.jit import set_threads
-        import numba
+        from wovenimpact.jit import capped_threads, set_threads
 
-        set_threads(min(n_threads, numba.config.NUMBA_NUM_THREADS))
+        set_threads(capped_threads(n_threads, "--threads" if threads else "run.threads"))
     digest = model.digest()
     run = spec.run
     ckpt_dir = out / "checkpoints"

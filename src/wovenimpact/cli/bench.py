@@ -21,8 +21,10 @@ def bench(
     """Time the explicit step on square plates; prints ns per element-cycle and stage shares."""
     from wovenimpact.benchmark import case_line, run_cases
 
-    counts = ([int(t) for t in threads.split(",")] if threads
-              else sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)}))
+    from wovenimpact.jit import capped_threads
+
+    counts = (list(dict.fromkeys(capped_threads(int(t), "--threads") for t in threads.split(",")))
+              if threads else sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)}))
     cases = run_cases(kinds.split(","), [int(s) for s in sizes.split(",")], counts, steps,
                       report=None if as_json else (lambda c: console.print(case_line(c))))
     if as_json:

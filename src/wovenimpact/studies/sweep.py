@@ -16,7 +16,7 @@ addressed by its dotted path in the case document::
 ``grid`` runs every combination, ``zip`` the i-th value of every parameter together.
 Every variant is validated like a case file (a bad value fails that variant, with the
 key named, and the others still run), run in ``OUT/runs/<id>/`` and summarised in
-``OUT/results.csv``. A variant whose ``summary.json`` exists with the same parameters
+``OUT/results.csv`` (and ``OUT/report.html``, linking each run's page). A variant whose ``summary.json`` exists with the same parameters
 is not run again (the study resumes). Runs go to a local process pool by default, or
 to a Dask cluster when a scheduler address is given.
 
@@ -46,6 +46,7 @@ from pydantic import BaseModel, Field, ValidationError
 from wovenimpact.errors import InputError
 from wovenimpact.jit import process_pool
 from wovenimpact.io.atomic import atomic_write_text
+from wovenimpact.io.report import write_study_report
 from wovenimpact.spec.fields import (
     STRICT,
     input_error,
@@ -205,6 +206,7 @@ def run_study(
     from wovenimpact.studies.plots import study_plots
 
     study_plots(info, variants, rows, out)
+    write_study_report(out, info.name, rows)  # OUT/report.html: variants linked, plots
     return rows
 
 

@@ -28,9 +28,12 @@ run: venv
 test: venv
 	$(BIN)/python -m pytest -q
 
+# The machine line first; then the fabric kernel alone, the explicit step (the same as
+# `wovenimpact bench`) and the ply-on-ply contact.
 bench: venv
+	$(BIN)/python -c "from wovenimpact.benchmark import machine_line; print(machine_line())"
 	$(BIN)/python benchmarks/bench_fabric_kernel.py
-	$(BIN)/python benchmarks/bench_shell.py
+	$(BIN)/python benchmarks/bench_shell.py --no-machine-line
 	$(BIN)/python benchmarks/bench_contact.py
 
 clean:

@@ -83,7 +83,7 @@ def verdicts(summary: dict) -> list[Verdict]:
         Verdict("residual_velocity_m_per_s", "residual velocity", residual_text, "0 m/s",
                 _status(None if residual is None else residual == 0.0)),
         Verdict("energy_error_fraction", "energy error",
-                "n/a" if error is None else f"{error:.2%}", f"≤ {ENERGY_ERROR_LIMIT:.0%}",
+                "n/a" if error is None else f"{error * 100:.2g} %", f"≤ {ENERGY_ERROR_LIMIT:.0%}",
                 _status(None if error is None else error <= ENERGY_ERROR_LIMIT)),
         Verdict("hourglass_fraction", "hourglass share of internal work",
                 "n/a" if hourglass is None else f"{hourglass:.1%}", f"≤ {HOURGLASS_LIMIT:.0%}",

@@ -49,6 +49,7 @@ from wovenimpact.io.atomic import atomic_write_text
 from wovenimpact.io.report import write_study_report
 from wovenimpact.spec.fields import (
     STRICT,
+    apply_overrides,
     input_error,
     problems_from_validation,
     read_toml,
@@ -87,8 +88,9 @@ def variant_id(values: dict) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:10]
 
 
-def load_study(path: str | Path) -> tuple[StudyInfo, list[Variant], Path]:
-    """Read a study file; returns its header, its variants and the base case's directory."""
+def load_study(path: str | Path, overrides=()) -> tuple[StudyInfo, list[Variant], Path]:
+    """Read a study file; returns its header, its variants and the base case's directory.
+    ``overrides`` (``--set KEY=VALUE``) change the base case before the parameters do."""
     path = Path(path)
     doc = read_toml(path, "study file")
     try:
@@ -96,7 +98,7 @@ def load_study(path: str | Path) -> tuple[StudyInfo, list[Variant], Path]:
     except ValidationError as err:
         raise input_error(problems_from_validation(err, StudyFile), str(path)) from None
     case_path = (path.parent / spec.study.case).resolve()
-    base_doc = read_toml(case_path, "case file named by study.case")
+    base_doc = apply_overrides(read_toml(case_path, "case file named by study.case"), overrides)
     keys = list(spec.parameters)
     columns = [spec.parameters[k] for k in keys]
     if spec.study.combine == "zip":
@@ -154,26 +156,31 @@ def run_study(
     workers: int = 2,
     threads_per_run: int = 1,
     progress=None,
+    overrides=(),
 ) -> list[dict]:
     """Run every variant of a study (resuming), write results.csv and plots; returns the rows.
 
     ``progress(done, total, variant_id, result)`` is called as each variant finishes
-    (resumed ones count as done from the start)."""
+    (resumed ones count as done from the start). ``overrides`` (``--set KEY=VALUE``)
+    change the base case of every variant; a variant is resumed only if it was run with
+    the same ones."""
     progress = progress or (lambda done, total, vid, result: None)
-    info, variants, base = load_study(study_path)
+    info, variants, base = load_study(study_path, overrides)
+    extra = {"--set": list(overrides)} if overrides else {}
     out = Path(out_dir)
     (out / "runs").mkdir(parents=True, exist_ok=True)
     results: dict[str, dict] = {}
     todo = []
     for v in variants:
-        done = finished(out / "runs" / v.id, v.values)
+        done = finished(out / "runs" / v.id, {**v.values, **extra})
         if done is not None:
             results[v.id] = {**done, "resumed": True}
         else:
             todo.append(v)
     if results:
         progress(len(results), len(variants), "", {"status": "finished earlier"})
-    args = [(v.document, str(base), str(out / "runs" / v.id), v.values, threads_per_run)
+    args = [(v.document, str(base), str(out / "runs" / v.id), {**v.values, **extra},
+             threads_per_run)
             for v in todo]
     if todo and scheduler:
         try:

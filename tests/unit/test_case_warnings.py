@@ -13,7 +13,8 @@ from wovenimpact.errors import InputWarning
 from wovenimpact.spec.case import load_case
 
 ROOT = Path(__file__).resolve().parents[2]
-TOUR = ROOT / "examples" / "cases" / "fabric_plate_impulse.toml"  # field 10, history 0.5, ckpt 25 µs
+# intervals: field 10 µs, history 0.5 µs, checkpoint 25 µs
+TOUR = ROOT / "examples" / "cases" / "fabric_plate_impulse.toml"
 
 
 def test_intervals_longer_than_a_shortened_end_time_are_clipped_with_a_warning():

@@ -35,7 +35,8 @@ def bench(
     if not as_json:
         console.print(machine_line(), highlight=False, soft_wrap=True)
     cases = run_cases(kinds.split(","), [int(s) for s in sizes.split(",")], counts, steps,
-                      report=None if as_json else (lambda c: console.print(case_line(c), soft_wrap=True)))
+                      report=None if as_json else
+                      (lambda c: console.print(case_line(c), soft_wrap=True)))
     if as_json:
         typer.echo(json.dumps({"cases": cases, "machine": machine(),
                                "threading_layer": numba.threading_layer()}))

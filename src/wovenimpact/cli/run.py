@@ -33,7 +33,9 @@ def run(
     case: Path = typer.Argument(..., help="Case file (TOML)."),
     out: Path = typer.Option(..., "--out", help="Output directory."),
     restart: bool = typer.Option(False, "--restart", help="Resume from the last checkpoint in OUT."),
-    threads: int = typer.Option(None, "--threads", min=1, help="Kernel threads (default: all cores; more than the cores is warned of and capped)."),
+    threads: int = typer.Option(
+        None, "--threads", min=1,
+        help="Kernel threads (default: all cores; more than the cores is warned of and capped)."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object (summary) on stdout."),
     overrides: list[str] = typer.Option(
         None, "--set", help="Change a case value: KEY=VALUE with a dotted key, e.g. "

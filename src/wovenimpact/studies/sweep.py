@@ -16,7 +16,8 @@ addressed by its dotted path in the case document::
 ``grid`` runs every combination, ``zip`` the i-th value of every parameter together.
 Every variant is validated like a case file (a bad value fails that variant, with the
 key named, and the others still run), run in ``OUT/runs/<id>/`` and summarised in
-``OUT/results.csv`` (and ``OUT/report.html``, linking each run's page). A variant whose ``summary.json`` exists with the same parameters
+``OUT/results.csv`` (and ``OUT/report.html``, linking each run's page). A variant
+whose ``summary.json`` exists with the same parameters
 is not run again (the study resumes). Runs go to a local process pool by default, or
 to a Dask cluster when a scheduler address is given.
 

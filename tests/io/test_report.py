@@ -14,6 +14,7 @@ import pytest  # noqa: E402
 
 import wovenimpact  # noqa: E402
 from tests.io.report_page import check_run_page, read_page  # noqa: E402
+from wovenimpact.errors import InputWarning  # noqa: E402
 from wovenimpact.io.report import write_index, write_run_report, write_study_report  # noqa: E402
 from wovenimpact.runs import run_case  # noqa: E402
 
@@ -61,7 +62,8 @@ def test_the_verdicts_come_first(tmp_path):
 
 def test_a_run_writes_its_page_with_the_case_as_run(tmp_path):
     out = tmp_path / "out"
-    run_case(TOUR, out, overrides=SMALL)
+    with pytest.warns(InputWarning, match="clipped to the end time"):
+        run_case(TOUR, out, overrides=SMALL)
     page = check_run_page(out)
     text = "".join(page.text)
     assert TOUR.read_text() in text  # the case file, verbatim

@@ -49,6 +49,7 @@ td.pass { color: #2e7d32; font-weight: bold; background: none; }
 td.fail { color: #c62828; font-weight: bold; background: none; }
 img { max-width: 100%; display: block; margin: 1em 0; }
 pre { background: #f5f5f5; padding: 1em; overflow-x: auto; }
+.pass-text { color: #2e7d32; } .fail-text { color: #c62828; }
 """
 
 
@@ -251,8 +252,6 @@ def write_index(work: str | Path, title: str) -> Path:
     body = []
     for group, items in groups.items():
         body += [f"<h2>{escape(group)}</h2>", "<ul>", *items, "</ul>"]
-    page = _page(title, body or ["<p>(no pages yet)</p>"]).replace(
-        "</style>", ".pass-text { color: #2e7d32; } .fail-text { color: #c62828; }</style>")
     path = work / "report.html"
-    atomic_write_text(path, page)
+    atomic_write_text(path, _page(title, body or ["<p>(no pages yet)</p>"]))
     return path

@@ -64,3 +64,23 @@ def test_a_full_plate_needs_no_symmetry_sets():
         warnings.simplefilter("error", InputWarning)
         load_case(TOUR, ["mesh.quarter=false", "boundary.1.nodes=edge_outer",
                          "boundary.2.nodes=edge_outer"])
+
+
+def test_a_study_tells_each_input_warning_once_not_once_per_variant(tmp_path):
+    """Variants run in worker processes: their warnings come back with the result and the
+    study repeats each distinct one once, with the number of variants it concerns."""
+    from wovenimpact.spec.fields import apply_overrides, read_toml
+    from wovenimpact.studies.sweep import run_variant, warn_once
+
+    doc = apply_overrides(read_toml(TOUR, "case"), ['run.end_time="1 us"', 'mesh.side="10 mm"',
+                                                     'mesh.element_size="2.5 mm"'])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", InputWarning)  # nothing escapes the variant
+        result = run_variant(doc, str(TOUR.parent), str(tmp_path / "v1"), {"k": 1})
+    assert result["status"] == "done"
+    assert len(result["warnings"]) == 2
+    assert result["warnings"][0].startswith("run.field_interval = 10 us is longer")
+    with pytest.warns(InputWarning) as record:
+        warn_once({"a": result, "b": result, "c": {"status": "done"}}, 3)
+    assert sorted(str(w.message)[:31] for w in record) == [
+        "2 of 3 variants: run.checkpoint", "2 of 3 variants: run.field_inte"]

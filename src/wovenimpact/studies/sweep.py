@@ -37,6 +37,7 @@ import io
 import itertools
 import json
 import traceback
+import warnings
 from concurrent.futures import as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -44,7 +45,7 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, Field, ValidationError
 
-from wovenimpact.errors import InputError
+from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.jit import process_pool
 from wovenimpact.io.atomic import atomic_write_text
 from wovenimpact.io.report import write_study_report
@@ -128,14 +129,35 @@ def run_variant(document: dict, base: str, out_dir: str, values: dict, threads: 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out / "parameters.json", json.dumps(values, indent=2, default=str) + "\n")
-    try:
-        spec = case_from_dict(document, source=f"variant {out.name}")
-        summary = run_spec(spec, base, out, threads=threads)
-        return {"status": "done", **summary}
-    except Exception as err:  # one failing case is reported, the others finish
-        message = f"{type(err).__name__}: {err}"
-        atomic_write_text(out / "error.txt", message + "\n\n" + traceback.format_exc())
-        return {"status": "failed", "error": message}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", InputWarning)
+        try:
+            spec = case_from_dict(document, source=f"variant {out.name}")
+            summary = run_spec(spec, base, out, threads=threads)
+            result = {"status": "done", **summary}
+        except Exception as err:  # one failing case is reported, the others finish
+            message = f"{type(err).__name__}: {err}"
+            atomic_write_text(out / "error.txt", message + "\n\n" + traceback.format_exc())
+            result = {"status": "failed", "error": message}
+    notes = [str(w.message).split(": ", 1)[-1] for w in caught
+             if issubclass(w.category, InputWarning)]
+    for w in caught:
+        if not issubclass(w.category, InputWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    if notes:  # told once per study by run_study, not once per variant and worker
+        result["warnings"] = list(dict.fromkeys(notes))
+    return result
+
+
+def warn_once(results: dict[str, dict], total: int) -> None:
+    """Each distinct input warning of the variants (``warnings`` of their results) as one
+    :class:`~wovenimpact.errors.InputWarning` saying how many variants it concerns."""
+    seen: dict[str, int] = {}
+    for r in results.values():
+        for note in r.get("warnings", ()):
+            seen[note] = seen.get(note, 0) + 1
+    for note, count in seen.items():
+        warnings.warn(f"{count} of {total} variants: {note}", InputWarning, stacklevel=3)
 
 
 def finished(out: Path, values: dict) -> dict | None:
@@ -201,6 +223,7 @@ def run_study(
             for fut in as_completed(futures):
                 results[futures[fut].id] = fut.result()
                 progress(len(results), len(variants), futures[fut].id, results[futures[fut].id])
+    warn_once(results, len(variants))
     rows = []
     for v in variants:
         r = results[v.id]

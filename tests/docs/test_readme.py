@@ -228,3 +228,11 @@ def test_one_flagship_time():
     times = re.findall(r"(?:~|\babout\s+|\btook\s+)\d+(?:\.\d+)?\s?s\b", text)
     assert len(times) == 1, times
     assert re.search(r"took\s+\d+(\.\d+)?\s+s\b[^`]*`machine: [^`]+, \d{4}-\d\d-\d\d`", text)
+
+
+def test_make_run_ends_by_printing_the_flagships_report_path():
+    text = (ROOT / "Makefile").read_text()
+    recipe = re.search(r"^run:.*\n((?:\t.*\n)+)", text, re.M)[1].splitlines()
+    flagship = next(line for line in recipe if "wovenimpact run " in line)
+    out = re.search(r"--out (\S+)", flagship)[1]
+    assert recipe[-1].strip().startswith("@echo") and f"{out}/report.html" in recipe[-1]

@@ -22,6 +22,34 @@ class Test(str, Enum):
     picture_frame = "picture-frame"
 
 
+class Homogenisation(str, Enum):
+    """``--homogenisation``: how crossover forces become membrane resultants."""
+
+    virial = "virial"
+    thesis = "thesis"
+
+
+class ShearLaw(str, Enum):
+    """``--shear-law``: the trellis shear law."""
+
+    true = "true"
+    thesis = "thesis"
+
+
+class Frame(str, Enum):
+    """``--frame``: the frame the yarn directions follow."""
+
+    fibre = "fibre"
+    green_naghdi = "green-naghdi"
+
+
+class Failure(str, Enum):
+    """``--failure``: yarn failure, instantaneous or with softening."""
+
+    instant = "instant"
+    progressive = "progressive"
+
+
 @app.command("element-test")
 def element_test(
     test: Test = typer.Argument(..., help="Which deformation history to apply."),
@@ -32,10 +60,10 @@ def element_test(
     ),
     angle: str = typer.Option("60 deg", help="Maximum shear angle of the shear tests (with unit)."),
     steps: int = typer.Option(600, min=1, help="Number of load steps."),
-    homogenisation: str = typer.Option(None, help="Override: 'virial' or 'thesis'."),
-    shear_law: str = typer.Option(None, "--shear-law", help="Override: 'true' or 'thesis'."),
-    frame: str = typer.Option(None, help="Override: 'fibre' or 'green-naghdi'."),
-    failure: str = typer.Option(None, help="Override: 'instant' or 'progressive'."),
+    homogenisation: Homogenisation = typer.Option(None, help="Override the material's."),
+    shear_law: ShearLaw = typer.Option(None, "--shear-law", help="Override the material's."),
+    frame: Frame = typer.Option(None, help="Override the material's."),
+    failure: Failure = typer.Option(None, help="Override the material's."),
     softening_strain: float = typer.Option(None, help="Override Δε_s of progressive failure."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object with the results."),
 ) -> None:
@@ -51,7 +79,7 @@ def element_test(
         if not isinstance(params, FabricParameters):
             raise InputError(f"--material {material}: element tests need a woven_fabric material")
         overrides = {
-            k: v
+            k: (v.value if isinstance(v, Enum) else v)
             for k, v in dict(
                 homogenisation=homogenisation,
                 shear=shear_law,
@@ -62,15 +90,6 @@ def element_test(
             if v is not None
         }
         if overrides:
-            allowed = {
-                "homogenisation": ("virial", "thesis"),
-                "shear": ("true", "thesis"),
-                "frame": ("fibre", "green-naghdi"),
-                "failure": ("instant", "progressive"),
-            }
-            for k, v in overrides.items():
-                if k in allowed and v not in allowed[k]:
-                    raise InputError(f"--{k} = {v!r} is not valid: choose one of {allowed[k]}")
             opts = dataclasses.replace(params.options, **overrides)
             if opts.failure == "progressive" and not opts.softening_strain > 0.0:
                 raise InputError(

@@ -46,7 +46,8 @@ HISTORY_COLUMNS = (
     "eroded_internal_energy_J", "energy_error_fraction", "max_displacement_m",
     "eroded_elements",
 )
-IMPACT_COLUMNS = ("impactor_velocity_m_per_s", "impactor_displacement_m", "contact_force_N",
+IMPACT_COLUMNS = ("impactor_velocity_m_per_s", "impactor_displacement_m", "contact_force_full_N",
+                  "impactor_nose_ahead_of_intact_m", "intact_material_ahead",
                   "impactor_kinetic_energy_J", "contact_energy_J")
 DEFAULT_OUTPUTS = {"history": 1000, "field": 20, "checkpoint": 10}  # per run, if not given
 
@@ -230,7 +231,7 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, steps: in
             "absorbed_energy_per_ply_J": per_ply,
             "max_deflection_m": max(ply_deflections(model, state)),
             "max_deflection_per_ply_m": ply_deflections(model, state),
-            "peak_contact_force_N": float(np.max(h["contact_force_N"])),
+            "peak_contact_force_N": float(np.max(h["contact_force_full_N"])),
         }
     return {**impact,
         "case": spec.case.name,

@@ -49,6 +49,7 @@ HISTORY_COLUMNS = (
 IMPACT_COLUMNS = ("impactor_velocity_m_per_s", "impactor_displacement_m", "contact_force_full_N",
                   "impactor_nose_ahead_of_intact_m", "intact_material_ahead",
                   "impactor_kinetic_energy_J", "contact_energy_J")
+SUMMARY_VERSION = 2  # 2: issue 9's outcome rule and energy keys; older summaries are re-run
 DEFAULT_OUTPUTS = {"history": 1000, "field": 20, "checkpoint": 10}  # per run, if not given
 
 
@@ -234,6 +235,7 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, steps: in
             "peak_contact_force_N": float(np.max(h["contact_force_full_N"])),
         }
     return {**impact,
+        "summary_version": SUMMARY_VERSION,
         "case": spec.case.name,
         "end_time_s": float(state.t),
         "steps": int(state.step),

@@ -80,7 +80,7 @@ def test_run_writes_every_output_and_a_json_summary(tmp_path):
     assert summary["energy_error_fraction"] < 1e-3
     assert json.loads((out / "summary.json").read_text())["steps"] == summary["steps"]
     header = (out / "history.csv").read_text().splitlines()[0].split(",")
-    assert header[0] == "time_s" and "kinetic_energy_J" in header
+    assert header[0] == "time_s" and "structure_kinetic_energy_part_J" in header
     assert (out / "plots" / "energy.png").stat().st_size > 1000
     pvd = (out / "fields" / "fields.pvd").read_text()
     assert pvd.count("<DataSet") == 1 + 4  # t = 0, then every 5 µs to 20 µs
@@ -311,7 +311,7 @@ def test_set_overrides_change_the_case_and_bad_ones_are_named(tmp_path):
 
     def ke0(d):
         rows = (d / "history.csv").read_text().splitlines()
-        return float(rows[1].split(",")[rows[0].split(",").index("kinetic_energy_J")])
+        return float(rows[1].split(",")[rows[0].split(",").index("structure_kinetic_energy_part_J")])
 
     assert ke0(out) == pytest.approx(ke0(base) / 4.0, rel=1e-12)  # half the speed
     for bad, words in (("impactor.velocity=100 m/s", "has no 'impactor'"),

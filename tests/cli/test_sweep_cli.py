@@ -36,7 +36,7 @@ def test_sweep_runs_variants_isolates_a_failure_and_resumes(tmp_path: Path):
     assert d60 > 1.5 * d30  # the faster kick moves the plate further
     assert (out / "results.csv").read_text().count("\n") == 4
     assert (out / "plots" / "max_displacement_m.png").exists()
-    assert (out / "plots" / "kinetic_energy_J_histories.png").exists()
+    assert (out / "plots" / "structure_kinetic_energy_part_J_histories.png").exists()
     # resume: finished variants are not run again
     stamp = (out / "runs" / rows[0]["id"] / "summary.json").stat().st_mtime_ns
     again = CliRunner().invoke(app, ["sweep", str(study), "--out", str(out), "--json"])

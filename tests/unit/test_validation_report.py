@@ -24,7 +24,7 @@ def _row(variant, residual, rebound, delta_residual=0.0, delta_rebound=0.0):
 
 
 CASES = {"plies1_100": {"outcome": "stopped", "perforated": False,
-                        "initial_kinetic_energy_J": 5.5}}
+                        "initial_total_kinetic_energy_J": 5.5}}
 
 
 def test_convergence_verdicts_follow_the_acceptance_limits():
@@ -44,7 +44,7 @@ def test_convergence_verdicts_follow_the_acceptance_limits():
 
 def test_spread_line_reports_the_extremes():
     rows = [{"status": "done", "rebound_velocity_m_per_s": v, "absorbed_energy_J": e,
-             "hourglass_energy_J": h, "internal_work_J": 4.0}
+             "hourglass_fraction": h / 4.0}
             for v, e, h in ((23.0, 7.6, 1.0), (24.5, 7.5, 2.0))]
     rows.append({"status": "failed"})
     line = spread_line(rows)
@@ -61,7 +61,7 @@ def test_undecided_runs_get_no_verdict_and_are_named():
         r["outcome"] = "perforated"
     rows[1]["outcome"] = "undecided"
     cases = {**CASES, "plies2_100": {"outcome": "undecided", "perforated": False,
-                                     "initial_kinetic_energy_J": 5.5}}
+                                     "initial_total_kinetic_energy_J": 5.5}}
     text = commentary(cases, rows)
     assert any("no convergence verdict — fine undecided" in line for line in text)
     assert not any("moves by" in line for line in text)

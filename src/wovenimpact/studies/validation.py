@@ -134,8 +134,7 @@ def spread_line(rows: list[dict]) -> str:
         vals = [float(r[key]) * scale for r in done]
         return min(vals), max(vals)
 
-    share = [float(r["hourglass_energy_J"]) / max(float(r["internal_work_J"]), 1e-300)
-             for r in done]
+    share = [float(r["hourglass_fraction"]) for r in done]
     rb, ab = span("rebound_velocity_m_per_s"), span("absorbed_energy_J")
     return (f"Across the {len(done)} runs the rebound velocity spans {rb[0]:.2f}–{rb[1]:.2f} "
             f"m/s and the absorbed energy {ab[0]:.3f}–{ab[1]:.3f} J, while the hourglass "
@@ -188,7 +187,7 @@ def commentary(cases: dict[str, dict], convergence: list[dict]) -> list[str]:
     stopped = [n for n, c in cases.items() if c["outcome"] == "stopped"]
     through = [n for n, c in cases.items() if c["outcome"] == "perforated"]
     open_ = [f"{n} ({c['outcome']})" for n, c in cases.items() if c["outcome"] not in DECIDED]
-    ke = {n: c["initial_kinetic_energy_J"] for n, c in cases.items()}
+    ke = {n: c["initial_total_kinetic_energy_J"] for n, c in cases.items()}
     out = [
         f"- With the FSP assumption {', '.join(stopped) or 'no case'} stop the impactor"
         + (f" and {', '.join(through)} perforate" if through else "")
@@ -268,7 +267,7 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
             log(f"case {name} → {out}")
             s = run_case(ROOT / "examples" / "plate_impact" / f"{name}.toml", out)
         cases[name] = s
-        hg = s["hourglass_energy_J"] / max(s["internal_work_J"], 1e-300)
+        hg = s["hourglass_fraction"]
         lines.append(
             f"| {name} | {s['outcome']} | {s['residual_velocity_m_per_s']:.1f} | "
             f"{THESIS_RESIDUAL[name]} | {s['rebound_velocity_m_per_s']:.1f} | "

@@ -39,9 +39,8 @@ def travel_direction(model, state, b: int = 0) -> np.ndarray:
 
 
 def impactor_row(model, state, b: int = 0) -> dict:
-    """Velocity and displacement along the initial travel direction, the contact force
-    resisting it (full-problem value), and where the intact material is
-    (:func:`intact_material_ahead`), of impactor b."""
+    """Velocity and displacement along the initial travel direction, and the contact
+    force resisting it (full-problem value), of impactor b."""
     d0 = -model.body_state0[b, RB.B_R:RB.B_R + 9].reshape(3, 3)[:, 0]
     row = state.bodies[b]
     x0 = model.body_state0[b, RB.B_X:RB.B_X + 3]
@@ -50,7 +49,6 @@ def impactor_row(model, state, b: int = 0) -> dict:
         "impactor_velocity_m_per_s": float(row[RB.B_V:RB.B_V + 3] @ d0),
         "impactor_displacement_m": float((row[RB.B_X:RB.B_X + 3] - x0) @ d0),
         "contact_force_full_N": float(-(row[RB.B_F:RB.B_F + 3] @ d0) * factor),
-        **intact_material_ahead(model, state, b),
     }
 
 

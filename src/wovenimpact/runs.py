@@ -35,6 +35,7 @@ from wovenimpact.kernels import shell_layout as S
 from wovenimpact.model.compile import CompiledCase, compile_case
 from wovenimpact.quantities import (
     impactor_row,
+    intact_material_ahead,
     ply_deflections,
     ply_energies,
     residual_velocity,
@@ -47,12 +48,13 @@ from wovenimpact.state import KINETIC0, State
 HISTORY_COLUMNS = (
     "time_s", "step", "dt_s", "structure_kinetic_energy_part_J", "internal_work_part_J",
     "stored_energy_part_J", "hourglass_energy_part_J", "external_work_part_J",
-    "eroded_kinetic_energy_part_J", "eroded_internal_energy_part_J", "energy_error_fraction",
-    "energy_normaliser_part_J", "max_displacement_m", "eroded_elements",
+    "eroded_kinetic_energy_part_J", "eroded_internal_energy_part_J", "contact_energy_part_J",
+    "contact_dissipated_part_J", "energy_error_fraction", "energy_normaliser_part_J",
+    "max_displacement_m", "eroded_elements",
 )
 IMPACT_COLUMNS = ("impactor_velocity_m_per_s", "impactor_displacement_m", "contact_force_full_N",
                   "impactor_nose_ahead_of_intact_m", "intact_material_ahead",
-                  "impactor_kinetic_energy_part_J", "contact_energy_part_J")
+                  "impactor_kinetic_energy_part_J")
 SUMMARY_VERSION = 2  # 2: issue 9's outcome rule and energy keys; older summaries are re-run
 DEFAULT_OUTPUTS = {"history": 1000, "field": 20, "checkpoint": 10}  # per run, if not given
 
@@ -64,7 +66,9 @@ def history_columns(model) -> tuple[str, ...]:
     in a quarter model; × ``symmetry_factor`` of summary.json gives the whole), ``*_full_*``
     of the whole problem; velocities, displacements, fractions and counts need neither.
     ``energy_error_fraction`` = |drift| / ``energy_normaliser_part_J``
-    (solver.explicit.energy_balance)."""
+    (solver.explicit.energy_balance). ``contact_energy_part_J`` is −(work of the contact
+    forces): the penalty springs' energy plus ``contact_dissipated_part_J``, what contact
+    dashpots and friction dissipated."""
     return HISTORY_COLUMNS + (IMPACT_COLUMNS if model.body_params.shape[0] else ())
 
 
@@ -74,8 +78,8 @@ def history_row(model, state: State) -> dict:
     disp = np.sqrt(np.max(np.sum((state.x - model.x0) ** 2, axis=1)))
     impact = {}
     if model.body_params.shape[0]:
-        impact = {**impactor_row(model, state), "impactor_kinetic_energy_part_J":
-                  eb["impactor_kinetic_J"], "contact_energy_part_J": eb["contact_energy_J"]}
+        impact = {**impactor_row(model, state), **intact_material_ahead(model, state),
+                  "impactor_kinetic_energy_part_J": eb["impactor_kinetic_J"]}
     return {
         **impact,
         "time_s": float(state.t), "step": int(state.step), "dt_s": float(state.dt),
@@ -85,6 +89,8 @@ def history_row(model, state: State) -> dict:
         "external_work_part_J": eb["external_work_J"],
         "eroded_kinetic_energy_part_J": eb["eroded_kinetic_J"],
         "eroded_internal_energy_part_J": eb["eroded_internal_J"],
+        "contact_energy_part_J": eb["contact_energy_J"],
+        "contact_dissipated_part_J": eb["contact_dissipated_J"],
         "energy_error_fraction": eb["error_fraction"],
         "energy_normaliser_part_J": eb["normaliser_J"], "max_displacement_m": float(disp),
         "eroded_elements": int(np.sum(state.elem[:, S.E_ALIVE] == 0.0)),

@@ -13,28 +13,31 @@ import matplotlib.pyplot as plt  # noqa: E402
 from wovenimpact.io.atomic import atomic_path  # noqa: E402
 
 
-DAMPING_COLUMNS = ("contact_damping_part_J", "contact_damping_J")  # first one present
+DAMPING_COLUMNS = ("contact_dissipated_part_J", "contact_damping_part_J")  # first present
 
 
 def energy_curves(h: dict, symmetry_factor: float = 1.0) -> dict[str, np.ndarray]:
     """The curves of :func:`energy_plot`, whole-problem values (J): the history's
     modelled-part columns (``*_part_J``) × ``symmetry_factor``.
 
-    Keys: ``structure kinetic``, ``impactor kinetic`` and ``contact energy`` (with an
-    impactor), ``contact damping`` (when the history has it), ``internal work`` with
-    its parts ``stored (live elements)``, ``hourglass (live elements)`` and ``eroded
-    internal (at erosion)``, ``eroded kinetic``, ``external work``, and ``balance
-    error`` = energy_error_fraction × energy_normaliser: exactly the quantity whose
-    largest value summary.json reports as ``energy_error_fraction``, drawn in J.
+    Keys: ``structure kinetic``, ``impactor kinetic`` (with an impactor), ``contact
+    energy`` and its part ``contact dissipated`` (dashpots and friction, when the
+    history has it), ``internal work`` with its parts ``stored (live elements)``,
+    ``hourglass (live elements)`` and ``eroded internal (at erosion)``, ``eroded
+    kinetic``, ``external work``, and ``balance error`` = energy_error_fraction ×
+    energy_normaliser: exactly the quantity whose largest value summary.json reports as
+    ``energy_error_fraction``, drawn in J. The balance is structure kinetic + impactor
+    kinetic + internal work + eroded kinetic − external work + contact energy − initial
+    kinetic energy; parts are not added again.
     """
     f = symmetry_factor
     out = {"structure kinetic": f * h["structure_kinetic_energy_part_J"]}
     if "impactor_kinetic_energy_part_J" in h:
         out["impactor kinetic"] = f * h["impactor_kinetic_energy_part_J"]
-        out["contact energy"] = f * h["contact_energy_part_J"]
+    out["contact energy"] = f * h["contact_energy_part_J"]
     damping = next((c for c in DAMPING_COLUMNS if c in h), None)
     if damping:
-        out["contact damping"] = f * h[damping]
+        out["contact dissipated"] = f * h[damping]
     out["internal work"] = f * h["internal_work_part_J"]
     out["stored (live elements)"] = f * h["stored_energy_part_J"]
     out["hourglass (live elements)"] = f * h["hourglass_energy_part_J"]
@@ -47,15 +50,16 @@ def energy_curves(h: dict, symmetry_factor: float = 1.0) -> dict[str, np.ndarray
 
 def energy_plot(h: dict, path: str | Path, title: str = "", symmetry_factor: float = 1.0) -> Path:
     """Energies of the whole system against time (:func:`energy_curves`, whole-problem
-    values): structure and impactor kinetic energy, internal work and its parts, contact
-    energy (and damping), eroded, external work, and the balance error, with a line at
-    1 % of the initial kinetic energy for scale."""
+    values): structure and impactor kinetic energy, internal work and its parts (dashed),
+    contact energy and what contact dashpots and friction dissipated of it (dashed),
+    eroded, external work, and the balance error, with a line at 1 % of the initial
+    kinetic energy for scale."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     t = h["time_s"] * 1e6
     curves = energy_curves(h, symmetry_factor)
     dashed = {"stored (live elements)", "hourglass (live elements)",
-              "eroded internal (at erosion)"}
+              "eroded internal (at erosion)", "contact dissipated"}
     fig, ax = plt.subplots(figsize=(7.5, 4.6))
     for label, y in curves.items():
         if label == "balance error":

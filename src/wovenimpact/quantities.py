@@ -8,11 +8,11 @@ model, ``kernels.rigid_body.BP_FRACTION``); forces and energies returned here as
 from __future__ import annotations
 
 import math
+import weakref
 
 import numpy as np
 
 from wovenimpact.errors import InputError
-
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as S
 
@@ -76,11 +76,11 @@ def attached_nodes(model, state) -> np.ndarray:
     target) counts all its live material as attached.
 
     The components are recomputed only when the set of live elements changes (one
-    entry is kept, keyed by the model and the alive flags)."""
+    entry is kept: the model, held by a weak reference, and its alive flags)."""
     alive = state.elem[:, S.E_ALIVE] != 0.0
-    key = (id(model), model.n_nodes, hash(alive.tobytes()))
-    hit = _ATTACHED_CACHE.get("key")
-    if hit == key:
+    ref = _ATTACHED_CACHE.get("model")
+    if (ref is not None and ref() is model
+            and np.array_equal(_ATTACHED_CACHE["alive"], alive)):
         return _ATTACHED_CACHE["value"]
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
@@ -100,7 +100,7 @@ def attached_nodes(model, state) -> np.ndarray:
         held = np.unique(label[support & used])
         attached = used & np.isin(label, held)
     _ATTACHED_CACHE.clear()
-    _ATTACHED_CACHE.update(key=key, value=attached)
+    _ATTACHED_CACHE.update(model=weakref.ref(model), alive=alive, value=attached)
     return attached
 
 

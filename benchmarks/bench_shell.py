@@ -1,6 +1,6 @@
 """``make bench``: the explicit step's cost (see :mod:`wovenimpact.benchmark`).
 
-Options: ``--sizes=10000,100000``, ``--kinds=fabric``, ``--threads=1,2``, ``--steps=N``,
+Options: ``--sizes=10000,100000``, ``--kinds=fabric,fabric_reduced``, ``--threads=1,2``, ``--steps=N``,
 ``--json`` (prints {"cases": [{"name", "elements", "threads", "ns_per_element_cycle",
 "shares"}]}). Same as ``wovenimpact bench``.
 """
@@ -17,7 +17,7 @@ from wovenimpact.benchmark import DEFAULT_SIZES, case_line, run_cases
 
 def main() -> None:
     sizes = DEFAULT_SIZES
-    kinds = ("elastic", "fabric")
+    kinds = ("elastic", "fabric", "fabric_reduced")
     thread_counts = sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)})
     steps = 20
     for arg in sys.argv[1:]:

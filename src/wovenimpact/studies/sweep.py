@@ -17,8 +17,10 @@ addressed by its dotted path in the case document::
 Every variant is validated like a case file (a bad value fails that variant, with the
 key named, and the others still run), run in ``OUT/runs/<id>/`` and summarised in
 ``OUT/results.csv`` (and ``OUT/report.html``, linking each run's page). A variant
-whose ``summary.json`` exists with the same parameters
-is not run again (the study resumes). Runs go to a local process pool by default, or
+whose ``summary.json`` exists with the same parameters is not run again (the study
+resumes). For impact runs results.csv always records the ``outcome`` (perforated,
+stopped, undecided, no contact), which the ballistic fits require to be decided. Runs
+go to a local process pool by default, or
 to a Dask cluster when a scheduler address is given.
 
 The local pool's workers are spawned (:func:`wovenimpact.jit.process_pool`), so a
@@ -161,12 +163,18 @@ def warn_once(results: dict[str, dict], total: int) -> None:
 
 
 def finished(out: Path, values: dict) -> dict | None:
-    """The summary of a variant already run with these values, else None."""
+    """The summary of a variant already run with these values, else None (also when the
+    summary was written by an older wovenimpact whose outcome rule or energy keys differ:
+    ``summary_version`` below ``runs.SUMMARY_VERSION``)."""
+    from wovenimpact.runs import SUMMARY_VERSION
+
     try:
         same = json.loads((out / "parameters.json").read_text()) == json.loads(
             json.dumps(values, default=str))
         summary = json.loads((out / "summary.json").read_text())
     except (OSError, ValueError):
+        return None
+    if summary.get("summary_version", 1) < SUMMARY_VERSION:
         return None
     return {"status": "done", **summary} if same else None
 
@@ -225,10 +233,13 @@ def run_study(
                 progress(len(results), len(variants), futures[fut].id, results[futures[fut].id])
     warn_once(results, len(variants))
     rows = []
+    impact = any("outcome" in r for r in results.values())
     for v in variants:
         r = results[v.id]
         row = {"id": v.id, **{k: _short(val) for k, val in v.values.items()},
                "status": r.get("status"), "error": r.get("error", "")}
+        if impact:  # the outcome of an impact run, always recorded (the fits need it)
+            row["outcome"] = r.get("outcome", "")
         for m in info.metrics:
             row[m] = r.get(m, "")
         rows.append(row)

@@ -11,6 +11,7 @@ docs/theory.md §2 (element) and §3 (integration).
 from __future__ import annotations
 
 import hashlib
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -250,7 +251,7 @@ class ShellContactParams:
 
     enabled: bool = True
     beta: float = 0.1
-    damping: float = 1.0
+    damping: float = 0.3
     friction: float = 0.0
     self_contact: bool = False
 
@@ -293,6 +294,8 @@ class Model:
         node_sets, elem_sets: named index arrays (outputs, BCs).
         shell_contact: parameters of the shell–shell contact between the surfaces
             (``ply`` labels the surfaces: plies, element sets or connected parts).
+        release_elems, release_time: elements eroded at ``release_time`` (s) — the
+            tie between a blade's hub part and its fragment (theory §7.2); none by default.
         section_names, material_names: labels for reports.
     """
 
@@ -326,6 +329,8 @@ class Model:
     node_sets: dict = field(default_factory=dict)
     elem_sets: dict = field(default_factory=dict)
     shell_contact: ShellContactParams = ShellContactParams()
+    release_elems: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    release_time: float = math.inf
     section_names: tuple = ()
     material_names: tuple = ()
 
@@ -348,7 +353,8 @@ class Model:
             h.update(str(a.dtype).encode() + str(a.shape).encode())
             h.update(a.tobytes())
         h.update(repr((self.ramp_time, self.alpha, self.erode_dt_fraction,
-                       self.shell_contact)).encode())
+                       self.shell_contact, self.release_time)).encode())
+        h.update(np.ascontiguousarray(self.release_elems).tobytes())
         return h.hexdigest()
 
 
@@ -397,6 +403,15 @@ def material_frame_gradients(x0, quads, warp_direction):
                            X[:, 2] - X[:, 0]], axis=1) / a2[:, None]
     g_grad, g_weight = gauss_gradients(X, Y)
     return grad, area, g_grad, g_weight
+
+
+def release_array(elems, n_elems: int) -> np.ndarray:
+    """The released elements as a sorted int64 array, checked against the mesh."""
+    idx = np.unique(np.asarray([] if elems is None else elems, dtype=np.int64))
+    if idx.size and (idx[0] < 0 or idx[-1] >= n_elems):
+        raise InputError(f"release elements refer to element {int(idx[-1])}; the mesh has "
+                         f"{n_elems}")
+    return idx
 
 
 def gauss_gradients(X, Y):
@@ -456,6 +471,8 @@ def build_model(
     node_sets: dict | None = None,
     elem_sets: dict | None = None,
     shell_contact: ShellContactParams | None = None,
+    release_elems=None,
+    release_time: float = math.inf,
 ) -> Model:
     """Assemble a :class:`Model` from a mesh, named sections and constraints.
 
@@ -474,6 +491,7 @@ def build_model(
         ply: (n_elems,) part index for per-ply outputs; default all 0.
         bodies: rigid impactors.
         shell_contact: shell–shell contact parameters (default ShellContactParams()).
+        release_elems, release_time: elements eroded at that time (a blade's release).
     """
     x0 = np.ascontiguousarray(nodes, dtype=float)
     q = np.ascontiguousarray(quads, dtype=np.int64)
@@ -572,5 +590,6 @@ def build_model(
         body_state0=body_state0,
         node_sets=dict(node_sets or {}), elem_sets=dict(elem_sets or {}),
         shell_contact=shell_contact or ShellContactParams(),
+        release_elems=release_array(release_elems, len(q)), release_time=float(release_time),
         section_names=tuple(names), material_names=tuple(getattr(m, "name", "") for m in mats),
     )

@@ -152,8 +152,24 @@ def stable_step(model, state: State, ws: Workspace, dt_cap: float) -> float:
     return dt
 
 
+def release(model, state: State) -> None:
+    """Erode the model's release elements still alive (a blade's fragment breaking free
+    of its hub part at ``model.release_time``); their energies are booked as eroded
+    internal energy, once. Their nodes left without a live element leave the model in
+    the node update that follows."""
+    idx = model.release_elems
+    live = idx[state.elem[idx, S.E_ALIVE] != 0.0]
+    if not live.size:
+        return
+    state.energy[ERODED_INTERNAL] += float(np.sum(
+        state.elem[live, S.E_U_MEMB] + state.elem[live, S.E_U_BEND] + state.elem[live, S.E_U_HG]))
+    state.elem[live, S.E_ALIVE] = 0.0
+
+
 def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     """Advance ``state`` from t^n to t^{n+1} in place (stages 1–5 of the module docstring)."""
+    if state.t >= model.release_time:
+        release(model, state)
     t0 = time.perf_counter()
     shell_forces(model, state, ws)
     t0 = ws.tick("shell forces", t0)

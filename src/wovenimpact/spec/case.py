@@ -38,7 +38,7 @@ Schema (see README and examples/cases/)::
                       contact_stiffness (penalty factor β of k = β m / Δt²),
                       contact_damping (ζ, fraction of critical; 1), friction (μ; 0)
     [contact]         shell–shell contact: surfaces = plies | parts | element_sets |
-                      none, self_contact, penalty_scale (β; 0.1), damping (ζ; 1),
+                      none, self_contact, penalty_scale (β; 0.1), damping (ζ; 0.3),
                       friction (μ; 0)
     [[initial_erosion]]  centre, radius, plies?: elements eroded at t = 0 (a hole: centroid
                       within radius of the axis through centre along cylinder_axis)
@@ -235,7 +235,7 @@ class ContactSpec(BaseModel):
     surfaces: Literal["plies", "parts", "element_sets", "none"] = "plies"
     self_contact: bool = False
     penalty_scale: quantity("dimensionless", gt=0, le=0.5, example="0.1") = 0.1
-    damping: quantity("dimensionless", ge=0, le=2, example="1") = 1.0
+    damping: quantity("dimensionless", ge=0, le=2, example="0.3") = 0.3
     friction: quantity("dimensionless", ge=0, le=10, example="0.2") = 0.0
 
 

@@ -87,10 +87,12 @@ class MetalElementTestResult:
 
     @property
     def energy_error_fraction(self) -> float:
-        """max |W − (W_e + W_p + W_fail)| / max W over the history."""
+        """max |W − (W_e + W_p)| / max W before failure (the failing step's work is the
+        trapezoid of a stress that drops to zero within it: not a measure of the kernel)."""
         h = self.history
-        w = h["external_work_J_per_m2"]
-        u = h["stored_energy_J_per_m2"] + h["plastic_work_J_per_m2"] + h["failure_energy_J_per_m2"]
+        alive = h["alive"] > 0.0
+        w = h["external_work_J_per_m2"][alive]
+        u = (h["stored_energy_J_per_m2"] + h["plastic_work_J_per_m2"])[alive]
         scale = np.max(np.abs(w)) if w.size else 0.0
         return float(np.max(np.abs(w - u)) / scale) if scale > 0.0 else 0.0
 
@@ -308,3 +310,12 @@ def write_history_csv(result: MetalElementTestResult, path: Path) -> Path:
             w.writerow([repr(float(result.history[n][i])) for n in names])
     tmp.replace(path)
     return path
+
+
+def read_history_csv(path: Path) -> dict[str, np.ndarray]:
+    """Read a history written by :func:`write_history_csv`."""
+    with open(path, newline="") as fh:
+        r = csv.reader(fh)
+        names = next(r)
+        data = np.array([[float(x) for x in row] for row in r])
+    return {n: data[:, j] for j, n in enumerate(names)}

@@ -465,3 +465,15 @@ def test_parameter_row_rejects_elastic_and_long_tables():
     rows = tuple((k * 0.01, 1e8 + k) for k in range(L.N_HARD_MAX + 1))
     with pytest.raises(ValueError, match="at most"):
         j2_parameter_row(dataclasses.replace(material("aluminium"), hardening=rows))
+
+
+def test_layout_shares_columns_with_the_elastic_row_and_the_fabric_state():
+    """A section kernel reads E, ν, ρ, the alive flag and the stored energy of a point the
+    same way for every material kind."""
+    from wovenimpact.kernels import fabric_layout as FL
+    from wovenimpact.kernels import shell_layout as SL
+
+    assert (L.P_E, L.P_NU, L.P_RHO) == (SL.E_MOD, SL.E_NU, SL.E_RHO)
+    assert (L.S_ALIVE, L.S_ENERGY) == (FL.S_ALIVE, FL.S_ENERGY)
+    p = j2_parameter_row(material("aluminium"))
+    assert (p[SL.E_MOD], p[SL.E_NU], p[SL.E_RHO]) == (72e9, 0.32, 2780.0)

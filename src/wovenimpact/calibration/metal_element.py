@@ -119,7 +119,8 @@ class MetalElementTestResult:
         return {
             "test": self.test,
             "material": self.params.name,
-            "max_stress_Pa": float(np.max(h["equivalent_stress_Pa"])),
+            "max_stress_Pa": float(np.max(h["equivalent_stress_Pa"])),  # Cauchy, von Mises
+            "max_kirchhoff_stress_Pa": float(np.max(h["kirchhoff_equivalent_Pa"])),
             "failure_plastic_strain": self.failure_plastic_strain,
             "failure_strain": strain_fail,
             "failure_displacement_m": disp,

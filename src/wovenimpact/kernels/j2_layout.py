@@ -26,14 +26,17 @@ N_HARD_MAX = 64
 N_PARAM = P_HARD + 2 * N_HARD_MAX
 
 # --- state (history variables and outputs of one material point) -------------
+# S_ALIVE and S_ENERGY sit at the same columns as in fabric_layout, so a section
+# kernel reads a point's alive flag and stored energy the same way for both kinds
+# (tests/unit/test_j2_kernel.py checks it).
 S_SIG = 0  # rotated Cauchy stress σ_xx, σ_yy, σ_xy (Pa), Green–Naghdi frame: S_SIG + 0..2
 S_TAU = 3  # rotated Kirchhoff stress τ = J σ (Pa), the variable of the return: S_TAU + 0..2
 S_EPS_P = 6  # ε̄p, equivalent plastic strain (—)
 S_PLASTIC_WORK = 7  # plastic work per unit reference area, cumulative (J/m²)
-S_ENERGY = 8  # elastic stored energy per unit reference area (J/m²), like fabric S_ENERGY
-S_THICK = 9  # λ3 = t / t0, thickness stretch (—)
-S_DAMAGE = 10  # D, Johnson–Cook damage (—), 0 … ≥ 1
-S_ALIVE = 11  # 1.0 until the point fails, then 0.0 for good (fabric S_ALIVE semantics)
+S_THICK = 8  # λ3 = t / t0, thickness stretch (—)
+S_DAMAGE = 9  # D, Johnson–Cook damage (—), 0 … ≥ 1
+S_ALIVE = 10  # 1.0 until the point fails, then 0.0 for good (as fabric_layout.S_ALIVE)
+S_ENERGY = 11  # elastic stored energy per unit reference area (J/m²) (as fabric_layout.S_ENERGY)
 S_RATE = 12  # ε̇p, equivalent plastic strain rate of the last step (1/s)
 S_YIELD = 13  # σ_y, current flow stress (Pa), rate factor included
 S_FAIL_ENERGY = 14  # elastic energy per reference area released when the point failed (J/m²)

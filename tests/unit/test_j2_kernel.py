@@ -366,7 +366,8 @@ def test_damage_accumulates_as_plastic_strain_over_jc_fracture_strain(test, eta,
     r = run_metal_element_test(params, test, n_steps=60, strain_rate=rate)
     h = r.history
     alive = h["alive"] > 0
-    dmg, eps, rt = h["damage"][alive], h["plastic_strain"][alive], h["plastic_strain_rate_per_s"][alive]
+    dmg, eps = h["damage"][alive], h["plastic_strain"][alive]
+    rt = h["plastic_strain_rate_per_s"][alive]
     base = d[0] + d[1] * math.exp(d[2] * eta)
     for k in range(1, dmg.size):
         de = eps[k] - eps[k - 1]

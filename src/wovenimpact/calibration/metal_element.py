@@ -115,7 +115,8 @@ class MetalElementTestResult:
         strain_fail = self.failure_strain
         disp = None
         if strain_fail is not None:
-            disp = ELEMENT_SIDE_M * (strain_fail if self.test == "shear" else math.expm1(strain_fail))
+            grow = strain_fail if self.test == "shear" else math.expm1(strain_fail)
+            disp = ELEMENT_SIDE_M * grow
         return {
             "test": self.test,
             "material": self.params.name,
@@ -251,7 +252,9 @@ def run_metal_element_test(
         raise ValueError(f"test = {test!r} is not valid for a metal: choose one of "
                          f"{', '.join(METAL_TESTS)}")
     if params.kind != "j2_plastic":
-        raise ValueError(f"material {params.name!r} is {params.kind}: element tests need j2_plastic")
+        raise ValueError(
+            f"material {params.name!r} is {params.kind}: element tests need j2_plastic"
+        )
     if n_steps < 1:
         raise ValueError(f"steps = {n_steps} is not valid: it must be ≥ 1")
     strain_max = DEFAULT_STRAIN[test] if strain is None else strain

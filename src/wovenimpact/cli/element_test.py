@@ -170,4 +170,5 @@ def _write_outputs(out: Path, result, write_csv, plot, test: Test, as_json: bool
                     for k, v in summary.items()}, indent=2)
     )
     tmp.replace(out / "summary.json")
-    emit({k: v for k, v in summary.items() if k != "figures"}, as_json, f"element test: {test.value}")
+    shown = {k: v for k, v in summary.items() if k != "figures"}
+    emit(shown, as_json, f"element test: {test.value}")

@@ -478,3 +478,37 @@ def test_layout_shares_columns_with_the_elastic_row_and_the_fabric_state():
     assert (L.S_ALIVE, L.S_ENERGY) == (FL.S_ALIVE, FL.S_ENERGY)
     p = j2_parameter_row(material("aluminium"))
     assert (p[SL.E_MOD], p[SL.E_NU], p[SL.E_RHO]) == (72e9, 0.32, 2780.0)
+
+
+def test_j2_point_called_like_fabric_point_from_a_section_loop():
+    """The shell's calling convention: a shared parameter table (wider than N_PARAM, the
+    J2 row not first), whole state tables, uint64 rows, F as scalars, Δt and t0."""
+    import numba
+
+    from wovenimpact.kernels.j2 import j2_point
+
+    @numba.njit
+    def section(p, m, fo, fn, dt, thick, s_in, s_out, n_out):
+        for k in range(fn.shape[0]):
+            st, c, a, b, c12 = j2_point(
+                p, m, fo[k, 0, 0], fo[k, 0, 1], fo[k, 1, 0], fo[k, 1, 1],
+                fn[k, 0, 0], fn[k, 0, 1], fn[k, 1, 0], fn[k, 1, 1], dt, thick,
+                s_in, s_out, np.uint64(k),
+            )
+            n_out[k, 0], n_out[k, 1], n_out[k, 2] = a, b, c12
+        return 0
+
+    params = material("ti6al4v_johnson_cook")
+    row = j2_parameter_row(params)
+    table = np.zeros((3, L.N_PARAM + 40))
+    table[0, :5] = 7.0  # another material's row
+    table[2, : L.N_PARAM] = row
+    n = 5
+    fo = np.repeat(np.eye(2)[None], n, axis=0)
+    fn = fo + np.linspace(0.0, 0.02, n)[:, None, None] * np.array([[1.0, 0.3], [0.0, -0.4]])
+    s_in = initial_state(params, n)
+    s_out = np.empty_like(s_in)
+    n_out = np.empty((n, 3))
+    section(table, np.uint64(2), fo, fn, 1e-6, T0, s_in, s_out, n_out)
+    ref = update_points(row, fo, fn, s_in, 1e-6, T0)
+    assert np.array_equal(s_out, ref.state) and np.array_equal(n_out, ref.resultant)

@@ -45,7 +45,10 @@ What the caller (the shell section) must do
   + s_out[i, S_PLASTIC_WORK] (dissipated, cumulative)
   + s_out[i, S_FAIL_ENERGY] (elastic energy released when the point failed: book
   it as eroded/failure energy). The three together grow by the step's work.
-- Current thickness t = t0 · s_out[i, S_THICK] (contact offsets, output).
+- Current thickness of the point t = t0 · s_out[i, S_THICK]; of an integrated section
+  t0 Σ_k w_k λ3,k with the through-thickness weights (contact offsets, output).
+- The parameter table may be wider than N_PARAM and hold other kinds' rows: only the
+  columns of j2_layout in row m are read.
 - Erosion: s_out[i, S_ALIVE] == 0 for a failed point; the element erodes when all
   (or a configured count of) its points have S_ALIVE 0.
 - Stable step: the returned stiffness E t0 max(1, J)/(1 − ν²) bounds the membrane

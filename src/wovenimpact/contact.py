@@ -33,7 +33,7 @@ class ShellContact:
     Usage in a time loop (nothing is written to the State; ``out_force`` is the
     caller's array)::
 
-        contact = ShellContact(model, beta=0.1, friction=0.0)        # once
+        contact = ShellContact(model, beta=0.1, damping=1.0, friction=0.0)  # once
         ...
         energy, n_active = contact.forces(state.x, state.v, dt,
                                           state.elem[:, E_ALIVE], state.node_active,
@@ -81,6 +81,8 @@ class ShellContact:
 
     Keyword parameters:
         beta: penalty scale β of k = β min(m_node, m̄_segment) / Δt² (0 < β ≤ 0.5; 0.1).
+        damping: ζ, the pair dashpot as a fraction of critical 2 √(k m_red) (≥ 0;
+            default 1: struck surfaces come to rest on each other, theory §6.3).
         friction: Coulomb coefficient μ ≥ 0 (0: frictionless, the default).
         plies: the plies taking part (default all); or
         elements: the element indices taking part (overrides ``plies``).
@@ -107,6 +109,7 @@ class ShellContact:
         model,
         *,
         beta: float = 0.1,
+        damping: float = 1.0,
         friction: float = 0.0,
         plies=None,
         elements=None,
@@ -119,11 +122,15 @@ class ShellContact:
     ) -> None:
         if not (math.isfinite(beta) and 0.0 < beta <= 0.5):
             raise InputError(f"contact beta = {beta!r}; valid: 0 < β ≤ 0.5 (default 0.1)")
+        if not (math.isfinite(damping) and 0.0 <= damping <= 2.0):
+            raise InputError(f"contact damping = {damping!r}; valid: 0 ≤ ζ ≤ 2 (a fraction of "
+                             "critical damping; default 1)")
         if not (math.isfinite(friction) and friction >= 0.0):
             raise InputError(f"contact friction = {friction!r}; valid: a coefficient μ ≥ 0")
         if not (math.isfinite(margin) and margin >= 0.0):
             raise InputError(f"contact margin = {margin!r} m; valid: ≥ 0")
         self.beta = float(beta)
+        self.damping = float(damping)
         self.friction = float(friction)
         self.self_contact = bool(self_contact)
         self.margin = float(margin)
@@ -260,12 +267,12 @@ class ShellContact:
         penalty_forces(
             x, v, self.quads, self.ply, self.node_mass, self.h_node, self.h_seg, self.margin,
             self.overlap,
-            self.beta, self.friction, float(dt), self.pair_ptr, self.pair_seg, self.geo,
-            self.pair_on, self.pair_f, self.pair_w, self.pair_e, self.node_f,
+            self.beta, self.damping, self.friction, float(dt), self.pair_ptr, self.pair_seg,
+            self.geo, self.pair_on, self.pair_f, self.pair_w, self.pair_e, self.node_f,
         )
         energy, n_active = assemble_contact_forces(
             self.quads, self.pair_ptr, self.pair_seg, self.pair_on, self.pair_f, self.pair_w,
-            self.pair_e, self.node_f, self.seg_ptr, self.seg_entry, self.cursor, out_force,
-            bool(accumulate),
+            self.pair_e, self.node_f, self.seg_ptr, self.seg_entry, self.cursor,
+            out_force, bool(accumulate),
         )
         return float(energy), int(n_active)

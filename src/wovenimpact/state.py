@@ -26,10 +26,12 @@ KINETIC0 = 5  # kinetic energy at t = 0 (nodes and rigid bodies)
 BODY_KINETIC = 6  # kinetic energy of the rigid bodies at the last whole step
 CONTACT_WORK = 7  # work of the contact forces on nodes and bodies (−penalty energy)
 NODE_CONTACT_WORK = 8  # the part of W_EXT done by contact forces on the nodes
-N_ENERGY = 9
+CONTACT_PENALTY = 9  # energy of the contact springs at the last whole step; the rest
+#                      of −CONTACT_WORK was dissipated by contact dashpots and friction
+N_ENERGY = 10
 ENERGY_NAMES = ("internal_work", "external_work", "kinetic", "eroded_kinetic",
                 "eroded_internal", "initial_kinetic", "body_kinetic", "contact_work",
-                "node_contact_work")
+                "node_contact_work", "contact_penalty")
 
 
 @dataclass
@@ -110,8 +112,9 @@ def initial_state(model, velocity=None, angular_velocity=None) -> State:
     w = np.zeros((n, 3)) if angular_velocity is None else np.broadcast_to(
         np.asarray(angular_velocity, dtype=float), (n, 3)).copy()
     elem = np.zeros((ne, S.N_ELEM_STATE))
-    elem[:, S.E_F] = 1.0
-    elem[:, S.E_F + 3] = 1.0
+    for col in (S.E_F, *range(S.E_FG, S.E_FG + 16, 4)):  # F = I at the centre and Gauss points
+        elem[:, col] = 1.0
+        elem[:, col + 3] = 1.0
     elem[:, S.E_ALIVE] = 1.0
     mat = model.section_state0[model.elem_section].copy()
     energy = np.zeros(N_ENERGY)

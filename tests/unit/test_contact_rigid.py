@@ -52,13 +52,51 @@ def test_penalty_force_pushes_nodes_out_along_the_normal():
     axis = np.array([0.0, 0.0, -1.0])  # tail below the tip: the body lies under z = tip
     tip = np.array([0.0, 0.0, -0.1e-3])
     x = np.array([[0.0, 0.0, 0.0], [1e-3, 0.0, 0.0], [5e-3, 0.0, 0.0]])
-    k = np.full(3, 1e6)
     force = np.zeros((3, 3))
     energy = np.zeros(3)
-    rigid_contact_forces(x, np.ones(3, np.int8), np.full(3, 0.25e-3), k, tip, axis,
+    zero = np.zeros(3)
+    # k = β m / Δt² = 1e6 N/m with β = 1, m = 1 kg, Δt = 1 ms; no dashpot, no friction
+    rigid_contact_forces(x, np.zeros((3, 3)), np.ones(3, np.int8), np.ones(3),
+                         np.full(3, 0.25e-3), 1.0, 0.0, 0.0, 1e-3, tip, axis, zero, zero, zero,
                          prof[:, 0], prof[:, 1], 10e-3, force, energy)
     gap = 0.25e-3 - 0.1e-3
     assert force[0] == pytest.approx([0.0, 0.0, 1e6 * gap])
     assert force[1] == pytest.approx([0.0, 0.0, 1e6 * gap])
     assert np.all(force[2] == 0.0)  # beyond the radius: no contact
     assert energy[0] == pytest.approx(0.5 * 1e6 * gap * gap)
+
+
+def test_dashpot_and_friction_act_on_the_velocity_relative_to_the_body():
+    """Nodes on the flat face of a body that moves at V = (1, 0, −3) m/s and spins at
+    ω = 50 rad/s about its axis: the dashpot force is −c v_n n with c = 2 ζ √β m/Δt and
+    v_n the normal velocity relative to the body's surface point (V + ω × r); friction
+    opposes the relative tangential velocity with μ |f_n|, capped at ½ m |v_t|/Δt; the
+    penalty energy is ½ k g²."""
+    imp = Impactor("cylinder", R, 6e-3)
+    prof = imp.profile()
+    axis = np.array([0.0, 0.0, -1.0])
+    tip = np.array([0.0, 0.0, -0.1e-3])
+    centre = tip + 3e-3 * axis
+    x = np.array([[0.0, 0.0, 0.0], [1e-3, 0.0, 0.0]])
+    v = np.array([[0.0, 0.0, -1.0], [0.5, 0.0, -2.0]])
+    body_v = np.array([1.0, 0.0, -3.0])
+    body_w = np.array([0.0, 0.0, 50.0])
+    beta, zeta, mu, dt, m = 0.1, 0.7, 0.3, 1e-7, 2e-6
+    force = np.zeros((2, 3))
+    energy = np.zeros(2)
+    rigid_contact_forces(x, v, np.ones(2, np.int8), np.full(2, m), np.full(2, 0.25e-3), beta,
+                         zeta, mu, dt, tip, axis, body_v, body_w, centre, prof[:, 0],
+                         prof[:, 1], 10e-3, force, energy)
+    k = beta * m / dt**2
+    c = 2.0 * zeta * np.sqrt(beta) * m / dt
+    gap = 0.25e-3 - 0.1e-3
+    n = np.array([0.0, 0.0, 1.0])
+    for i in range(2):
+        v_rel = v[i] - (body_v + np.cross(body_w, x[i] - centre))
+        vn = v_rel @ n
+        f_n = k * gap - c * vn
+        vt = v_rel - vn * n
+        f_t = min(mu * abs(f_n), 0.5 * m * np.linalg.norm(vt) / dt)
+        expect = f_n * n - f_t * vt / np.linalg.norm(vt)
+        assert force[i] == pytest.approx(expect, rel=1e-12)
+        assert energy[i] == pytest.approx(0.5 * k * gap * gap, rel=1e-12)

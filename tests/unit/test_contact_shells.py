@@ -323,10 +323,11 @@ def test_two_free_plies_collide_and_rebound():
     contact forces alone, stepped by central differences (leapfrog, kinetic energy
     ½ m v^{n−1/2}·v^{n+1/2} at whole steps): momentum is conserved to rounding, the
     energy (kinetic + contact) never grows and ends within 3 % of the start, the
-    penetration stays a small fraction of the offsets and each ply rebounds at ≈ ∓V."""
+    penetration stays a small fraction of the offsets and each ply rebounds at ≈ ∓V
+    (undamped contact, ζ = 0)."""
     t, V = 0.5e-3, 20.0
     mesh, model = plies_model(spacing=t + 0.05e-3, thickness=t)
-    contact = ShellContact(model, remove_initial_overlap=False)
+    contact = ShellContact(model, damping=0.0, remove_initial_overlap=False)
     dt = 2e-8
     x = model.x0.copy()
     v = np.zeros_like(x)
@@ -359,3 +360,42 @@ def test_two_free_plies_collide_and_rebound():
     m_top = model.node_mass[top]
     assert (m_top * v[top, 2]).sum() / m_top.sum() == pytest.approx(V, rel=0.02)
     assert np.all(v[top, 2] > 0.9 * V) and np.all(v[bot, 2] < -0.9 * V)
+
+
+def test_damped_plies_collide_plastically():
+    """The same collision with the pair dashpots: the restitution e (relative velocity
+    after / before) falls as the damping ζ grows — about 1 undamped, below 1 % at
+    ζ = 1 (a plastic impact: the plies come to rest on each other) — momentum stays
+    zero to rounding, and the energy never grows (kinetic + penalty ≤ the initial)."""
+    t, V = 0.5e-3, 20.0
+    mesh, model = plies_model(spacing=t + 0.05e-3, thickness=t)
+    top = mesh.node_sets["ply1"]
+    bot = mesh.node_sets["ply0"]
+    m = model.node_mass[:, None]
+    m_top = model.node_mass[top]
+    alive = np.ones(model.n_elems)
+    active = np.ones(model.n_nodes, dtype=np.int8)
+    dt = 2e-8
+    restitution = []
+    for zeta in (0.0, 0.05, 0.15, 0.3, 1.0):
+        contact = ShellContact(model, damping=zeta, remove_initial_overlap=False)
+        x = model.x0.copy()
+        v = np.zeros_like(x)
+        v[top, 2] = -V
+        v[bot, 2] = V
+        ke0 = 0.5 * (m * v * v).sum()
+        f = np.zeros_like(x)
+        for _ in range(400):
+            x += dt * v
+            energy, _ = contact.forces(x, v, dt, alive, active, f)
+            v_new = v + dt * f / m
+            assert 0.5 * (m * v * v_new).sum() + energy <= ke0 * (1 + 1e-12)
+            v = v_new
+        np.testing.assert_allclose((m * v).sum(axis=0), 0.0, atol=1e-12 * np.abs(m * V).sum())
+        v_top = (m_top * v[top, 2]).sum() / m_top.sum()
+        v_bot = (m_top * v[bot, 2]).sum() / m_top.sum()
+        restitution.append((v_top - v_bot) / (2 * V))
+    print(f"\nrestitution for ζ = 0, 0.05, 0.15, 0.3, 1: {np.round(restitution, 4).tolist()}")
+    assert restitution[0] > 0.97
+    assert all(a > b for a, b in zip(restitution, restitution[1:]))
+    assert abs(restitution[-1]) < 0.01

@@ -424,8 +424,10 @@ def test_integrated_elastic_section_bends_like_the_resultant_section():
 
 
 def test_integrated_fabric_section_pulled_in_plane_matches_the_resultant_section():
-    """With no curvature every point of an integrated fabric section sees the same F:
-    a strip pulled along the warp gives the same tensions with 1 or 5 points."""
+    """With no curvature every through-thickness point of an integrated fabric section
+    sees the F of its in-plane point: a strip pulled along the warp gives the same
+    tensions with 1 or 5 points (state blocks: 2×2 in-plane points × n through the
+    thickness)."""
     from tests.conftest import reference_fabric
 
     fab = reference_fabric()
@@ -445,8 +447,8 @@ def test_integrated_fabric_section_pulled_in_plane_matches_the_resultant_section
             step(model, st, ws)
         curves.append(st.mat[:, FL.S_TENSION].copy())
         if points == 5:
-            per_point = st.mat[:, FL.S_TENSION::FL.N_STATE]
-            assert np.allclose(per_point, per_point[:, :1], rtol=1e-9)
+            per_point = st.mat[:, FL.S_TENSION::FL.N_STATE].reshape(len(quads), 4, 5)
+            assert np.allclose(per_point, per_point[:, :, :1], rtol=1e-9)
     print(f"\nintegrated fabric section: T_w {curves[1]} N vs resultant {curves[0]} N")
     assert curves[0].max() > 10.0
     assert np.allclose(curves[1], curves[0], rtol=1e-9)

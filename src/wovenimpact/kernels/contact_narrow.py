@@ -25,17 +25,25 @@ Gap and penalty, for a kept pair of node p and segment s:
 
     g = d − (h_p + h_s − o_p),    d = |p − x_c|,
     k = β · min(m_p, m̄_s) / Δt²,  m̄_s = ¼ Σ_I m_I (mean nodal mass of s),
-    f_n = −k g n  on the node when g < 0,  energy ½ k g²,
+    c = min(2 ζ √(k m_red), ½ m_red/Δt),   m_red = m_p m̄_s / (m_p + m̄_s),
+    f_n = (−k g − c v_n) n  on the node when g < 0,  energy ½ k g²,
 
 h the half-thicknesses (shell offsets) and o_p the node's initial-overlap
 allowance (``initial_overlap``; 0 if unused). With β ≤ ½ the pair's frequency obeys
 ω² Δt² = β min(m_p, m̄_s)(1/m_p + 1/m̄_s) ≤ 2β ≤ 1 < 4: contact never limits the
 stable step.
 
-Friction (Coulomb, optional, stateless): with the relative velocity of the node and
-the closest point v_r = v_p − Σ N_I(ξ, η) v_I and its tangential part v_t,
+with v_n = v_r · n the normal part of the velocity of the node relative to the closest
+point, v_r = v_p − Σ N_I(ξ, η) v_I, and ζ the damping as a fraction of critical (the
+dashpot acts while the pair overlaps, also as it separates: with ζ ≥ 1 struck
+surfaces come to rest on each other, a plastic impact, instead of bouncing apart at
+twice the speed). The cap keeps the explicit dashpot stable: a node and a segment
+over it are paired twice (both passes), and together the two pairs then remove at most
+the relative normal velocity in one step — the plastic impact.
 
-    f_t = −min(μ |f_n|, ½ m_red |v_t| / Δt) v_t / |v_t|,   m_red = m_p m̄_s / (m_p + m̄_s):
+Friction (Coulomb, optional, stateless): with the tangential part v_t of v_r,
+
+    f_t = −min(μ |f_n|, ½ m_red |v_t| / Δt) v_t / |v_t|:
 
 kinetic friction, regularised near sticking by a cap that removes at most half the
 relative tangential velocity in one step (no spring memory, so no true stick).
@@ -230,7 +238,7 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, pair_ptr, pair_
 
 @loop_kernel
 def penalty_forces(
-    x, v, quads, ply, node_mass, h_node, h_seg, margin, overlap, beta, mu, dt,
+    x, v, quads, ply, node_mass, h_node, h_seg, margin, overlap, beta, zeta, mu, dt,
     pair_ptr, pair_seg, geo, pair_on, pair_f, pair_w, pair_e, node_f,
 ):
     """Penalty (and friction) force of every candidate pair (module docstring).
@@ -240,7 +248,8 @@ def penalty_forces(
         quads, ply: segments and their plies; node_mass: (n_nodes,) lumped masses.
         h_node, h_seg: node and segment offsets (m); margin: the search margin m (m);
         overlap: (n_nodes,) o_p (m).
-        beta: penalty scale β; mu: friction coefficient μ (0: frictionless).
+        beta: penalty scale β; zeta: damping ζ (fraction of critical); mu: friction
+            coefficient μ (0: frictionless).
         dt: the time step the forces are for (s), > 0.
         pair_ptr, pair_seg: candidates (contact_broad.find_candidates).
         geo: (capacity, N_GEO), pair_on: (capacity,) int8: scratch / written.
@@ -276,22 +285,28 @@ def penalty_forces(
             m_p = node_mass[p]
             m_s = 0.25 * (node_mass[q0] + node_mass[q1] + node_mass[q2] + node_mass[q3])
             k_pen = beta * min(m_p, m_s) * inv_dt2
-            f_n = -k_pen * g
+            m_red = m_p * m_s / (m_p + m_s)
             nx, ny, nz = geo[k, GEO_N], geo[k, GEO_N + 1], geo[k, GEO_N + 2]
-            gx, gy, gz = f_n * nx, f_n * ny, f_n * nz
-            if mu > 0.0:
+            if zeta > 0.0 or mu > 0.0:
                 vx = v[p, 0] - (n1 * v[q0, 0] + n2 * v[q1, 0] + n3 * v[q2, 0] + n4 * v[q3, 0])
                 vy = v[p, 1] - (n1 * v[q0, 1] + n2 * v[q1, 1] + n3 * v[q2, 1] + n4 * v[q3, 1])
                 vz = v[p, 2] - (n1 * v[q0, 2] + n2 * v[q1, 2] + n3 * v[q2, 2] + n4 * v[q3, 2])
                 vn = vx * nx + vy * ny + vz * nz
+            else:
+                vx = vy = vz = vn = 0.0
+            # at most ½ m_red/Δt: the two passes of a pair then remove at most its whole
+            # relative normal velocity in one step (a stable explicit dashpot)
+            c_pen = min(2.0 * zeta * math.sqrt(k_pen * m_red), 0.5 * m_red / dt)
+            f_n = -k_pen * g - c_pen * vn
+            gx, gy, gz = f_n * nx, f_n * ny, f_n * nz
+            if mu > 0.0:
                 tx, ty, tz = vx - vn * nx, vy - vn * ny, vz - vn * nz
                 vt = math.sqrt(tx * tx + ty * ty + tz * tz)
                 if vt > 0.0:
-                    m_red = m_p * m_s / (m_p + m_s)
-                    f_t = min(mu * f_n, 0.5 * m_red * vt / dt) / vt
-                    gx -= f_t * tx
-                    gy -= f_t * ty
-                    gz -= f_t * tz
+                    f_t = min(mu * abs(f_n), 0.5 * m_red * vt / dt)
+                    gx -= f_t * tx / vt
+                    gy -= f_t * ty / vt
+                    gz -= f_t * tz / vt
             pair_f[k, 0] = gx
             pair_f[k, 1] = gy
             pair_f[k, 2] = gz

@@ -5,7 +5,8 @@ the tail on the axis, ζ along the unit axis a from the tip at c). A node at p h
 axial coordinate ζ = (p − c)·a and radius ρ = |p − c − ζ a|; its signed distance to
 the body is the 2-D distance from (ζ, ρ) to the profile, negative inside. With the
 shell half-thickness h as offset, the node is in contact when d < h and receives the
-penalty force f = k (h − d) n along the outward surface normal n (frictionless).
+penalty force f = k (h − d) n along the outward surface normal n, a dashpot on the
+normal relative velocity and optional Coulomb friction (``rigid_contact_forces``).
 ``profile_distance`` is one point; ``rigid_contact_forces`` loops over the nodes
 (each writes its own row; the body's resultant is summed by the caller).
 """
@@ -59,15 +60,33 @@ def profile_distance(zeta, rho, prof_z, prof_r):
 
 @loop_kernel
 def rigid_contact_forces(
-    x, node_active, offset, stiffness, tip, axis, prof_z, prof_r, reach, force, energy
+    x, v, node_active, node_mass, offset, beta, zeta, mu, dt, tip, axis, body_v, body_w,
+    body_c, prof_z, prof_r, reach, force, energy,
 ):
-    """Penalty forces on the nodes from a rigid body of revolution.
+    """Penalty, damping and friction forces on the nodes from a rigid body of revolution.
+
+    For a node with gap g = h − d > 0 (h its offset, d its signed distance to the body),
+    outward normal n and velocity relative to the body's surface point
+    v_r = v − (V + ω × (p − c)), split into v_n = v_r·n and v_t = v_r − v_n n:
+
+        k = β m / Δt²,  c = min(2 ζ √(k m), m/Δt) = min(2 ζ √β, 1) m / Δt
+                                (ζ: fraction of critical; the cap removes at most the
+                                 whole relative normal velocity in one step)
+        f_n = k g − c v_n                  (along n; the dashpot also acts while the
+                                            node recedes inside the gap: no rebound)
+        f_t = −min(μ |f_n|, ½ m |v_t| / Δt) v_t/|v_t|   (Coulomb, capped near sticking)
+
+    (theory §6.2). With ζ ≥ 1 a node struck by a face comes to rest on it (a plastic
+    impact, the face's speed) instead of leaving at twice its speed.
 
     Args:
-        x: (n, 3) node positions; node_active: (n,) 0 for eroded nodes.
-        offset: (n,) contact offset of each node (shell half-thickness, m).
-        stiffness: (n,) penalty stiffness of each node (N/m).
+        x, v: (n, 3) node positions x^n and velocities v^{n−1/2}.
+        node_active: (n,) 0 for nodes that take no contact (eroded).
+        node_mass: (n,) lumped masses (kg); offset: (n,) contact offsets h (m).
+        beta, zeta, mu: penalty scale β, damping ζ, friction coefficient μ.
+        dt: the step the forces are for (s).
         tip, axis: (3,) nose-tip position and unit axis (tip → tail).
+        body_v, body_w, body_c: (3,) the body's velocity, global spin and centre of mass.
         prof_z, prof_r: meridian profile polyline.
         reach: bounding radius of the body about its tip plus the largest offset (m),
             nodes farther are skipped.
@@ -76,6 +95,7 @@ def rigid_contact_forces(
     """
     n = x.shape[0]
     length = prof_z[prof_z.shape[0] - 1]
+    c_factor = min(2.0 * zeta * math.sqrt(beta), 1.0)
     for i in prange(n):
         force[i, 0] = 0.0
         force[i, 1] = 0.0
@@ -84,14 +104,14 @@ def rigid_contact_forces(
         if node_active[i] == 0:
             continue
         px, py, pz = x[i, 0] - tip[0], x[i, 1] - tip[1], x[i, 2] - tip[2]
-        zeta = px * axis[0] + py * axis[1] + pz * axis[2]
-        if zeta < -reach or zeta > length + reach:
+        zeta_ax = px * axis[0] + py * axis[1] + pz * axis[2]
+        if zeta_ax < -reach or zeta_ax > length + reach:
             continue
-        qx, qy, qz = px - zeta * axis[0], py - zeta * axis[1], pz - zeta * axis[2]
+        qx, qy, qz = px - zeta_ax * axis[0], py - zeta_ax * axis[1], pz - zeta_ax * axis[2]
         rho = math.sqrt(qx * qx + qy * qy + qz * qz)
         if rho > reach:
             continue
-        d, nz, nr = profile_distance(zeta, rho, prof_z, prof_r)
+        d, nz, nr = profile_distance(zeta_ax, rho, prof_z, prof_r)
         gap = offset[i] - d
         if gap <= 0.0:
             continue
@@ -99,8 +119,29 @@ def rigid_contact_forces(
             ex, ey, ez = qx / rho, qy / rho, qz / rho
         else:  # on the axis: only the axial part of the normal is defined
             ex = ey = ez = 0.0
-        f = stiffness[i] * gap
-        force[i, 0] = f * (nz * axis[0] + nr * ex)
-        force[i, 1] = f * (nz * axis[1] + nr * ey)
-        force[i, 2] = f * (nz * axis[2] + nr * ez)
-        energy[i] = 0.5 * stiffness[i] * gap * gap
+        nx = nz * axis[0] + nr * ex
+        ny = nz * axis[1] + nr * ey
+        nzz = nz * axis[2] + nr * ez
+        m = node_mass[i]
+        k = beta * m / (dt * dt)
+        c = c_factor * m / dt
+        # velocity of the node relative to the body's material point at it
+        ax_, ay_, az_ = x[i, 0] - body_c[0], x[i, 1] - body_c[1], x[i, 2] - body_c[2]
+        vrx = v[i, 0] - (body_v[0] + body_w[1] * az_ - body_w[2] * ay_)
+        vry = v[i, 1] - (body_v[1] + body_w[2] * ax_ - body_w[0] * az_)
+        vrz = v[i, 2] - (body_v[2] + body_w[0] * ay_ - body_w[1] * ax_)
+        vn = vrx * nx + vry * ny + vrz * nzz
+        f = k * gap - c * vn
+        fx, fy, fz = f * nx, f * ny, f * nzz
+        if mu > 0.0:
+            tx, ty, tz = vrx - vn * nx, vry - vn * ny, vrz - vn * nzz
+            vt = math.sqrt(tx * tx + ty * ty + tz * tz)
+            if vt > 0.0:
+                f_t = min(mu * abs(f), 0.5 * m * vt / dt)
+                fx -= f_t * tx / vt
+                fy -= f_t * ty / vt
+                fz -= f_t * tz / vt
+        force[i, 0] = fx
+        force[i, 1] = fy
+        force[i, 2] = fz
+        energy[i] = 0.5 * k * gap * gap

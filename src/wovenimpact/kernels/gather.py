@@ -11,7 +11,7 @@ from __future__ import annotations
 import numpy as np
 from numba import prange
 
-from wovenimpact.jit import inline_kernel, loop_kernel
+from wovenimpact.jit import inline_kernel, kernel, loop_kernel
 
 
 @inline_kernel
@@ -60,3 +60,25 @@ def gather_nodal_forces(node_ptr, node_elem, node_corner, blocks, alive, out, li
         out[n, 4] = f4
         out[n, 5] = f5
         live_count[n] = live
+
+
+@loop_kernel
+def nodes_with_live_elements(node_ptr, node_elem, alive, node_active, out):
+    """out[n] = 1 if node n is active and has a live element (``alive``, uint8 per
+    element), else 0: the nodes that survive this step's erosion."""
+    nn = node_ptr.shape[0] - 1
+    for n in prange(nn):
+        live = 0
+        if node_active[n] != 0:
+            for k in range(node_ptr[n], node_ptr[n + 1]):
+                live += alive[node_elem[k]]
+        out[n] = 1 if live > 0 else 0
+
+
+@kernel
+def node_sum(values):
+    """Σ values[n] in node order (serial, deterministic; no BLAS threads)."""
+    s = 0.0
+    for n in range(values.shape[0]):
+        s += values[n]
+    return s

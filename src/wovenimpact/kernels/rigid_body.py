@@ -37,7 +37,9 @@ BP_REACH = 5  # radius of a sphere about the tip enclosing the body (m)
 BP_NPTS = 6  # number of profile points used in Model.body_profiles
 BP_AXIAL_ONLY = 7  # 1: the body moves along its axis only (symmetry planes through it)
 BP_FRACTION = 8  # share of the body in the model (0.25 in a quarter model)
-N_BODY_PARAM = 9
+BP_DAMPING = 9  # contact damping ζ, fraction of critical of each node–body pair
+BP_FRICTION = 10  # Coulomb coefficient μ between the body and the nodes
+N_BODY_PARAM = 11
 
 
 @kernel

@@ -46,6 +46,7 @@ from wovenimpact.kernels.shell_layout import (
     C_BEND_E,
     C_BEND_NU,
     C_HOURGLASS,
+    C_INPLANE,
     C_MAT,
     C_POINTS,
     C_SHEAR_G,
@@ -54,6 +55,7 @@ from wovenimpact.kernels.shell_layout import (
     E_ALIVE,
     E_DT,
     E_F,
+    E_FG,
     E_HG,
     E_KAPPA,
     E_M,
@@ -69,6 +71,7 @@ from wovenimpact.kernels.shell_layout import (
     EL_NAN,
     EL_OK,
     MAT_FABRIC,
+    MEMBRANE_FULL,
     N_ELEM_STATE,
 )
 
@@ -213,54 +216,75 @@ def through_thickness_f(z, kx, ky, kxy2, f11, f12, f21, f22):
 
 
 @kernel
-def integrated_section(
-    e, n_pts, thick, kind, mat_params, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22,
-    ko_x, ko_y, ko_xy2, k_x, k_y, k_xy2, m_in, m_out,
-):
-    """The material at n Simpson points z_k through the thickness (theory §4).
+def point_response(kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, thick,
+                   rows_in, rows_out, row):
+    """The material at one point: F_old → F_new (o.., g..), dispatched on its kind.
 
-    Point k sees F_k = (I + z_k κ̂) F; its resultant N_k (force per length of the
-    whole section) is weighted by the Simpson weights w_k (Σ w_k = 1):
-    N = Σ w_k N_k, M = Σ w_k z_k N_k (exact for the bending of a linear material).
-    The fabric points' states are consecutive blocks of the element's material row.
+    Fabric points keep their state in row ``row`` of the material rows (the
+    crossover kernel); elastic points have none.
 
     Returns:
-        (status, eroded, C_m, W, N_xx, N_yy, N_xy, M_xx, M_yy, M_xy): status 0 if
-        every point updated; eroded if every point is eroded; the largest membrane
-        tangent; stored energy per reference area Σ w_k W_k.
+        (status, alive, C_m, W, N_xx, N_yy, N_xy): 0 if the point updated; False once
+        the point has eroded; its membrane tangent bound (N/m); stored energy per
+        reference area (J/m²); the resultant N (force per current length of the whole
+        section).
+    """
+    if kind == MAT_FABRIC:
+        st, c, a, b, c12 = fabric_point(
+            mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, rows_in, rows_out, row
+        )
+        if st != 0:
+            return st, False, 0.0, 0.0, 0.0, 0.0, 0.0
+        return 0, rows_out[row, FL.S_ALIVE] != 0.0, c, rows_out[row, FL.S_ENERGY], a, b, c12
+    energy, c, a, b, c12 = elastic_membrane(
+        g11, g12, g21, g22, mat_params[m, E_MOD], mat_params[m, E_NU], thick
+    )
+    return 0, True, c, energy, a, b, c12
+
+
+@kernel
+def section_response(
+    n_pts, thick, kind, mat_params, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22,
+    ko_x, ko_y, ko_xy2, k_x, k_y, k_xy2, rows_in, rows_out, row0,
+):
+    """The section at one in-plane point: its n through-thickness points (theory §4).
+
+    n = 1: the mid-surface point alone (resultant section; the caller adds M = D κ).
+    n ≥ 3 (odd): Simpson points z_k; point k sees F_k = (I + z_k κ̂) F and its resultant
+    N_k (force per length of the whole section) is weighted by the Simpson weights w_k
+    (Σ w_k = 1): N = Σ w_k N_k, M = Σ w_k z_k N_k (exact for the bending of a linear
+    material). Point k's state is row ``row0 + k`` of the material rows.
+
+    Returns:
+        (status, n_alive, C_m, W, N_xx, N_yy, N_xy, M_xx, M_yy, M_xy): status 0 if
+        every point updated (else the first failure's code); the points not eroded;
+        the largest membrane tangent; stored energy per reference area Σ w_k W_k.
     """
     n_xx = n_yy = n_xy = 0.0
     mxx = myy = mxy = 0.0
     w_sum = 0.0
     c_max = 0.0
     alive = 0
-    fabric = kind == MAT_FABRIC
-    if fabric:
-        blocks = m_in.shape[1] // FL.N_STATE
-        rows_in = m_in.reshape((m_in.shape[0] * blocks, FL.N_STATE))
-        rows_out = m_out.reshape((m_out.shape[0] * blocks, FL.N_STATE))
-    h = thick / (n_pts - 1)
+    h = thick / (n_pts - 1) if n_pts > 1 else 0.0
     for k in range(n_pts):
-        z = -0.5 * thick + k * h
-        w = (1.0 if k == 0 or k == n_pts - 1 else (4.0 if k % 2 == 1 else 2.0)) / (3.0 * (n_pts - 1))
+        if n_pts == 1:
+            z = 0.0
+            w = 1.0
+        else:
+            z = -0.5 * thick + k * h
+            w = (1.0 if k == 0 or k == n_pts - 1 else (4.0 if k % 2 == 1 else 2.0)) / (
+                3.0 * (n_pts - 1))
         g11, g12, g21, g22 = through_thickness_f(z, k_x, k_y, k_xy2, f11, f12, f21, f22)
         if g11 * g22 - g12 * g21 <= 0.0:
-            return 1, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-        if fabric:
-            o11, o12, o21, o22 = through_thickness_f(z, ko_x, ko_y, ko_xy2, fo11, fo12, fo21, fo22)
-            row = e * np.uint64(blocks) + np.uint64(k)
-            st, c, a, b, c12 = fabric_point(
-                mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, rows_in, rows_out, row
-            )
-            if st != 0:
-                return st, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-            energy = rows_out[row, FL.S_ENERGY]
-            if rows_out[row, FL.S_ALIVE] != 0.0:
-                alive += 1
-        else:
-            energy, c, a, b, c12 = elastic_membrane(
-                g11, g12, g21, g22, mat_params[m, E_MOD], mat_params[m, E_NU], thick
-            )
+            return EL_INVERTED, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        o11, o12, o21, o22 = through_thickness_f(z, ko_x, ko_y, ko_xy2, fo11, fo12, fo21, fo22)
+        st, live, c, energy, a, b, c12 = point_response(
+            kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, thick,
+            rows_in, rows_out, row0 + np.uint64(k),
+        )
+        if st != 0:
+            return EL_MATERIAL, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        if live:
             alive += 1
         n_xx += w * a
         n_yy += w * b
@@ -270,13 +294,108 @@ def integrated_section(
         mxy += w * z * c12
         w_sum += w * energy
         c_max = max(c_max, c)
-    return 0, alive == 0, c_max, w_sum, n_xx, n_yy, n_xy, mxx, myy, mxy
+    return 0, alive, c_max, w_sum, n_xx, n_yy, n_xy, mxx, myy, mxy
+
+
+@kernel
+def first_piola(n11, n22, n12, f11, f12, f21, f22):
+    """P = J N F⁻ᵀ (force per reference length) from the Cauchy resultant N and F;
+    F⁻ᵀ = [[f22, −f21], [−f12, f11]] / J. Returns (P11, P12, P21, P22)."""
+    return (n11 * f22 - n12 * f12, -n11 * f21 + n12 * f11,
+            n12 * f22 - n22 * f12, -n12 * f21 + n22 * f11)
+
+
+@kernel
+def sync_yarn_damage(rows_out, row0, n_pts):
+    """Yarn failure is an element's, not a Gauss point's (theory §4.5): the element is
+    about one crossover cell, so a family broken at one of its 2×2 points is broken
+    in all of them (d_i = max over the points, per through-thickness level)."""
+    for k in range(n_pts):
+        for fam in range(2):
+            d = 0.0
+            for g in range(4):
+                d = max(d, rows_out[row0 + np.uint64(g * n_pts + k), FL.S_DAMAGE + fam])
+            for g in range(4):
+                rows_out[row0 + np.uint64(g * n_pts + k), FL.S_DAMAGE + fam] = d
+
+
+@kernel
+def full_membrane(
+    e, lx, ly, gauss_grad, gauss_weight, a0, n_pts, thick, kind, mat_params, m, el_in, el_out,
+    ko_x, ko_y, ko_xy2, k_x, k_y, k_xy2, rows_in, rows_out, row0,
+):
+    """Fully integrated membrane: the section at the 2×2 Gauss points (theory §4.5).
+
+    At point g (reference gradients G_g = ∂N/∂X, weight w_g = det J, Σ w_g = A0):
+    F_g = Σ_I x̂_I ⊗ G_gI in the corotational frame, the section's response N_g, M_g
+    (:func:`section_response`, its state rows ``row0 + g n_pts + k``), and the corner
+    forces f̂_I = Σ_g w_g P_g G_gI with P_g = J_g N_g F_g⁻ᵀ; stored energy Σ_g w_g W_g.
+    F_g of the step is kept in the element state (``E_FG``) for the next one. Fabric
+    yarn damage is shared by the element's points (:func:`sync_yarn_damage`).
+
+    Returns:
+        (status, eroded, C_m, U, N̄_xx, N̄_yy, N̄_xy, M̄_xx, M̄_yy, M̄_xy, (f̂x_I), (f̂y_I)):
+        eroded once a point's whole section has eroded; C_m the largest tangent; U the
+        stored energy (J); N̄, M̄ the area averages; the in-plane corner forces.
+    """
+    fx = (0.0, 0.0, 0.0, 0.0)
+    fy = (0.0, 0.0, 0.0, 0.0)
+    u = c_max = 0.0
+    n_xx = n_yy = n_xy = m_xx = m_yy = m_xy = 0.0
+    eroded = False
+    for g in range(4):
+        q1 = (gauss_grad[e, g, 0, 0], gauss_grad[e, g, 0, 1], gauss_grad[e, g, 0, 2],
+              gauss_grad[e, g, 0, 3])
+        q2 = (gauss_grad[e, g, 1, 0], gauss_grad[e, g, 1, 1], gauss_grad[e, g, 1, 2],
+              gauss_grad[e, g, 1, 3])
+        f11 = lx[0] * q1[0] + lx[1] * q1[1] + lx[2] * q1[2] + lx[3] * q1[3]
+        f12 = lx[0] * q2[0] + lx[1] * q2[1] + lx[2] * q2[2] + lx[3] * q2[3]
+        f21 = ly[0] * q1[0] + ly[1] * q1[1] + ly[2] * q1[2] + ly[3] * q1[3]
+        f22 = ly[0] * q2[0] + ly[1] * q2[1] + ly[2] * q2[2] + ly[3] * q2[3]
+        det = f11 * f22 - f12 * f21
+        if not (det > 0.0):
+            st = EL_NAN if not math.isfinite(det) else EL_INVERTED
+            return st, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, fx, fy
+        col = E_FG + 4 * g
+        st, n_alive, c, w, a, b, c12, ma, mb, mc = section_response(
+            n_pts, thick, kind, mat_params, m,
+            el_in[e, col], el_in[e, col + 1], el_in[e, col + 2], el_in[e, col + 3],
+            f11, f12, f21, f22, ko_x, ko_y, ko_xy2, k_x, k_y, k_xy2,
+            rows_in, rows_out, row0 + np.uint64(g * n_pts),
+        )
+        if st != 0:
+            return st, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, fx, fy
+        el_out[e, col] = f11
+        el_out[e, col + 1] = f12
+        el_out[e, col + 2] = f21
+        el_out[e, col + 3] = f22
+        if n_alive == 0:
+            eroded = True
+        wg = gauss_weight[e, g]
+        u += wg * w
+        c_max = max(c_max, c)
+        n_xx += wg * a
+        n_yy += wg * b
+        n_xy += wg * c12
+        m_xx += wg * ma
+        m_yy += wg * mb
+        m_xy += wg * mc
+        p11, p12, p21, p22 = first_piola(a, b, c12, f11, f12, f21, f22)
+        fx = (fx[0] + wg * (p11 * q1[0] + p12 * q2[0]), fx[1] + wg * (p11 * q1[1] + p12 * q2[1]),
+              fx[2] + wg * (p11 * q1[2] + p12 * q2[2]), fx[3] + wg * (p11 * q1[3] + p12 * q2[3]))
+        fy = (fy[0] + wg * (p21 * q1[0] + p22 * q2[0]), fy[1] + wg * (p21 * q1[1] + p22 * q2[1]),
+              fy[2] + wg * (p21 * q1[2] + p22 * q2[2]), fy[3] + wg * (p21 * q1[3] + p22 * q2[3]))
+    if kind == MAT_FABRIC:
+        sync_yarn_damage(rows_out, row0, n_pts)
+    inv = 1.0 / a0
+    return (0, eroded, c_max, u, n_xx * inv, n_yy * inv, n_xy * inv, m_xx * inv, m_yy * inv,
+            m_xy * inv, fx, fy)
 
 
 @kernel
 def shell_force(
-    e, x, v, omega, dt, quads, area0, ref_grad, sec, sections, mat_kind, mat_params,
-    el_in, el_out, m_in, m_out, blocks,
+    e, x, v, omega, dt, quads, area0, ref_grad, gauss_grad, gauss_weight, sec, sections,
+    mat_kind, mat_params, el_in, el_out, rows_in, rows_out, point_blocks, blocks,
 ):
     """Internal forces of shell element e at x^n (see the module docstring).
 
@@ -285,11 +404,13 @@ def shell_force(
         x, v, omega: (n_nodes, 3) positions x^n, velocities v^{n−1/2}, spins ω^{n−1/2}.
         dt: Δt^{n−1/2}, the step the rates act over (0 at the start).
         quads: (n_elems, 4) node indices; area0: (n_elems,) reference areas A0;
-            ref_grad: (n_elems, 2, 4) ∂N_I/∂X in the material frame.
+            ref_grad: (n_elems, 2, 4) ∂N_I/∂X in the material frame (centre);
+            gauss_grad, gauss_weight: the same at the 2×2 Gauss points, and det J.
         sec: the element's row of sections (unsigned); mat_kind, mat_params: material kinds and
             parameter table (row int(sections[sec, C_MAT])).
         el_in, el_out: element state tables (shell_layout), start / end of step.
-        m_in, m_out: material state tables, start / end of step.
+        rows_in, rows_out: material point states, start / end of step, one row per
+            point: element e owns rows e·point_blocks … + point_blocks − 1.
         blocks: (n_elems, 4, 6), row e written: forces (global, N) and moments
             (global, N·m) per corner, the internal (resisting) forces.
 
@@ -298,8 +419,9 @@ def shell_force(
     """
     for j in range(N_ELEM_STATE):
         el_out[e, j] = el_in[e, j]
-    for j in range(m_in.shape[1]):
-        m_out[e, j] = m_in[e, j]
+    for r in range(e * np.uint64(point_blocks), (e + np.uint64(1)) * np.uint64(point_blocks)):
+        for j in range(rows_in.shape[1]):
+            rows_out[r, j] = rows_in[r, j]
     if el_in[e, E_ALIVE] == 0.0:
         el_out[e, E_DT] = math.inf
         clear_block(blocks, e)
@@ -366,7 +488,7 @@ def shell_force(
     el_out[e, E_KAPPA + 1] = kap_y
     el_out[e, E_KAPPA + 2] = kap_xy2
 
-    # 3. membrane: F = Σ x̂_I ⊗ ∂N_I/∂X
+    # 3. membrane: F = Σ x̂_I ⊗ ∂N_I/∂X at the centre (one-point membrane, outputs)
     g1 = (ref_grad[e, 0, 0], ref_grad[e, 0, 1], ref_grad[e, 0, 2], ref_grad[e, 0, 3])
     g2 = (ref_grad[e, 1, 0], ref_grad[e, 1, 1], ref_grad[e, 1, 2], ref_grad[e, 1, 3])
     f11 = f12 = f21 = f22 = 0.0
@@ -387,39 +509,46 @@ def shell_force(
     thick = sections[sec, C_THICK]
     mu = sections[sec, C_AREAL_MASS]
     m = np.uint64(sections[sec, C_MAT])
+    kind = mat_kind[m]
     a0 = area0[e]
     n_pts = int(sections[sec, C_POINTS])
     integrated = n_pts > 1
-    if integrated:
-        status, eroded, c_memb, w_memb, n11, n22, n12, mi_xx, mi_yy, mi_xy = integrated_section(
-            e, n_pts, thick, mat_kind[m], mat_params, m,
+    row0 = e * np.uint64(point_blocks)
+    if int(sections[sec, C_INPLANE]) == MEMBRANE_FULL:
+        status, eroded, c_memb, w_memb, n11, n22, n12, mi_xx, mi_yy, mi_xy, mf_x, mf_y = (
+            full_membrane(
+                e, lx, ly, gauss_grad, gauss_weight, a0, n_pts, thick, kind, mat_params, m,
+                el_in, el_out, el_in[e, E_KAPPA], el_in[e, E_KAPPA + 1], el_in[e, E_KAPPA + 2],
+                kap_x, kap_y, kap_xy2, rows_in, rows_out, row0,
+            )
+        )
+        full = True
+    else:
+        status, n_alive, c_memb, w_memb, n11, n22, n12, mi_xx, mi_yy, mi_xy = section_response(
+            n_pts, thick, kind, mat_params, m,
             el_in[e, E_F], el_in[e, E_F + 1], el_in[e, E_F + 2], el_in[e, E_F + 3],
             f11, f12, f21, f22, el_in[e, E_KAPPA], el_in[e, E_KAPPA + 1],
-            el_in[e, E_KAPPA + 2], kap_x, kap_y, kap_xy2, m_in, m_out,
+            el_in[e, E_KAPPA + 2], kap_x, kap_y, kap_xy2, rows_in, rows_out, row0,
         )
-    elif mat_kind[m] == MAT_FABRIC:
-        status, c_memb, n11, n22, n12 = fabric_point(
-            mat_params, m, el_in[e, E_F], el_in[e, E_F + 1], el_in[e, E_F + 2],
-            el_in[e, E_F + 3], f11, f12, f21, f22, m_in, m_out, e,
-        )
-        w_memb = m_out[e, FL.S_ENERGY]
-        eroded = status == 0 and m_out[e, FL.S_ALIVE] == 0.0
-    else:
-        w_memb, c_memb, n11, n22, n12 = elastic_membrane(
-            f11, f12, f21, f22, mat_params[m, E_MOD], mat_params[m, E_NU], thick
-        )
-        status = 0
-        eroded = False
+        eroded = status == 0 and n_alive == 0
+        w_memb *= a0
+        # one point: f̂_I = A0 P ∂N_I/∂X
+        p11, p12, p21, p22 = first_piola(n11, n22, n12, f11, f12, f21, f22)
+        mf_x = (a0 * (p11 * g1[0] + p12 * g2[0]), a0 * (p11 * g1[1] + p12 * g2[1]),
+                a0 * (p11 * g1[2] + p12 * g2[2]), a0 * (p11 * g1[3] + p12 * g2[3]))
+        mf_y = (a0 * (p21 * g1[0] + p22 * g2[0]), a0 * (p21 * g1[1] + p22 * g2[1]),
+                a0 * (p21 * g1[2] + p22 * g2[2]), a0 * (p21 * g1[3] + p22 * g2[3]))
+        full = False
     if status != 0:
         el_out[e, E_N] = 0.0
         el_out[e, E_N + 1] = 0.0
         el_out[e, E_N + 2] = 0.0
         el_out[e, E_DT] = 0.0
         clear_block(blocks, e)
-        return EL_MATERIAL, 0
+        return status, 0
     if eroded:
         # no force from now on; its stored energy is booked by the caller
-        el_out[e, E_U_MEMB] = w_memb * a0
+        el_out[e, E_U_MEMB] = w_memb
         el_out[e, E_ALIVE] = 0.0
         el_out[e, E_DT] = math.inf
         for j in range(3):
@@ -429,12 +558,7 @@ def shell_force(
     el_out[e, E_N] = n11
     el_out[e, E_N + 1] = n22
     el_out[e, E_N + 2] = n12
-    el_out[e, E_U_MEMB] = w_memb * a0
-    # first Piola resultant P = J N F⁻ᵀ; F⁻ᵀ = [[f22, −f21], [−f12, f11]] / J
-    p11 = n11 * f22 - n12 * f12
-    p12 = -n11 * f21 + n12 * f11
-    p21 = n12 * f22 - n22 * f12
-    p22 = -n12 * f21 + n22 * f11
+    el_out[e, E_U_MEMB] = w_memb
 
     # 4. bending and transverse shear: M = D Δκ accumulated (resultant section) or
     # from the points (integrated section, bending energy then in the membrane term)
@@ -471,7 +595,7 @@ def shell_force(
     gam, bb = hourglass_vectors(lx, ly, b1, b2)
     gam_mid = hourglass_vectors(mid[3][0], mid[3][1], mb1, mb2)[0]
     r = sections[sec, C_HOURGLASS]
-    k_m = r * c_memb * area * bb
+    k_m = 0.0 if full else r * c_memb * area * bb  # a 2×2 membrane has no in-plane modes
     # w mode: the bilinear w of an element is the nodal-value trace of a twist;
     # k = 16 D Σb² is its twist energy for a square element (r = 1)
     k_w = r * 16.0 * d_b * bb
@@ -496,8 +620,8 @@ def shell_force(
     # turned to global axes
     fsum = 0.0
     for i in range(4):
-        fx = a0 * (p11 * g1[i] + p12 * g2[i]) + gam[i] * hg0
-        fy = a0 * (p21 * g1[i] + p22 * g2[i]) + gam[i] * hg1
+        fx = mf_x[i] + gam[i] * hg0
+        fy = mf_y[i] + gam[i] * hg1
         fz = area * (b1[i] * qx + b2[i] * qy) + gam[i] * hg2
         mx = area * (-b2[i] * myy - b1[i] * mxy - 0.25 * qy) + gam[i] * hg3
         my = area * (b1[i] * mxx + b2[i] * mxy + 0.25 * qx) + gam[i] * hg4
@@ -537,12 +661,14 @@ def shell_force(
 @loop_kernel
 def internal_force_for_shells(
     x, v, omega, dt, quads, elem_section, sections, mat_kind, mat_params, area0, ref_grad,
-    el_in, el_out, m_in, m_out, blocks, status, eroded_now, alive, dt_erode,
+    gauss_grad, gauss_weight, el_in, el_out, m_in, m_out, blocks, status, eroded_now, alive,
+    dt_erode,
 ):
     """``shell_force`` for every element (prange; each element writes its own rows).
 
     Args: positions/velocities/spins (n_nodes, 3); dt; Model arrays; element and
-    material state in/out; blocks (n_elems, 4, 6) written; status, eroded_now
+    material state in/out (m_in, m_out: (n_elems, width), an element's points' state
+    blocks side by side); blocks (n_elems, 4, 6) written; status, eroded_now
     (n_elems,) written; alive (n_elems,) uint8 written: 1 for an element alive at
     the end of the step (a compact copy of ``el_out[:, E_ALIVE]`` for the node
     kernels); dt_erode: an element whose own stable step L_e/c_e falls below it is
@@ -560,10 +686,22 @@ def internal_force_for_shells(
     n_failed = 0
     n_eroded = 0
     dt_min = math.inf
+    # the material state as one row per point: an element's row of m_in holds its
+    # points' state blocks side by side (fabric); elastic-only models have none
+    width = m_in.shape[1]
+    point_blocks = width // FL.N_STATE
+    if point_blocks > 0 and point_blocks * FL.N_STATE == width:
+        rows_in = m_in.reshape((ne * point_blocks, FL.N_STATE))
+        rows_out = m_out.reshape((ne * point_blocks, FL.N_STATE))
+    else:
+        rows_in = m_in
+        rows_out = m_out
+        point_blocks = 1
     for e in prange(ne):
         st, er = shell_force(
-            np.uint64(e), x, v, omega, dt, quads, area0, ref_grad, np.uint64(elem_section[e]),
-            sections, mat_kind, mat_params, el_in, el_out, m_in, m_out, blocks,
+            np.uint64(e), x, v, omega, dt, quads, area0, ref_grad, gauss_grad, gauss_weight,
+            np.uint64(elem_section[e]), sections, mat_kind, mat_params, el_in, el_out,
+            rows_in, rows_out, point_blocks, blocks,
         )
         if st == EL_OK and er == 0 and el_out[e, E_DT] < dt_erode:
             el_out[e, E_ALIVE] = 0.0

@@ -14,6 +14,9 @@ Sections (``Model.sections``, one row per section, SI):
 - ``C_POINTS``: through-thickness integration points: 1 = resultant section (membrane
   from the material, bending M = D κ), n ≥ 3 odd = the material evaluated at n
   Simpson points z_k (membrane N = Σ w_k N_k, bending M = Σ w_k z_k N_k).
+- ``C_INPLANE``: in-plane membrane points: 1 = one point at the centre plus
+  Flanagan–Belytschko hourglass springs on the in-plane modes (``MEMBRANE_REDUCED``),
+  4 = 2×2 Gauss points, no in-plane hourglass modes (``MEMBRANE_FULL``; theory §4.5).
 
 Material kinds (``Model.mat_kind``): ``MAT_ELASTIC`` (params E, ν, ρ in columns
 ``E_MOD``, ``E_NU``, ``E_RHO``) and ``MAT_FABRIC`` (the crossover parameter vector of
@@ -33,8 +36,12 @@ Per-element state (``State.elem``, one row per element):
 - ``E_KAPPA``: total curvatures κ_x, κ_y, 2κ_xy (1/m), accumulated from the rates (used
   by integrated sections).
 
-The material state of an element is ``n_points`` consecutive blocks of the material's
-state vector (one block for a resultant section).
+- ``E_FG``: the in-plane F at the four Gauss points of a fully integrated membrane
+  (4 × 4 values, point g at ``E_FG + 4 g``).
+
+The material state of an element is ``n_inplane × n_points`` consecutive blocks of the
+material's state vector, block ``g · n_points + k`` for in-plane point g and
+through-thickness point k (one block for a one-point resultant section).
 """
 
 from __future__ import annotations
@@ -49,7 +56,11 @@ C_SHEAR_G = 5
 C_SHEAR_K = 6
 C_HOURGLASS = 7
 C_POINTS = 8
-N_SECTION = 9
+C_INPLANE = 9
+N_SECTION = 10
+
+MEMBRANE_REDUCED = 1
+MEMBRANE_FULL = 4
 
 # material kinds and the elastic parameter vector
 MAT_ELASTIC = 0
@@ -70,7 +81,8 @@ E_U_HG = 19
 E_DT = 20
 E_ALIVE = 21
 E_KAPPA = 22
-N_ELEM_STATE = 25
+E_FG = 25
+N_ELEM_STATE = 41
 
 # per-element status codes written by the force kernel
 EL_OK = 0

@@ -20,7 +20,14 @@ from wovenimpact.model.mesh import Mesh, plate_mesh
 from wovenimpact.impactor import Impactor
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels.contact_rigid import rigid_contact_forces
-from wovenimpact.model.model import BoundaryConditions, Model, RigidBody, Section, build_model
+from wovenimpact.model.model import (
+    BoundaryConditions,
+    Model,
+    RigidBody,
+    Section,
+    ShellContactParams,
+    build_model,
+)
 from wovenimpact.spec.case import DOFS, AbaqusMeshSpec, CaseSpec, PlateMeshSpec
 from wovenimpact.spec.fields import read_toml
 from wovenimpact.spec.material import load_material, material_from_dict
@@ -71,7 +78,8 @@ def load_case_material(base: Path, name: str, ref):
 
 
 def make_mesh(spec: CaseSpec, base: Path) -> tuple[Mesh, list[str]]:
-    """The mesh and each element's section name."""
+    """The mesh and each element's section name; ``mesh.ply`` labels the contact
+    surfaces (:func:`contact_surfaces`)."""
     m = spec.mesh
     if isinstance(m, PlateMeshSpec):
         mesh = plate_mesh(m.side, m.element_size, plies=m.plies, spacing=m.spacing or 0.0,
@@ -96,7 +104,36 @@ def make_mesh(spec: CaseSpec, base: Path) -> tuple[Mesh, list[str]]:
     if missing:
         raise InputError(f"mesh.sections: {len(missing)} elements (first: {missing[0]}) are in "
                          "none of the listed element sets; every element needs a section")
+    mesh.ply = contact_surfaces(mesh, spec.contact.surfaces, list(m.sections))
     return mesh, names  # type: ignore[return-value]
+
+
+def contact_surfaces(mesh: Mesh, how: str, elsets: list[str]) -> np.ndarray:
+    """Surface label of each element of an imported mesh (theory §6.3): shells of
+    different surfaces meet in the shell–shell contact.
+
+    - ``"parts"``: the connected parts (elements sharing nodes, transitively): the
+      layers of an imported pack or casing, each meshed on its own nodes;
+    - ``"element_sets"``: the element sets of ``mesh.sections``, in their order;
+    - ``"none"``: one surface (no contact unless ``self_contact``).
+    """
+    ne = mesh.n_elems
+    if how == "none":
+        return np.zeros(ne, dtype=np.int64)
+    if how == "element_sets":
+        label = np.full(ne, -1, dtype=np.int64)
+        for i, name in enumerate(elsets):
+            idx = np.asarray(mesh.elem_sets[name], dtype=np.int64)
+            label[idx[label[idx] < 0]] = i
+        return label
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    rows = np.repeat(np.arange(ne), 4)
+    incidence = coo_matrix((np.ones(4 * ne), (rows, mesh.quads.ravel())),
+                           shape=(ne, mesh.n_nodes)).tocsr()
+    _, label = connected_components(incidence @ incidence.T, directed=False)
+    return label.astype(np.int64)
 
 
 def node_set(mesh: Mesh, name: str, key: str) -> np.ndarray:
@@ -138,15 +175,17 @@ def check_impactor_clearance(model: Model) -> None:
     n = model.n_nodes
     force = np.zeros((n, 3))
     energy = np.zeros(n)
+    zero = np.zeros(3)
     for b in range(model.body_params.shape[0]):
         p = model.body_params[b]
         st = model.body_state0[b]
         axis = st[RB.B_R:RB.B_R + 9].reshape(3, 3)[:, 0]
         tip = st[RB.B_X:RB.B_X + 3] - p[RB.BP_TIP] * axis
         prof = model.body_profiles[b, : int(p[RB.BP_NPTS])]
-        rigid_contact_forces(model.x0, np.ones(n, np.int8), model.node_offset, np.ones(n), tip,
-                             axis, np.ascontiguousarray(prof[:, 0]),
-                             np.ascontiguousarray(prof[:, 1]),
+        # k = 1 N/m per node: energy ½ g², no dashpot
+        rigid_contact_forces(model.x0, np.zeros((n, 3)), np.ones(n, np.int8), np.ones(n),
+                             model.node_offset, 1.0, 0.0, 0.0, 1.0, tip, axis, zero, zero, zero,
+                             np.ascontiguousarray(prof[:, 0]), np.ascontiguousarray(prof[:, 1]),
                              p[RB.BP_REACH] + float(model.node_offset.max()), force, energy)
         bad = np.flatnonzero(energy > 0.0)
         if bad.size:
@@ -170,6 +209,7 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
             bending_modulus=s.bending_modulus, bending_poisson=s.bending_poisson,
             transverse_shear_modulus=s.transverse_shear_modulus, shear_factor=s.shear_factor,
             hourglass=s.hourglass, areal_mass=s.areal_mass, points=s.points,
+            membrane=s.membrane,
         )
         for name, s in spec.sections.items()
     }
@@ -203,6 +243,7 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         # a quarter model carries a quarter of the impactor, which moves along its axis
         bodies.append(RigidBody(geometry, tip=im.position, direction=im.direction,
                                 speed=im.velocity, mass=im.mass, beta=im.contact_stiffness,
+                                damping=im.contact_damping, friction=im.friction,
                                 fraction=0.25 if quarter else 1.0, axial_only=quarter))
     used = {s: i for i, s in enumerate(dict.fromkeys(elem_sections))}
     model = build_model(
@@ -211,6 +252,10 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         warp_direction=spec.mesh.warp_direction, body_accel=accel, alpha=spec.run.alpha,
         erode_dt_fraction=spec.run.erode_dt_fraction, ply=mesh.ply, bodies=bodies,
         node_sets=mesh.node_sets, elem_sets=mesh.elem_sets,
+        shell_contact=ShellContactParams(
+            enabled=spec.contact.surfaces != "none" or spec.contact.self_contact,
+            beta=spec.contact.penalty_scale, damping=spec.contact.damping,
+            friction=spec.contact.friction, self_contact=spec.contact.self_contact),
     )
     v = np.zeros((mesh.n_nodes, 3))
     w = np.zeros((mesh.n_nodes, 3))

@@ -26,6 +26,12 @@ from wovenimpact.materials.metal import MetalParameters
 
 FREE, FIXED, PRESCRIBED = 0, 1, 2  # boundary-condition codes per degree of freedom
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
+MEMBRANE_POINTS = {"full": S.MEMBRANE_FULL, "reduced": S.MEMBRANE_REDUCED}
+GAUSS = 1.0 / np.sqrt(3.0)  # 2×2 Gauss points at (±1/√3, ±1/√3), weights 1
+GAUSS_XI = np.array([-GAUSS, GAUSS, GAUSS, -GAUSS])  # point g next to corner g
+GAUSS_ETA = np.array([-GAUSS, -GAUSS, GAUSS, GAUSS])
+CORNER_XI = np.array([-1.0, 1.0, 1.0, -1.0])
+CORNER_ETA = np.array([-1.0, -1.0, 1.0, 1.0])
 
 
 @dataclass(frozen=True)
@@ -48,6 +54,9 @@ class Section:
             material evaluated at n Simpson points through the thickness (the
             thesis's S4R + VUMAT section; metals' default in Abaqus is 5), its
             bending stiffness then comes from the material itself.
+        membrane: ``"full"`` = 2×2 Gauss points in the plane (no in-plane hourglass
+            modes, theory §4.5), ``"reduced"`` = one point and hourglass springs;
+            default full for fabric sections, reduced for metals.
     """
 
     material: FabricParameters | MetalParameters
@@ -59,6 +68,7 @@ class Section:
     hourglass: float = 0.05
     areal_mass: float | None = None
     points: int = 1
+    membrane: str | None = None
 
     def row(self, mat_index: int, name: str) -> np.ndarray:
         """The section's row of ``Model.sections`` (layout in shell_layout)."""
@@ -103,6 +113,10 @@ class Section:
                              "section) or an odd number ≥ 3 (Simpson integration)")
         if not 0.0 <= self.hourglass < 1.0:
             raise InputError(f"section {name!r}: hourglass = {self.hourglass!r}; valid: 0 ≤ r < 1")
+        membrane = self.membrane or ("full" if isinstance(m, FabricParameters) else "reduced")
+        if membrane not in MEMBRANE_POINTS:
+            raise InputError(f"section {name!r}: membrane = {membrane!r}; valid: "
+                             f"{' or '.join(repr(k) for k in MEMBRANE_POINTS)}")
         r[S.C_THICK] = t
         r[S.C_MAT] = mat_index
         r[S.C_AREAL_MASS] = mu
@@ -112,6 +126,7 @@ class Section:
         r[S.C_SHEAR_K] = self.shear_factor
         r[S.C_HOURGLASS] = self.hourglass
         r[S.C_POINTS] = self.points
+        r[S.C_INPLANE] = MEMBRANE_POINTS[membrane]
         return r
 
 
@@ -164,6 +179,8 @@ class RigidBody:
         speed: initial speed along ``direction`` (m/s).
         mass: if given, the mass (kg) the density is scaled to.
         beta: penalty factor of the node contact stiffness k = β m_node/Δt².
+        damping: contact damping ζ, a fraction of critical (2 √(k m_node)) per node.
+        friction: Coulomb coefficient μ between the body and the nodes.
         fraction: the share of the body in the model (0.25 in a quarter model: mass
             and inertia are scaled by it).
         axial_only: the body translates along its axis only, without rotating (a
@@ -176,6 +193,8 @@ class RigidBody:
     speed: float = 0.0
     mass: float | None = None
     beta: float = 0.1
+    damping: float = 1.0
+    friction: float = 0.0
     fraction: float = 1.0
     axial_only: bool = False
 
@@ -197,14 +216,34 @@ class RigidBody:
         reach = float(np.max(np.hypot(profile[:, 0], profile[:, 1])))
         params = np.zeros(RB.N_BODY_PARAM)
         params[[RB.BP_MASS, RB.BP_I_AXIAL, RB.BP_I_TRANS, RB.BP_TIP, RB.BP_BETA, RB.BP_REACH,
-                RB.BP_NPTS, RB.BP_AXIAL_ONLY, RB.BP_FRACTION]] = (
+                RB.BP_NPTS, RB.BP_AXIAL_ONLY, RB.BP_FRACTION, RB.BP_DAMPING, RB.BP_FRICTION]] = (
             m, i_a, i_t, zc, self.beta, reach, len(profile), float(self.axial_only),
-            self.fraction)
+            self.fraction, self.damping, self.friction)
         state = np.zeros(RB.N_BODY_STATE)
         state[RB.B_X:RB.B_X + 3] = np.asarray(self.tip, dtype=float) + zc * axis
         state[RB.B_V:RB.B_V + 3] = self.speed * travel
         state[RB.B_R:RB.B_R + 9] = rot.ravel()
         return params, profile, state
+
+
+@dataclass(frozen=True)
+class ShellContactParams:
+    """Shell–shell contact of a model (plies on plies, layers on layers; theory §6.3).
+
+    Attributes:
+        enabled: build the contact (False: surfaces pass through each other).
+        beta: penalty scale β of k = β min(m_node, m̄_segment)/Δt², 0 < β ≤ 0.5.
+        damping: ζ, fraction of critical damping 2 √(k m_red) of each node–segment pair.
+        friction: Coulomb coefficient μ ≥ 0.
+        self_contact: a surface also meets its own non-adjacent segments (a folding
+            ply or a single imported surface).
+    """
+
+    enabled: bool = True
+    beta: float = 0.1
+    damping: float = 1.0
+    friction: float = 0.0
+    self_contact: bool = False
 
 
 @dataclass(frozen=True, eq=False)
@@ -220,6 +259,8 @@ class Model:
         mat_params: (n_mats, n_params) parameter vectors, zero-padded.
         section_state0: (n_sections, n_mat_state) initial material state of an element
             of each section (its points' state blocks side by side).
+        gauss_grad, gauss_weight: (n_elems, 4, 2, 4) ∂N_I/∂X at the 2×2 Gauss points
+            and (n_elems, 4) their weights det J (fully integrated membranes).
         ref_grad: (n_elems, 2, 4) ∂N_I/∂X at the element centre in its reference
             material frame (warp along x).
         area0: (n_elems,) reference areas.
@@ -241,6 +282,8 @@ class Model:
         body_profiles: (n_bodies, n_points, 2) their meridian polylines (ζ, ρ), padded.
         body_state0: (n_bodies, N_BODY_STATE) their state at t = 0.
         node_sets, elem_sets: named index arrays (outputs, BCs).
+        shell_contact: parameters of the shell–shell contact between the surfaces
+            (``ply`` labels the surfaces: plies, element sets or connected parts).
         section_names, material_names: labels for reports.
     """
 
@@ -253,6 +296,8 @@ class Model:
     section_state0: np.ndarray
     ref_grad: np.ndarray
     area0: np.ndarray
+    gauss_grad: np.ndarray
+    gauss_weight: np.ndarray
     node_mass: np.ndarray
     node_inertia: np.ndarray
     bc_code: np.ndarray
@@ -271,6 +316,7 @@ class Model:
     body_state0: np.ndarray
     node_sets: dict = field(default_factory=dict)
     elem_sets: dict = field(default_factory=dict)
+    shell_contact: ShellContactParams = ShellContactParams()
     section_names: tuple = ()
     material_names: tuple = ()
 
@@ -292,14 +338,21 @@ class Model:
             h.update(name.encode())
             h.update(str(a.dtype).encode() + str(a.shape).encode())
             h.update(a.tobytes())
-        h.update(repr((self.ramp_time, self.alpha, self.erode_dt_fraction)).encode())
+        h.update(repr((self.ramp_time, self.alpha, self.erode_dt_fraction,
+                       self.shell_contact)).encode())
         return h.hexdigest()
 
 
 def material_frame_gradients(x0, quads, warp_direction):
-    """Reference centre gradients ∂N_I/∂X (n, 2, 4) and areas in each element's
-    material frame: e3 the element normal, e1 the warp direction projected on the
-    element plane, e2 = e3 × e1 (the fill direction of an unsheared fabric)."""
+    """Reference gradients and areas in each element's material frame: e3 the element
+    normal, e1 the warp direction projected on the element plane, e2 = e3 × e1 (the fill
+    direction of an unsheared fabric).
+
+    Returns (grad (n, 2, 4), area (n,), gauss_grad (n, 4, 2, 4), gauss_weight (n, 4)):
+    the one-point (centre, BLT) gradients ∂N_I/∂X, the reference areas, and ∂N_I/∂X at
+    the 2×2 Gauss points with their weights det J(ξ_g, η_g) (Σ_g = area for a planar
+    quad) — see :func:`gauss_gradients`.
+    """
     xe = x0[quads]  # (n, 4, 3)
     d13 = xe[:, 2] - xe[:, 0]
     d24 = xe[:, 3] - xe[:, 1]
@@ -333,7 +386,36 @@ def material_frame_gradients(x0, quads, warp_direction):
                            Y[:, 0] - Y[:, 2]], axis=1) / a2[:, None]
     grad[:, 1] = np.stack([X[:, 3] - X[:, 1], X[:, 0] - X[:, 2], X[:, 1] - X[:, 3],
                            X[:, 2] - X[:, 0]], axis=1) / a2[:, None]
-    return grad, area
+    g_grad, g_weight = gauss_gradients(X, Y)
+    return grad, area, g_grad, g_weight
+
+
+def gauss_gradients(X, Y):
+    """∂N_I/∂X at the 2×2 Gauss points of bilinear quads with corner coordinates X, Y
+    (n, 4) in the element plane, and the weights det J (Gauss weights 1).
+
+    N_I = ¼ (1 + ξ_I ξ)(1 + η_I η); J = [[∂X/∂ξ, ∂Y/∂ξ], [∂X/∂η, ∂Y/∂η]];
+    [∂N/∂X, ∂N/∂Y]ᵀ = J⁻¹ [∂N/∂ξ, ∂N/∂η]ᵀ (theory §4.5).
+    """
+    n = X.shape[0]
+    grad = np.empty((n, 4, 2, 4))
+    weight = np.empty((n, 4))
+    for g in range(4):
+        dn_dxi = 0.25 * CORNER_XI * (1.0 + CORNER_ETA * GAUSS_ETA[g])
+        dn_deta = 0.25 * CORNER_ETA * (1.0 + CORNER_XI * GAUSS_XI[g])
+        j11, j12 = X @ dn_dxi, Y @ dn_dxi
+        j21, j22 = X @ dn_deta, Y @ dn_deta
+        det = j11 * j22 - j12 * j21
+        bad = np.flatnonzero(~(det > 0.0))
+        if bad.size:
+            raise InputError(
+                f"element {int(bad[0])} has a non-positive Jacobian at a Gauss point "
+                "(a concave or folded quad); fix the mesh"
+            )
+        grad[:, g, 0] = (j22[:, None] * dn_dxi - j12[:, None] * dn_deta) / det[:, None]
+        grad[:, g, 1] = (-j21[:, None] * dn_dxi + j11[:, None] * dn_deta) / det[:, None]
+        weight[:, g] = det
+    return grad, weight
 
 
 def node_element_map(quads: np.ndarray, n_nodes: int):
@@ -364,6 +446,7 @@ def build_model(
     bodies: list[RigidBody] | None = None,
     node_sets: dict | None = None,
     elem_sets: dict | None = None,
+    shell_contact: ShellContactParams | None = None,
 ) -> Model:
     """Assemble a :class:`Model` from a mesh, named sections and constraints.
 
@@ -381,6 +464,7 @@ def build_model(
             the first one, 0 ≤ f < 1 (0: never); default 0.05.
         ply: (n_elems,) part index for per-ply outputs; default all 0.
         bodies: rigid impactors.
+        shell_contact: shell–shell contact parameters (default ShellContactParams()).
     """
     x0 = np.ascontiguousarray(nodes, dtype=float)
     q = np.ascontiguousarray(quads, dtype=np.int64)
@@ -429,11 +513,12 @@ def build_model(
     for i, p in enumerate(params):
         mat_params[i, : len(p)] = p
     # per section: its points' state blocks side by side (width: the widest section)
-    blocks = [np.tile(states[int(r[S.C_MAT])], int(r[S.C_POINTS])) for r in sec_table]
+    blocks = [np.tile(states[int(r[S.C_MAT])], int(r[S.C_POINTS]) * int(r[S.C_INPLANE]))
+              for r in sec_table]
     section_state0 = np.zeros((len(blocks), max(1, max(len(b) for b in blocks))))
     for i, b in enumerate(blocks):
         section_state0[i, : len(b)] = b
-    ref_grad, area0 = material_frame_gradients(x0, q, warp_direction)
+    ref_grad, area0, gauss_grad, gauss_weight = material_frame_gradients(x0, q, warp_direction)
     # lumped masses: a quarter of each element's mass to each corner; rotary inertia
     # m · max(t²/12, A/8) so that rotations never govern the stable step (theory §3)
     thick = sec_table[es, S.C_THICK]
@@ -468,7 +553,8 @@ def build_model(
         x0=x0, quads=q, elem_section=es, sections=sec_table,
         mat_kind=np.array(kinds, dtype=np.int64), mat_params=mat_params,
         section_state0=section_state0,
-        ref_grad=ref_grad, area0=area0, node_mass=node_mass, node_inertia=node_inertia,
+        ref_grad=ref_grad, area0=area0, gauss_grad=gauss_grad, gauss_weight=gauss_weight,
+        node_mass=node_mass, node_inertia=node_inertia,
         bc_code=bcs.code.copy(), bc_velocity=bcs.velocity.copy(), ramp_time=float(bcs.ramp_time),
         body_accel=ba, node_ptr=ptr, node_elem=n_elem, node_corner=n_corner, alpha=float(alpha),
         erode_dt_fraction=float(erode_dt_fraction),
@@ -476,5 +562,6 @@ def build_model(
         node_offset=node_offset, body_params=body_params, body_profiles=body_profiles,
         body_state0=body_state0,
         node_sets=dict(node_sets or {}), elem_sets=dict(elem_sets or {}),
+        shell_contact=shell_contact or ShellContactParams(),
         section_names=tuple(names), material_names=tuple(getattr(m, "name", "") for m in mats),
     )

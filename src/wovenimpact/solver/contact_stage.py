@@ -4,7 +4,8 @@ Called between the element stage and the node update. It fills ``ws.f_con`` (the
 contact forces on the nodes at x^n, external loads of the shells) and the resultant
 force and torque on each rigid body, then advances the bodies by central differences
 (kernels.rigid_body). Penalty stiffnesses k = β m/Δt² use the step about to be taken,
-so contact never limits the stable step (ω Δt ≤ √(2β) per contact spring).
+so contact never limits the stable step (ω Δt ≤ √(2β) per contact spring); each pair
+also has a dashpot (ζ of critical) and optional Coulomb friction.
 """
 
 from __future__ import annotations
@@ -14,8 +15,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from wovenimpact.kernels import rigid_body as RB
-from wovenimpact.kernels.shell_layout import E_ALIVE
 from wovenimpact.kernels.contact_rigid import rigid_contact_forces
+from wovenimpact.kernels.gather import nodes_with_live_elements, node_sum
 from wovenimpact.kernels.rigid_body import advance_body
 
 
@@ -26,20 +27,26 @@ class ContactBuffers:
     f_con: np.ndarray  # (n, 3) total contact force per node
     f_body: np.ndarray  # (n, 3) contact force of one body on each node
     e_body: np.ndarray  # (n,) penalty energy per node (one body)
-    shells: object | None  # ShellContact driver, if plies can touch each other
+    active: np.ndarray  # (n,) int8: nodes that take contact forces this step
+    shells: object | None  # ShellContact driver, if surfaces can touch each other
     shell_energy: float = 0.0
     shell_pairs: int = 0
+    penalty_energy: float = 0.0  # Σ ½ k g² of every body and shell pair at x^n (J)
 
     @classmethod
-    def for_model(cls, model, shell_contact: bool = True, friction: float = 0.0,
-                  beta: float = 0.1) -> ContactBuffers:
+    def for_model(cls, model) -> ContactBuffers:
+        """Buffers and, when the model has two or more surfaces (``model.ply``) or
+        self-contact, the shell–shell contact of ``model.shell_contact``."""
         n = model.n_nodes
         shells = None
-        if shell_contact and np.unique(model.ply).size > 1:
+        p = model.shell_contact
+        if p.enabled and (np.unique(model.ply).size > 1 or p.self_contact):
             from wovenimpact.contact import ShellContact
 
-            shells = ShellContact(model, beta=beta, friction=friction)
-        return cls(np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n), shells)
+            shells = ShellContact(model, beta=p.beta, damping=p.damping, friction=p.friction,
+                                  self_contact=p.self_contact)
+        return cls(np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n),
+                   np.zeros(n, dtype=np.int8), shells)
 
 
 def body_frame(state_row, params):
@@ -49,32 +56,49 @@ def body_frame(state_row, params):
     return tip, axis
 
 
-def contact_forces(model, state, cb: ContactBuffers, dt: float) -> list[tuple[np.ndarray, np.ndarray]]:
+def contact_forces(model, state, cb: ContactBuffers, dt: float, elem_alive,
+                   eroded_now: int) -> list[tuple[np.ndarray, np.ndarray]]:
     """Contact forces on the nodes (into cb.f_con) and (force, torque) on every body.
+
+    ``elem_alive`` (n_elems,) are the elements alive at the end of this step's element
+    stage; when ``eroded_now`` of them eroded in it, the nodes they left without a live
+    element take no contact force (they leave the model in this step's node update,
+    so nothing could react to it: the body would be pushed by a node that is gone).
 
     Penalty stiffness k = β m / Δt_k² with Δt_k = max(Δt, Δt_first): it follows a step
     that grows (so that ω Δt stays below 2) but not one that falls. When a crushed
     element cut the step, every spring already compressed stiffened at once and gave
     its new energy back: 16 plies struck at 200 m/s, the step fell from 1.5e-7 to
     4.3e-8 s in 0.5 µs, the contact did +20 J of work, the FSP dropped from 144 to 66
-    m/s and the energy error reached 2.7 % by 12 µs (6e-4 with this rule).
+    m/s and the energy error reached 2.7 % by 12 µs (6e-4 with this rule). The springs'
+    energy goes to ``cb.penalty_energy``; the dashpots and friction (theory §6.2–6.3)
+    dissipate the rest of the contact forces' work.
     """
     cb.f_con[:] = 0.0
     dt = max(dt, state.dt_first)
+    active = state.node_active
+    if eroded_now:
+        nodes_with_live_elements(model.node_ptr, model.node_elem, elem_alive, state.node_active,
+                                 cb.active)
+        active = cb.active
     resultants = []
-    k_node = None
+    cb.penalty_energy = 0.0
     for b in range(model.body_params.shape[0]):
         p = model.body_params[b]
         row = state.bodies[b]
-        if k_node is None:
-            k_node = p[RB.BP_BETA] * model.node_mass / (dt * dt)
         tip, axis = body_frame(row, p)
+        rot = row[RB.B_R:RB.B_R + 9].reshape(3, 3)
+        spin = rot @ row[RB.B_W:RB.B_W + 3]
         prof = model.body_profiles[b, : int(p[RB.BP_NPTS])]
         rigid_contact_forces(
-            state.x, state.node_active, model.node_offset, k_node, tip, axis,
+            state.x, state.v, active, model.node_mass, model.node_offset, p[RB.BP_BETA],
+            p[RB.BP_DAMPING], p[RB.BP_FRICTION], dt, tip, axis,
+            np.ascontiguousarray(row[RB.B_V:RB.B_V + 3]), spin,
+            np.ascontiguousarray(row[RB.B_X:RB.B_X + 3]),
             np.ascontiguousarray(prof[:, 0]), np.ascontiguousarray(prof[:, 1]),
             p[RB.BP_REACH] + float(model.node_offset.max()), cb.f_body, cb.e_body,
         )
+        cb.penalty_energy += node_sum(cb.e_body)
         cb.f_con += cb.f_body
         force = -cb.f_body.sum(axis=0)
         if p[RB.BP_AXIAL_ONLY]:  # symmetry planes through the axis: no torque, no drift
@@ -85,9 +109,9 @@ def contact_forces(model, state, cb: ContactBuffers, dt: float) -> list[tuple[np
             torque = -np.cross(arm, cb.f_body).sum(axis=0)
         resultants.append((force, torque))
     if cb.shells is not None:
-        alive = state.elem[:, E_ALIVE]
         cb.shell_energy, cb.shell_pairs = cb.shells.forces(
-            state.x, state.v, dt, alive, state.node_active, cb.f_con, accumulate=True)
+            state.x, state.v, dt, elem_alive, active, cb.f_con, accumulate=True)
+        cb.penalty_energy += cb.shell_energy
     return resultants
 
 

@@ -35,6 +35,7 @@ from wovenimpact.solver.contact_stage import ContactBuffers, advance_bodies, con
 from wovenimpact.kernels.shell import internal_force_for_shells
 from wovenimpact.state import (
     BODY_KINETIC,
+    CONTACT_PENALTY,
     CONTACT_WORK,
     NODE_CONTACT_WORK,
     ERODED_INTERNAL,
@@ -104,7 +105,7 @@ def shell_forces(model, state: State, ws: Workspace) -> None:
     n_failed, ws.n_eroded, ws.dt_min = internal_force_for_shells(
         state.x, state.v, state.omega, state.dt, model.quads, model.elem_section,
         model.sections, model.mat_kind, model.mat_params, model.area0, model.ref_grad,
-        state.elem, ws.elem, state.mat, ws.mat, ws.blocks, ws.status, ws.eroded_now, ws.alive,
+        model.gauss_grad, model.gauss_weight, state.elem, ws.elem, state.mat, ws.mat, ws.blocks, ws.status, ws.eroded_now, ws.alive,
         model.erode_dt_fraction * state.dt_first / model.alpha,
     )
     if n_failed:
@@ -159,7 +160,7 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     dt_new = stable_step(model, state, ws, dt_cap)
     t0 = ws.tick("stable step", t0)
     cb = ws.contact
-    resultants = contact_forces(model, state, cb, dt_new)
+    resultants = contact_forces(model, state, cb, dt_new, ws.alive, ws.n_eroded)
     # work of the contact forces on the nodes over [x^{n−1}, x^n] (trapezoid), before
     # the velocities move on
     w_con_nodes = 0.0
@@ -184,6 +185,7 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     en[BODY_KINETIC] = ke_bodies
     en[CONTACT_WORK] += w_con_nodes + w_con_bodies
     en[NODE_CONTACT_WORK] += w_con_nodes
+    en[CONTACT_PENALTY] = cb.penalty_energy
     en[W_INT] += float(np.sum(ws.w_int))
     en[W_EXT] += float(np.sum(ws.w_ext))
     en[KINETIC] = float(np.sum(ws.ke))
@@ -240,6 +242,8 @@ def energy_balance(model, state: State) -> dict[str, float]:
         "hourglass_J": hourglass,
         "external_work_J": float(external),
         "contact_energy_J": float(contact),
+        "contact_penalty_J": float(en[CONTACT_PENALTY]),
+        "contact_dissipated_J": float(contact - en[CONTACT_PENALTY]),
         "eroded_kinetic_J": float(en[ERODED_KINETIC]),
         "eroded_internal_J": float(en[ERODED_INTERNAL]),
         "total_J": float(total),

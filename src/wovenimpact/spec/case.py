@@ -15,7 +15,9 @@ Schema (see README and examples/cases/)::
                       NAME = { file = "...", set = { warp = { crimp = "0.06" } } }
     [sections.NAME]   material, thickness?, bending_modulus?, bending_poisson?,
                       transverse_shear_modulus?, shear_factor?, hourglass?, areal_mass?,
-                      points? (1: resultant section; odd n ≥ 3: n Simpson points)
+                      points? (1: resultant section; odd n ≥ 3: n Simpson points),
+                      membrane? ("full": 2×2 in-plane points, fabric default;
+                      "reduced": one point + hourglass springs, metal default)
     [mesh]            kind = "plate": side, element_size, plies, spacing, quarter,
                       section, warp_direction   | kind = "abaqus": file, sections
                       = {ELSET = SECTION}, warp_direction
@@ -28,7 +30,11 @@ Schema (see README and examples/cases/)::
     [body_force]      acceleration = [ax, ay, az]
     [impactor]        shape = sphere | cylinder, radius, length, nose, nose_length, fillet,
                       density | mass, position (nose tip), direction, velocity,
-                      contact_stiffness (penalty factor β of k = β m / Δt²)
+                      contact_stiffness (penalty factor β of k = β m / Δt²),
+                      contact_damping (ζ, fraction of critical; 1), friction (μ; 0)
+    [contact]         shell–shell contact: surfaces = plies | parts | element_sets |
+                      none, self_contact, penalty_scale (β; 0.1), damping (ζ; 1),
+                      friction (μ; 0)
     [[initial_erosion]]  centre, radius, plies?: elements eroded at t = 0 (a hole: centroid
                       within radius of the axis through centre along cylinder_axis)
     [run]             end_time, field_interval, history_interval, checkpoint_interval,
@@ -84,6 +90,9 @@ class SectionSpec(BaseModel):
     hourglass: quantity("dimensionless", ge=0, lt=1, example="0.05") = 0.05
     areal_mass: quantity("areal_density", gt=0, example="0.477 kg/m^2") | None = None
     points: int = Field(default=1, ge=1)  # 1: resultant section; odd ≥ 3: Simpson points
+    # in-plane membrane integration: "full" 2×2 Gauss points (default for fabric) or
+    # "reduced" one point + hourglass springs (default for metals); theory §4.5
+    membrane: Literal["full", "reduced"] | None = None
 
 
 class PlateMeshSpec(BaseModel):
@@ -193,6 +202,10 @@ class ImpactorSpec(BaseModel):
     direction: tuple[float, float, float] = (0.0, 0.0, -1.0)
     velocity: quantity("velocity", gt=0, example="120 m/s")
     contact_stiffness: quantity("dimensionless", gt=0, le=0.5, example="0.1") = 0.1
+    # dashpot of each node–body pair, a fraction of critical 2 √(k m): 1 makes a struck
+    # node come to rest on the face (plastic impact) instead of leaving at twice its speed
+    contact_damping: quantity("dimensionless", ge=0, le=2, example="1") = 1.0
+    friction: quantity("dimensionless", ge=0, le=10, example="0.2") = 0.0
 
     @model_validator(mode="after")
     def _cylinder_needs_length(self):
@@ -201,6 +214,23 @@ class ImpactorSpec(BaseModel):
         if sum(c * c for c in self.direction) == 0.0:
             raise ValueError("direction must be a non-zero vector")
         return self
+
+
+class ContactSpec(BaseModel):
+    """``[contact]``: shell–shell contact (plies on plies, layers on layers; theory §6.3).
+
+    ``surfaces`` says which shells meet: ``"plies"`` (the plies of a plate mesh; for an
+    imported mesh the same as ``"parts"``), ``"parts"`` (connected parts of an imported
+    mesh), ``"element_sets"`` (the element sets of ``mesh.sections``) or ``"none"``;
+    ``self_contact`` also lets a surface meet its own non-adjacent segments.
+    """
+
+    model_config = STRICT
+    surfaces: Literal["plies", "parts", "element_sets", "none"] = "plies"
+    self_contact: bool = False
+    penalty_scale: quantity("dimensionless", gt=0, le=0.5, example="0.1") = 0.1
+    damping: quantity("dimensionless", ge=0, le=2, example="1") = 1.0
+    friction: quantity("dimensionless", ge=0, le=10, example="0.2") = 0.0
 
 
 class InitialErosionSpec(BaseModel):
@@ -237,6 +267,7 @@ class CaseSpec(BaseModel):
     initial_velocity: list[InitialVelocitySpec] = []
     body_force: BodyForceSpec | None = None
     impactor: ImpactorSpec | None = None
+    contact: ContactSpec = ContactSpec()
     initial_erosion: list[InitialErosionSpec] = []
     run: RunSpec
 

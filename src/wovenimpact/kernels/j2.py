@@ -49,6 +49,9 @@ What the caller (the shell section) must do
   t0 Σ_k w_k λ3,k with the through-thickness weights (contact offsets, output).
 - The parameter table may be wider than N_PARAM and hold other kinds' rows: only the
   columns of j2_layout in row m are read.
+- A status other than STATUS_OK (j2_layout: inverted or non-finite F, a return that did
+  not converge) leaves s_out[i] partly written and N = 0: treat it as fabric_point's
+  (the element reports EL_MATERIAL). A failed point is STATUS_OK with N = 0.
 - Erosion: s_out[i, S_ALIVE] == 0 for a failed point; the element erodes when all
   (or a configured count of) its points have S_ALIVE 0.
 - Stable step: the returned stiffness E t0 max(1, J)/(1 − ν²) bounds the membrane

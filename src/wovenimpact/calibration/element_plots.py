@@ -106,9 +106,21 @@ def plot_metal_element_test(result, out_dir: Path) -> list[Path]:
     ax.plot(eps, h["kirchhoff_equivalent_Pa"][alive] / 1e6, lw=2.5, alpha=0.6,
             label="point: Kirchhoff τ_eq (the return's variable)")
     ax.plot(eps, h["equivalent_stress_Pa"][alive] / 1e6, "--", label="point: Cauchy σ_eq")
+    if params.rate is not None:
+        from wovenimpact.calibration.metal_element import rate_factor
+
+        scaled = h["table_stress_Pa"] * rate_factor(params, h["plastic_strain_rate_per_s"])
+        ax.plot(eps, scaled[alive] / 1e6, "g-.", lw=1,
+                label="table × (1 + C ln(ε̇p/ε̇0)) at the point's rate")
     e_tab = np.array([r[0] for r in params.hardening])
     s_tab = np.array([r[1] for r in params.hardening])
-    e_max = max(float(np.max(eps)) if eps.size else 0.0, float(e_tab[-1]))
+    e_pt = float(np.max(eps)) if eps.size else 0.0
+    e_max = 1.3 * e_pt if e_pt > 0.0 else float(e_tab[-1])
+    keep = e_tab <= e_max
+    e_tab, s_tab = e_tab[keep], s_tab[keep]
+    if not keep.all():  # the table continues beyond the plot: draw it to the edge
+        e_tab = np.append(e_tab, e_max)
+        s_tab = np.append(s_tab, params.flow_stress(e_max))
     e_line = np.append(e_tab, e_max * 1.05) if e_max > e_tab[-1] else e_tab
     s_line = np.append(s_tab, s_tab[-1]) if e_max > e_tab[-1] else s_tab
     ax.plot(e_line, s_line / 1e6, "k:", lw=1)
@@ -116,7 +128,7 @@ def plot_metal_element_test(result, out_dir: Path) -> list[Path]:
     if result.failure_plastic_strain is not None:
         ax.axvline(result.failure_plastic_strain, color="r", lw=0.8, ls=":", label="failure")
     ax.set(xlabel="equivalent plastic strain ε̄p", ylabel="equivalent stress (MPa)",
-           title=f"{title}; max |τ_eq − table × rate| / σ_y {result.table_error_max:.1e}",
+           title=f"{title}\nmax |τ_eq − table × R| / σ_y = {result.table_error_max:.1e}",
            xlim=(0.0, max(e_max, 1e-6) * 1.05))
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)

@@ -512,3 +512,67 @@ def test_j2_point_called_like_fabric_point_from_a_section_loop():
     section(table, np.uint64(2), fo, fn, 1e-6, T0, s_in, s_out, n_out)
     ref = update_points(row, fo, fn, s_in, 1e-6, T0)
     assert np.array_equal(s_out, ref.state) and np.array_equal(n_out, ref.resultant)
+
+
+# --- oracle: a 3-D radial return with σ33 = 0 imposed by an outer root search ------------
+
+
+def oracle_step(params, tau_old, eps_p, lam3, f_old, f_new, dt):
+    """One step by a different algorithm: the classic 3-D radial return (Wilkins) on the
+    Kirchhoff stress, with the through-thickness strain increment Δε33 found by Brent's
+    method so that τ33 = 0 — backward Euler under the plane-stress constraint, which the
+    kernel's projected (Simo–Taylor) return must reproduce to solver precision."""
+    e, nu = params.modulus, params.poisson
+    g, k = e / (2.0 * (1.0 + nu)), e / (3.0 * (1.0 - 2.0 * nu))
+    uo, un = polar_oracle(f_old), polar_oracle(f_new)
+    lm = (un - uo) @ np.linalg.inv(0.5 * (uo + un))
+    d2 = 0.5 * (lm + lm.T)
+    sig_old = np.zeros((3, 3))
+    sig_old[:2, :2] = [[tau_old[0], tau_old[2]], [tau_old[2], tau_old[1]]]
+
+    def sigma_y(x):
+        rf = float(rate_factor(params, x / dt)) if dt > 0.0 else 1.0
+        return float(params.flow_stress(eps_p + x)) * rf
+
+    def radial_return(de33):
+        de = np.zeros((3, 3))
+        de[:2, :2] = d2
+        de[2, 2] = de33
+        tr = np.trace(de)
+        trial = sig_old + 2.0 * g * (de - tr / 3.0 * np.eye(3)) + k * tr * np.eye(3)
+        dev = trial - np.trace(trial) / 3.0 * np.eye(3)
+        q = math.sqrt(1.5 * np.sum(dev * dev))
+        if q <= sigma_y(0.0):
+            return trial, 0.0
+        x = brentq(lambda x: q - 3.0 * g * x - sigma_y(x), 0.0, q / (3.0 * g),
+                   xtol=1e-300, rtol=1e-15, maxiter=500)
+        return trial - 3.0 * g * x / q * dev, x
+
+    scale = abs(d2[0, 0]) + abs(d2[1, 1]) + abs(d2[0, 1]) + 1e-14
+    de33 = brentq(lambda z: radial_return(z)[0][2, 2], -3.0 * scale, 3.0 * scale,
+                  xtol=1e-300, rtol=1e-15, maxiter=500)
+    sig, x = radial_return(de33)
+    return np.array([sig[0, 0], sig[1, 1], sig[0, 1]]), eps_p + x, lam3 * math.exp(de33)
+
+
+@pytest.mark.parametrize("name", FILES)
+@pytest.mark.parametrize("seed", [0, 1])
+def test_kernel_matches_a_3d_radial_return_with_sigma33_solved_to_zero(name, seed):
+    params = material(name)
+    params = dataclasses.replace(params, damage=None, fracture_strain=None)  # plasticity only
+    rng = np.random.default_rng(seed)
+    path = [np.eye(2)]
+    for _ in range(25):  # random increments up to 1 %, with rotation
+        d = rng.uniform(-0.01, 0.01, (2, 2))
+        path.append(rot(rng.uniform(-0.2, 0.2)) @ (np.eye(2) + d) @ path[-1])
+    dt = 1e-5
+    states, _ = drive(params, np.array(path), dt=dt)
+    tau, eps_p, lam3 = np.zeros(3), 0.0, 1.0
+    for k in range(1, len(path)):
+        tau, eps_p, lam3 = oracle_step(params, tau, eps_p, lam3, path[k - 1], path[k], dt)
+        st_k = states[k]
+        sy = flow_stress_oracle(params, st_k)
+        assert np.max(np.abs(st_k[L.S_TAU : L.S_TAU + 3] - tau)) <= 1e-9 * sy, k
+        assert st_k[L.S_EPS_P] == pytest.approx(eps_p, rel=1e-9, abs=1e-15)
+        assert st_k[L.S_THICK] == pytest.approx(lam3, rel=1e-12)
+    assert states[-1, L.S_EPS_P] > 0.02  # the path is well into the plastic range

@@ -1,12 +1,14 @@
 """Cost of the explicit step: ns per element-cycle for elastic and fabric shell plates
-(``wovenimpact bench``, ``make bench`` → benchmarks/bench_shell.py).
+(``wovenimpact bench``; ``make bench`` runs it between the fabric-kernel and the contact
+benchmarks of ``benchmarks/``). The first line printed is :func:`machine_line`.
 
 A clamped square plate, pre-stretched 2 % in-plane (so fabric yarns carry tension and
 the crossover solve does real work) and set moving with a smooth transverse velocity
 field, is stepped with one thread and with two. Prints one line per case with the
 share of time per stage; ``--json`` prints {"cases": [{"name", "elements", "threads",
 "ns_per_element_cycle", "shares"}]}. ``--sizes=10000,100000`` chooses plate sizes,
-``--kinds=fabric`` the plates, ``--threads=2`` the thread counts and ``--steps=N`` the
+``--kinds=fabric,fabric_reduced`` the plates (``fabric_reduced``: the one-point membrane
+with hourglass springs, for the cost of the 2×2 one), ``--threads=2`` the thread counts and ``--steps=N`` the
 timed steps per case (20). The threading layer is printed first (``NUMBA_THREADING_LAYER``
 overrides the default of :mod:`wovenimpact.jit`).
 """
@@ -37,9 +39,10 @@ def plate_model(kind: str, n_elements: int):
     per_edge = int(round(math.sqrt(n_elements)))
     size = 0.94e-3
     mesh = plate_mesh(per_edge * size, size)
-    if kind == "fabric":
+    if kind in ("fabric", "fabric_reduced"):  # 2×2 membrane (default) or one point + springs
         fabric = load_material(REFERENCE_FABRIC)
-        sec = Section(fabric, bending_modulus=1e9, transverse_shear_modulus=3.28e9)
+        sec = Section(fabric, bending_modulus=1e9, transverse_shear_modulus=3.28e9,
+                      membrane="reduced" if kind == "fabric_reduced" else "full")
     else:
         steel = MetalParameters(name="steel", kind="elastic", density=7850.0, modulus=210e9,
                                 poisson=0.3)
@@ -87,6 +90,35 @@ def run_cases(kinds, sizes, thread_counts, steps: int = 20, report=None) -> list
                 if report is not None:
                     report(cases[-1])
     return cases
+
+
+def machine() -> dict:
+    """What a timing depends on: CPU model, cores, threads Numba may use, OS, versions, date."""
+    import os
+    import platform
+    from datetime import date
+
+    from wovenimpact import __version__
+
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as f:
+            cpu = next(line.split(":", 1)[1].strip() for line in f if line.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
+    return {"cpu": cpu, "cores": os.cpu_count(), "numba_threads": numba.config.NUMBA_NUM_THREADS,
+            "system": platform.system(), "python": platform.python_version(),
+            "numba": numba.__version__, "wovenimpact": __version__,
+            "date": date.today().isoformat()}
+
+
+def machine_line(m: dict | None = None) -> str:
+    """The first line of ``wovenimpact bench`` / ``make bench``: where the numbers were taken
+    (the README quotes times with this line)."""
+    m = m or machine()
+    return (f"machine: {m['cpu']}, {m['cores']} cores ({m['numba_threads']} Numba threads), "
+            f"{m['system']}, Python {m['python']}, numba {m['numba']}, wovenimpact "
+            f"{m['wovenimpact']}, {m['date']}")
 
 
 def case_line(c: dict) -> str:

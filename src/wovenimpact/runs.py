@@ -9,7 +9,8 @@
   consistent files); ``restart=True`` resumes from the newest one and the run ends
   bitwise identical to an uninterrupted one (the output schedule is a function of
   the State alone);
-- ``OUT/plots/energy.png`` and ``OUT/summary.json`` at the end.
+- ``OUT/plots/energy.png``, ``OUT/summary.json`` and ``OUT/report.html`` (one page:
+  verdicts, summary, plots, case, provenance; :mod:`wovenimpact.io.report`) at the end.
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from wovenimpact.io.atomic import atomic_write_text
 from wovenimpact.io.checkpoint import latest_checkpoint, load_checkpoint, save_checkpoint
 from wovenimpact.io.fields import FieldWriter
 from wovenimpact.io.history import History
+from wovenimpact.io.report import write_run_report
 from wovenimpact.kernels import shell_layout as S
 from wovenimpact.model.compile import CompiledCase, compile_case
 from wovenimpact.quantities import (
@@ -120,8 +122,10 @@ def run_case(
         overrides: ``KEY=VALUE`` changes to the case (``--set``; spec.fields.parse_override).
     """
     spec, base = load_case(case_path, overrides)
+    source = {"case_text": Path(case_path).read_text(encoding="utf-8"), "case_path": case_path,
+              "overrides": tuple(overrides or ())}
     return run_spec(spec, base, out_dir, restart=restart, threads=threads, progress=progress,
-                    max_steps=max_steps)
+                    max_steps=max_steps, source=source)
 
 
 def run_spec(
@@ -133,19 +137,20 @@ def run_spec(
     threads: int | None = None,
     progress: Callable[[State, float], None] | None = None,
     max_steps: int | None = None,
+    source: dict | None = None,
 ) -> dict:
     """:func:`run_case` for a validated :class:`~wovenimpact.spec.case.CaseSpec` whose
-    relative paths (materials, mesh) are relative to ``base``."""
+    relative paths (materials, mesh) are relative to ``base``. ``source`` (case_text,
+    case_path, overrides) is what report.html shows as the case; without it, the spec."""
     compiled = compile_case(spec, Path(base))
     model = compiled.model
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     n_threads = threads or spec.run.threads
     if n_threads is not None:
-        from wovenimpact.jit import set_threads
-        import numba
+        from wovenimpact.jit import capped_threads, set_threads
 
-        set_threads(min(n_threads, numba.config.NUMBA_NUM_THREADS))
+        set_threads(capped_threads(n_threads, "--threads" if threads else "run.threads"))
     digest = model.digest()
     run = spec.run
     ckpt_dir = out / "checkpoints"
@@ -207,6 +212,7 @@ def run_spec(
     if "impactor_velocity_m_per_s" in h:
         impactor_plot(h, out / "plots" / "impactor.png", title=spec.case.name)
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n")
+    write_run_report(out, spec=spec, model_digest=digest, **(source or {}))  # report.html
     return summary
 
 

@@ -370,13 +370,46 @@ def test_penalty_stiffness_does_not_follow_a_falling_step(tmp_path):
     compiled = compile_case(*load_case(write_case(tmp_path, text=text)))
     model, state = compiled.model, compiled.state
     state.bodies[0, RB.B_X + 2] -= 0.3e-3  # the flat nose 0.05 mm into the ply's surface
+    state.bodies[0, RB.B_V:RB.B_V + 3] = 0.0  # at rest: no dashpot force, the spring alone
     state.dt_first = 1e-7
     cb = ContactBuffers.for_model(model)
+    alive = np.ones(model.n_elems, dtype=np.uint8)
 
     def force(dt):
-        return contact_forces(model, state, cb, dt)[0][0][2]
+        return contact_forces(model, state, cb, dt, alive, 0)[0][0][2]
 
     f_ref = force(1e-7)
     assert f_ref > 0.0  # the ply pushes the impactor back up
     assert force(1e-8) == f_ref
     assert force(2e-7) == pytest.approx(f_ref / 4.0, rel=1e-12)
+
+
+def test_a_node_eroded_in_the_step_takes_no_contact_force(tmp_path):
+    """Momentum: a node whose last element erodes in this step leaves the model in the
+    node update, so the contact stage must neither push it nor let it push the body.
+    With the elements under the face eroded this step, the body feels only the nodes
+    that keep a live element; with nothing eroded it feels them all."""
+    from wovenimpact.kernels import rigid_body as RB
+    from wovenimpact.solver.contact_stage import ContactBuffers, contact_forces
+
+    text = CASE.replace('[[initial_velocity]]\nvelocity = ["0 m/s", "0 m/s", "-60 m/s"]\n'
+                        'radius = "1.5 mm"\n', "") + IMPACTOR.replace("{z}", "0.4 mm")
+    compiled = compile_case(*load_case(write_case(tmp_path, text=text)))
+    model, state = compiled.model, compiled.state
+    state.bodies[0, RB.B_X + 2] -= 0.3e-3  # the flat nose 0.05 mm into the ply's surface
+    state.dt_first = 1e-7
+    cb = ContactBuffers.for_model(model)
+    alive = np.ones(model.n_elems, dtype=np.uint8)
+    contact_forces(model, state, cb, 1e-7, alive, 0)
+    pushed = np.flatnonzero(np.linalg.norm(cb.f_con, axis=1) > 0.0)
+    assert pushed.size > 0
+    # erode every element of the pushed nodes: they are left without a live element
+    gone = np.unique(np.concatenate([model.node_elem[model.node_ptr[n]:model.node_ptr[n + 1]]
+                                     for n in pushed]))
+    alive[gone] = 0
+    resultants = contact_forces(model, state, cb, 1e-7, alive, gone.size)
+    orphan = [n for n in pushed
+              if not alive[model.node_elem[model.node_ptr[n]:model.node_ptr[n + 1]]].any()]
+    assert orphan and np.all(cb.f_con[orphan] == 0.0)
+    body_force = resultants[0][0]
+    assert np.allclose(body_force, -cb.f_con.sum(axis=0) * np.array([0, 0, 1.0]), atol=1e-12)

@@ -37,6 +37,13 @@ def test_sweep_runs_variants_isolates_a_failure_and_resumes(tmp_path: Path):
     assert (out / "results.csv").read_text().count("\n") == 4
     assert (out / "plots" / "max_displacement_m.png").exists()
     assert (out / "plots" / "kinetic_energy_J_histories.png").exists()
+    # the study's page links the page of each finished variant
+    from tests.io.report_page import check_run_page, read_page
+
+    page = read_page(out / "report.html")
+    assert page.links == [f"runs/{r['id']}/report.html" for r in rows[:2]]
+    for r in rows[:2]:
+        check_run_page(out / "runs" / r["id"])
     # resume: finished variants are not run again
     stamp = (out / "runs" / rows[0]["id"] / "summary.json").stat().st_mtime_ns
     again = CliRunner().invoke(app, ["sweep", str(study), "--out", str(out), "--json"])

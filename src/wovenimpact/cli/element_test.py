@@ -28,6 +28,34 @@ class Test(str, Enum):
     picture_frame = "picture-frame"
 
 
+class Homogenisation(str, Enum):
+    """``--homogenisation``: how crossover forces become membrane resultants."""
+
+    virial = "virial"
+    thesis = "thesis"
+
+
+class ShearLaw(str, Enum):
+    """``--shear-law``: the trellis shear law."""
+
+    true = "true"
+    thesis = "thesis"
+
+
+class Frame(str, Enum):
+    """``--frame``: the frame the yarn directions follow."""
+
+    fibre = "fibre"
+    green_naghdi = "green-naghdi"
+
+
+class Failure(str, Enum):
+    """``--failure``: yarn failure, instantaneous or with softening."""
+
+    instant = "instant"
+    progressive = "progressive"
+
+
 @app.command("element-test")
 def element_test(
     test: Test = typer.Argument(..., help="Which deformation history to apply."),
@@ -51,10 +79,12 @@ def element_test(
     ),
     thickness: str = typer.Option("1 mm", help="Metal: reference thickness t0 (with unit)."),
     steps: int = typer.Option(None, min=1, help="Number of load steps (fabric 600, metal 400)."),
-    homogenisation: str = typer.Option(None, help="Override: 'virial' or 'thesis'."),
-    shear_law: str = typer.Option(None, "--shear-law", help="Override: 'true' or 'thesis'."),
-    frame: str = typer.Option(None, help="Override: 'fibre' or 'green-naghdi'."),
-    failure: str = typer.Option(None, help="Override: 'instant' or 'progressive'."),
+    homogenisation: Homogenisation = typer.Option(None, help="Fabric: override the material's."),
+    shear_law: ShearLaw = typer.Option(
+        None, "--shear-law", help="Fabric: override the material's."
+    ),
+    frame: Frame = typer.Option(None, help="Fabric: override the material's."),
+    failure: Failure = typer.Option(None, help="Fabric: override the material's."),
     softening_strain: float = typer.Option(None, help="Override Δε_s of progressive failure."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object with the results."),
 ) -> None:
@@ -118,7 +148,7 @@ def element_test(
         displacement = "0.06 mm" if displacement is None else displacement
         steps = 600 if steps is None else steps
         overrides = {
-            k: v
+            k: (v.value if isinstance(v, Enum) else v)
             for k, v in dict(
                 homogenisation=homogenisation,
                 shear=shear_law,
@@ -129,15 +159,6 @@ def element_test(
             if v is not None
         }
         if overrides:
-            allowed = {
-                "homogenisation": ("virial", "thesis"),
-                "shear": ("true", "thesis"),
-                "frame": ("fibre", "green-naghdi"),
-                "failure": ("instant", "progressive"),
-            }
-            for k, v in overrides.items():
-                if k in allowed and v not in allowed[k]:
-                    raise InputError(f"--{k} = {v!r} is not valid: choose one of {allowed[k]}")
             opts = dataclasses.replace(params.options, **overrides)
             if opts.failure == "progressive" and not opts.softening_strain > 0.0:
                 raise InputError(

@@ -5,19 +5,21 @@ positions x^n and the half-step velocities v^{n−1/2}, ω^{n−1/2}:
 
 1. corotational frame: e3 along d13 × d24 (diagonals), e1 along side 1→2
    projected on the element plane, e2 = e3 × e1; local coordinates of the nodes;
-2. membrane: in-plane deformation gradient F = Σ_I x̂_I ⊗ ∂N_I/∂X (centre of the
-   bilinear element, X the reference material frame with the warp along x), the
-   material gives the resultant N (fabric kernel, or an elastic St Venant–Kirchhoff
-   membrane) and the nodal forces are f̂_I = A0 P ∂N_I/∂X with P = J N F⁻ᵀ — a
-   total-Lagrangian membrane, work-conjugate to the material's stored energy;
+2. membrane: in-plane deformation gradient F = Σ_I x̂_I ⊗ ∂N_I/∂X (X the reference
+   material frame with the warp along x), the material gives the resultant N (fabric
+   kernel, or an elastic St Venant–Kirchhoff membrane) and the nodal forces are
+   f̂_I = Σ_g w_g P_g ∂N_I/∂X|_g with P = J N F⁻ᵀ — a total-Lagrangian membrane,
+   work-conjugate to the material's stored energy — at the 2×2 Gauss points
+   (``full_membrane``, theory §4.5) or at the centre alone (w = A0; reduced);
 3. bending and transverse shear in rate form (Belytschko–Lin–Tsay 1984):
    κ̇_x = b1·θ̇_y, κ̇_y = −b2·θ̇_x, 2κ̇_xy = b2·θ̇_y − b1·θ̇_x,
    γ̇_xz = b1·v_z + ¼Σθ̇_y, γ̇_yz = b2·v_z − ¼Σθ̇_x (zero for any rigid
    rotation), M += D Δκ, Q += k G t Δγ;
-4. hourglass control, Flanagan–Belytschko stiffness form, for the in-plane,
-   transverse and rotational modes, with its energy; generalized stiffnesses
-   r C_m A Σb², r 16 D Σb² and r D A Σb² (membrane, w, θ), each the order of the
-   physical energy of a smooth field with the same nodal values;
+4. hourglass control, Flanagan–Belytschko stiffness form, for the in-plane modes
+   (reduced membranes only), the transverse and the rotational modes, with its
+   energy; generalized stiffnesses r C_m A Σb², r 16 D Σb² and r D A Σb² (membrane,
+   w, θ), each the order of the physical energy of a smooth field with the same
+   nodal values;
 5. the element's stable step L_e / c_e, L_e = A / max edge (eq. 4.9–4.11), c_e from
    the current membrane tangent and the transverse-shear wave speed, and no more than
    the rotational bound 2 √(I/k_θ) of its corners' spins.

@@ -24,7 +24,7 @@ from wovenimpact.materials.fabric import FabricParameters
 from wovenimpact.materials.fabric import initial_state as fabric_initial_state
 from wovenimpact.materials.metal import MetalParameters
 
-FREE, FIXED, PRESCRIBED = 0, 1, 2  # boundary-condition codes per degree of freedom
+FREE, FIXED, PRESCRIBED, ROTATING = 0, 1, 2, 3  # boundary-condition codes per degree of freedom
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 MEMBRANE_POINTS = {"full": S.MEMBRANE_FULL, "reduced": S.MEMBRANE_REDUCED}
 GAUSS = 1.0 / np.sqrt(3.0)  # 2×2 Gauss points at (±1/√3, ±1/√3), weights 1
@@ -159,6 +159,15 @@ class BoundaryConditions:
         """Symmetry plane with normal along axis 0/1/2: u_n = 0 and the two in-plane rotations."""
         rot = [3 + a for a in range(3) if a != normal_axis]
         return self.fix(nodes, (normal_axis, *rot))
+
+    def rotate(self, nodes, omega, centre=(0.0, 0.0, 0.0)) -> BoundaryConditions:
+        """Turn ``nodes`` rigidly at ``omega`` (rad/s vector) about the axis through
+        ``centre`` (all six DOFs; times the amplitude): a driven hub, a blade root."""
+        idx = np.asarray(nodes, dtype=np.int64)
+        self.code[idx, :] = ROTATING
+        self.velocity[idx, :3] = np.asarray(omega, dtype=float)
+        self.velocity[idx, 3:] = np.asarray(centre, dtype=float)
+        return self
 
     def prescribe(self, nodes, dof: int, velocity: float) -> BoundaryConditions:
         """Drive ``dof`` of ``nodes`` at ``velocity`` (m/s or rad/s) times the amplitude."""

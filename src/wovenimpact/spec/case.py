@@ -8,6 +8,11 @@ together, one line each, naming the key::
 
     plate.toml: run.end_time: has no unit (got '200'; valid: a time > 0 such as '60 us')
 
+Two things are warnings (:class:`~wovenimpact.errors.InputWarning`), not errors: an
+output interval longer than ``run.end_time`` (clipped to it, so that a run shortened
+with ``--set run.end_time=…`` just runs) and a quarter plate whose ``symmetry_x`` /
+``symmetry_y`` node sets no boundary constrains.
+
 Schema (see README and examples/cases/)::
 
     [case]            name, description
@@ -44,12 +49,13 @@ Schema (see README and examples/cases/)::
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from pathlib import Path
 from typing import Any, Literal
 
 from pydantic import BaseModel, Field, ValidationError, model_validator
 
-from wovenimpact.errors import InputError
+from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.spec.fields import (
     STRICT,
     Problem,
@@ -288,13 +294,54 @@ def check_references(spec: CaseSpec) -> list[Problem]:
     if isinstance(spec.mesh, PlateMeshSpec) and spec.mesh.plies > 1 and spec.mesh.spacing is None:
         problems.append(Problem("mesh.spacing", "is missing", valid="the distance between ply "
                                 "mid-planes, e.g. '0.5 mm', needed when plies > 1"))
-    run = spec.run
-    for k in ("field_interval", "history_interval", "checkpoint_interval"):
-        v = getattr(run, k)
-        if v is not None and v > run.end_time:
-            problems.append(Problem(f"run.{k}", "is longer than run.end_time", v,
-                                    f"at most {run.end_time:g} s"))
     return problems
+
+
+INTERVALS = ("field_interval", "history_interval", "checkpoint_interval")
+QUARTER_SETS = ("symmetry_x", "symmetry_y")
+
+
+def _time_text(seconds: float) -> str:
+    """A time for a message, in µs below a millisecond (case files mostly say "us")."""
+    return f"{seconds * 1e6:g} us" if seconds < 1e-3 else f"{seconds:g} s"
+
+
+def clipped_intervals(spec: CaseSpec, source: str = "<dict>") -> CaseSpec:
+    """``spec`` with every output interval longer than ``run.end_time`` set to the end time
+    (a shortened run, e.g. ``--set run.end_time="5 us"``, just writes its outputs at the
+    end), each change told by an :class:`~wovenimpact.errors.InputWarning` naming the key."""
+    run = spec.run
+    changes = {}
+    for key in INTERVALS:
+        value = getattr(run, key)
+        if value is not None and value > run.end_time:
+            changes[key] = run.end_time
+            warnings.warn(f"{source}: run.{key} = {_time_text(value)} is longer than "
+                          f"run.end_time = {_time_text(run.end_time)}: clipped to the end time",
+                          InputWarning, stacklevel=3)
+    if not changes:
+        return spec
+    return spec.model_copy(update={"run": run.model_copy(update=changes)})
+
+
+def missing_symmetry_sets(spec: CaseSpec) -> list[str]:
+    """The symmetry node sets of a quarter plate (``mesh.quarter = true``) that no
+    ``[[boundary]]`` constrains: without them the quarter is a free-edged small plate."""
+    if not (isinstance(spec.mesh, PlateMeshSpec) and spec.mesh.quarter):
+        return []
+    constrained = {b.nodes for b in spec.boundary}
+    return [name for name in QUARTER_SETS if name not in constrained]
+
+
+def warn_missing_symmetry(spec: CaseSpec, source: str = "<dict>") -> None:
+    """An :class:`~wovenimpact.errors.InputWarning` naming the sets of
+    :func:`missing_symmetry_sets`, with the boundary tables that would constrain them."""
+    missing = missing_symmetry_sets(spec)
+    if missing:
+        tables = " ".join(f'[[boundary]] nodes = "{m}", type = "{m}";' for m in missing)
+        warnings.warn(f"{source}: mesh.quarter = true but no boundary constrains "
+                      f"{' and '.join(missing)} (add {tables.rstrip(';')})",
+                      InputWarning, stacklevel=3)
 
 
 def _without_mesh_kind(p: Problem) -> Problem:
@@ -315,7 +362,8 @@ def case_from_dict(doc: dict[str, Any], source: str = "<dict>") -> CaseSpec:
     problems = check_references(spec)
     if problems:
         raise input_error(problems, source)
-    return spec
+    warn_missing_symmetry(spec, source)
+    return clipped_intervals(spec, source)
 
 
 def load_case(path: str | Path, overrides=()) -> tuple[CaseSpec, Path]:

@@ -17,6 +17,7 @@ from pathlib import Path
 
 from wovenimpact.errors import InputError
 from wovenimpact.io.atomic import atomic_write_text
+from wovenimpact.io.report import write_index
 from wovenimpact.spec.fields import read_toml, set_dotted
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -309,4 +310,5 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
     lines += ["## Commentary", "", *commentary(cases, convergence),
               *study_commentary(study_rows)]
     atomic_write_text(report, "\n".join(lines) + "\n")
+    write_index(work, "wovenimpact validate: every run and study")  # WORK/report.html
     return report

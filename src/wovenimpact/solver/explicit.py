@@ -105,7 +105,8 @@ def shell_forces(model, state: State, ws: Workspace) -> None:
     n_failed, ws.n_eroded, ws.dt_min = internal_force_for_shells(
         state.x, state.v, state.omega, state.dt, model.quads, model.elem_section,
         model.sections, model.mat_kind, model.mat_params, model.area0, model.ref_grad,
-        model.gauss_grad, model.gauss_weight, state.elem, ws.elem, state.mat, ws.mat, ws.blocks, ws.status, ws.eroded_now, ws.alive,
+        model.gauss_grad, model.gauss_weight, state.elem, ws.elem, state.mat, ws.mat,
+        model.point_width, ws.blocks, ws.status, ws.eroded_now, ws.alive,
         model.erode_dt_fraction * state.dt_first / model.alpha,
     )
     if n_failed:

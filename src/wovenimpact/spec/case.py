@@ -95,7 +95,8 @@ class SectionSpec(BaseModel):
     shear_factor: quantity("dimensionless", gt=0, le=1, example="0.8333") = 5.0 / 6.0
     hourglass: quantity("dimensionless", ge=0, lt=1, example="0.05") = 0.05
     areal_mass: quantity("areal_density", gt=0, example="0.477 kg/m^2") | None = None
-    points: int = Field(default=1, ge=1)  # 1: resultant section; odd ≥ 3: Simpson points
+    # 1: resultant section; odd ≥ 3: Simpson points (default 5 for plastic metals, else 1)
+    points: int | None = Field(default=None, ge=1)
     # in-plane membrane integration: "full" 2×2 Gauss points (default for fabric) or
     # "reduced" one point + hourglass springs (default for metals); theory §4.5
     membrane: Literal["full", "reduced"] | None = None

@@ -28,6 +28,11 @@ Schema (see README and examples/cases/)::
                       = {ELSET = SECTION}, warp_direction
     [[boundary]]      nodes = SET, type = clamped | pinned | symmetry_x | symmetry_y |
                       symmetry_z | velocity (with dof and velocity)
+                      | kind = "containment": element_size, [mesh.casing] (inner_radius,
+                      length, sector, centre_angle, inner_section, layer_section, layers,
+                      layer_spacing), [mesh.blade] (section, root/crack/tip_radius,
+                      root/tip_chord, angle, stagger)
+    [spin]            rate, release_time, relaxation_tolerance (containment cases)
     [amplitude]       ramp_time (smooth step of prescribed velocities, thesis Fig. 8-3)
     [[initial_velocity]]  nodes = SET, velocity = [vx, vy, vz] and/or
                       angular_velocity = [wx, wy, wz] about centre; optional radius
@@ -124,6 +129,74 @@ class AbaqusMeshSpec(BaseModel):
     file: str = Field(min_length=1)
     sections: dict[str, str] = Field(min_length=1)  # element set → section name
     warp_direction: tuple[float, float, float] = (1.0, 0.0, 0.0)
+
+
+Angle = quantity("angle", example="90 deg")
+
+
+class CasingSpec(BaseModel):
+    """``[mesh.casing]``: coaxial cylindrical layers about the z axis (MODEL.md §6).
+
+    The inner metal shell (``inner_section``; omit it for an all-metal casing of
+    layers) has its inner surface at ``inner_radius``; ``layers`` layers of
+    ``layer_section`` follow outwards, their mid-surfaces ``layer_spacing`` apart
+    (default: the layer section's thickness, touching), the first one
+    ``layer_spacing``/2 outside the inner shell's outer surface.
+    """
+
+    model_config = STRICT
+    inner_radius: Length = 0.25
+    length: Length = 0.15
+    sector: Angle = 2.0 * 3.141592653589793
+    centre_angle: quantity("angle", example="90 deg") = 0.0
+    inner_section: str | None = None
+    layer_section: str = Field(min_length=1)
+    layers: int = Field(ge=1, le=200)
+    layer_spacing: Length | None = None
+
+
+class BladeSpec(BaseModel):
+    """``[mesh.blade]``: a flat tapered blade in the plane of the z axis (model.casing).
+
+    Defaults (MODEL.md §7: the thesis's blade is not in its text): root 40 mm, split at
+    60 mm (the released fragment is the airfoil outboard of it: 0.237 kg of titanium
+    4.98 mm thick, centre of mass at r = 142.9 mm, so ω r_cm = 149.6 m/s at 1047 rad/s),
+    tip 245 mm (5 mm inside a 250 mm casing), chords 80 mm at the root and 40 mm at the
+    tip, radial along ``angle`` (from +x), no stagger.
+    """
+
+    model_config = STRICT
+    section: str = Field(min_length=1)
+    root_radius: Length = 0.04
+    crack_radius: Length = 0.06
+    tip_radius: Length = 0.245
+    root_chord: Length = 0.08
+    tip_chord: Length = 0.04
+    angle: quantity("angle", example="90 deg") = 0.0
+    stagger: quantity("angle", example="30 deg") = 0.0
+
+
+class ContainmentMeshSpec(BaseModel):
+    """``[mesh] kind = "containment"``: a casing and a fan blade (thesis ch. 8). Node
+    sets ``casing.ends``, ``casing.end_low``, ``casing.end_high``, ``casing.cut_edges``,
+    ``casing.layer{k}``, ``blade.root``, ``blade.hub``, ``blade.fragment``."""
+
+    model_config = STRICT
+    kind: Literal["containment"]
+    element_size: Length
+    casing: CasingSpec
+    blade: BladeSpec
+
+
+class SpinSpec(BaseModel):
+    """``[spin]``: the blade turns at ``rate`` about the z axis: its centrifugal
+    pre-stress by dynamic relaxation, then ω × r velocities (theory §7.1); its root
+    keeps turning; the fragment is released at ``release_time`` (theory §7.2)."""
+
+    model_config = STRICT
+    rate: Spin = 1047.0
+    release_time: quantity("time", ge=0, example="0 us") = 0.0
+    relaxation_tolerance: quantity("dimensionless", gt=0, lt=0.1, example="1e-5") = 1e-5
 
 
 class BoundarySpec(BaseModel):
@@ -268,15 +341,29 @@ class CaseSpec(BaseModel):
     case: CaseInfo
     materials: dict[str, str | MaterialRef] = Field(min_length=1)
     sections: dict[str, SectionSpec] = Field(min_length=1)
-    mesh: PlateMeshSpec | AbaqusMeshSpec = Field(discriminator="kind")
+    mesh: PlateMeshSpec | AbaqusMeshSpec | ContainmentMeshSpec = Field(discriminator="kind")
     boundary: list[BoundarySpec] = []
     amplitude: AmplitudeSpec = AmplitudeSpec()
     initial_velocity: list[InitialVelocitySpec] = []
     body_force: BodyForceSpec | None = None
     impactor: ImpactorSpec | None = None
+    spin: SpinSpec | None = None
     contact: ContactSpec = ContactSpec()
     initial_erosion: list[InitialErosionSpec] = []
     run: RunSpec
+
+
+def mesh_sections(mesh) -> list[tuple[str, str]]:
+    """(key, section name) of every section the mesh table names."""
+    if isinstance(mesh, PlateMeshSpec):
+        return [("mesh.section", mesh.section)]
+    if isinstance(mesh, AbaqusMeshSpec):
+        return [("mesh.sections", s) for s in mesh.sections.values()]
+    out = [("mesh.casing.layer_section", mesh.casing.layer_section),
+           ("mesh.blade.section", mesh.blade.section)]
+    if mesh.casing.inner_section is not None:
+        out.append(("mesh.casing.inner_section", mesh.casing.inner_section))
+    return out
 
 
 def check_references(spec: CaseSpec) -> list[Problem]:
@@ -286,12 +373,12 @@ def check_references(spec: CaseSpec) -> list[Problem]:
         if sec.material not in spec.materials:
             problems.append(Problem(f"sections.{name}.material", "names no material",
                                     sec.material, f"one of {sorted(spec.materials)}"))
-    used = [spec.mesh.section] if isinstance(spec.mesh, PlateMeshSpec) else list(
-        spec.mesh.sections.values())
-    key = "mesh.section" if isinstance(spec.mesh, PlateMeshSpec) else "mesh.sections"
-    for s in used:
+    for key, s in mesh_sections(spec.mesh):
         if s not in spec.sections:
             problems.append(Problem(key, "names no section", s, f"one of {sorted(spec.sections)}"))
+    if isinstance(spec.mesh, ContainmentMeshSpec) and spec.spin is None:
+        problems.append(Problem("spin", "is missing", valid="a [spin] table (rate, "
+                                "release_time) for a containment case"))
     if isinstance(spec.mesh, PlateMeshSpec) and spec.mesh.plies > 1 and spec.mesh.spacing is None:
         problems.append(Problem("mesh.spacing", "is missing", valid="the distance between ply "
                                 "mid-planes, e.g. '0.5 mm', needed when plies > 1"))
@@ -347,7 +434,7 @@ def warn_missing_symmetry(spec: CaseSpec, source: str = "<dict>") -> None:
 
 def _without_mesh_kind(p: Problem) -> Problem:
     """``mesh.plate.side`` → ``mesh.side``: the kind selects the table, it is not a key."""
-    for kind in ("plate", "abaqus"):
+    for kind in ("plate", "abaqus", "containment"):
         if p.path.startswith(f"mesh.{kind}."):
             return dataclasses.replace(p, path="mesh." + p.path[len(kind) + 6:])
     return p

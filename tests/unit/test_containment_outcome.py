@@ -55,8 +55,9 @@ def test_turned_back_against_intact_layers_is_contained_and_not_before_arriving(
 
 def test_a_released_fragment_starts_at_omega_r_cm_and_is_undecided_before_impact(tmp_path):
     """The hybrid example (5 mm elements), run 6 µs: the fragment's initial
-    centre-of-mass speed is ω r_cm of its relaxed configuration to 0.1 %, and a run that
-    ends before the impact is undecided, not escaped."""
+    centre-of-mass speed is ω r_cm of its relaxed configuration to 0.1 %, a run that
+    ends before the impact is undecided, not escaped, and its report.html is a whole
+    offline page consistent with its summary."""
     from pathlib import Path
 
     from wovenimpact.io.history import read_csv
@@ -69,3 +70,6 @@ def test_a_released_fragment_starts_at_omega_r_cm_and_is_undecided_before_impact
     r_cm = float(h["fragment_cm_radius_m"][0])
     assert summary["fragment_initial_speed_m_per_s"] == pytest.approx(1047.0 * r_cm, rel=1e-3)
     assert summary["outcome"] == "undecided"
+    from tests.io.report_page import check_run_page
+
+    check_run_page(tmp_path / "out")

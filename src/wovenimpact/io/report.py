@@ -4,8 +4,8 @@ A run's page sits beside its ``summary.json`` and answers "did it hold, and can 
 the run" before anything else:
 
 1. the verdicts, each green (``pass``), red (``fail``) or grey (``n/a``, key absent):
-   outcome (green when the impactor was stopped), residual velocity (green at 0, with
-   the rebound velocity), energy error against :data:`ENERGY_ERROR_LIMIT` (1 %) and
+   outcome (green when the impactor was stopped, or a blade fragment contained),
+   residual velocity (a fragment's exit speed; green at 0, with the rebound velocity), energy error against :data:`ENERGY_ERROR_LIMIT` (1 %) and
    hourglass share ``hourglass_fraction`` against :data:`HOURGLASS_LIMIT` (10 %);
 2. the whole summary as a table;
 3. every PNG of ``plots/``, inlined as base64;
@@ -68,10 +68,14 @@ def _status(ok: bool | None) -> str:
     return "na" if ok is None else ("pass" if ok else "fail")
 
 
+HELD = ("stopped", "contained")  # the outcomes that mean the structure held
+
+
 def verdicts(summary: dict) -> list[Verdict]:
     """The verdicts of a run's summary (see the module docstring for the rules)."""
     outcome = summary.get("outcome")
-    residual = summary.get("residual_velocity_m_per_s")
+    residual = summary.get("residual_velocity_m_per_s",
+                           summary.get("fragment_exit_speed_m_per_s"))
     rebound = summary.get("rebound_velocity_m_per_s")
     error = summary.get("energy_error_fraction")
     hourglass = summary.get("hourglass_fraction")
@@ -80,7 +84,7 @@ def verdicts(summary: dict) -> list[Verdict]:
         residual_text += f" (rebound {rebound:.2f} m/s)"
     return [
         Verdict("outcome", "outcome", "n/a" if outcome is None else str(outcome),
-                "stopped", _status(None if outcome is None else outcome == "stopped")),
+                " or ".join(HELD), _status(None if outcome is None else outcome in HELD)),
         Verdict("residual_velocity_m_per_s", "residual velocity", residual_text, "0 m/s",
                 _status(None if residual is None else residual == 0.0)),
         Verdict("energy_error_fraction", "energy error",
@@ -212,7 +216,7 @@ def write_study_report(out_dir: str | Path, title: str, rows: list[dict]) -> Pat
             href = f"runs/{row['id']}/report.html"
             return f'<a href="{escape(href)}">{escape(str(row["id"]))}</a>', ""
         if column == "outcome" and row.get("outcome"):
-            return escape(str(row["outcome"])), _status(row["outcome"] == "stopped")
+            return escape(str(row["outcome"])), _status(row["outcome"] in HELD)
         if column == "status":
             return escape(str(row["status"])), _status(row["status"] == "done")
         return None, ""

@@ -675,7 +675,7 @@ def shell_force(
 def internal_force_for_shells(
     x, v, omega, dt, quads, elem_section, sections, mat_kind, mat_params, area0, ref_grad,
     gauss_grad, gauss_weight, el_in, el_out, m_in, m_out, point_width, blocks, status,
-    eroded_now, alive, dt_erode,
+    eroded_now, alive, dt_erode, erode_inverted,
 ):
     """``shell_force`` for every element (prange; each element writes its own rows).
 
@@ -686,7 +686,8 @@ def internal_force_for_shells(
     the end of the step (a compact copy of ``el_out[:, E_ALIVE]`` for the node
     kernels); dt_erode: an element whose own stable step L_e/c_e falls below it is
     eroded (crushed or collapsed elements, e.g. fabric with one yarn family
-    broken; 0 disables).
+    broken; 0 disables); erode_inverted: an element inverted (non-positive area or
+    Jacobian) is eroded instead of stopping the run.
 
     Returns:
         (n_failed, n_eroded, dt_min): elements with a non-OK status, elements
@@ -716,7 +717,15 @@ def internal_force_for_shells(
             np.uint64(elem_section[e]), sections, mat_kind, mat_params, el_in, el_out,
             rows_in, rows_out, point_blocks, blocks,
         )
-        if st == EL_OK and er == 0 and el_out[e, E_DT] < dt_erode:
+        if st == EL_INVERTED and erode_inverted:
+            # crushed through itself (LS-DYNA's erosion on a negative Jacobian): it goes,
+            # with the energies it held at the start of the step
+            el_out[e, E_ALIVE] = 0.0
+            el_out[e, E_DT] = math.inf
+            clear_block(blocks, e)
+            st = EL_OK
+            er = 1
+        elif st == EL_OK and er == 0 and el_out[e, E_DT] < dt_erode:
             el_out[e, E_ALIVE] = 0.0
             el_out[e, E_DT] = math.inf
             clear_block(blocks, e)

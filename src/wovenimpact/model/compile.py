@@ -360,6 +360,7 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
             friction=spec.contact.friction, self_contact=spec.contact.self_contact),
         release_elems=mesh.elem_sets.get("blade.release") if spin is not None else None,
         release_time=spec.spin.release_time if spin is not None else math.inf,
+        erode_inverted=spec.run.erode_inverted,
     )
     v = np.zeros((mesh.n_nodes, 3))
     w = np.zeros((mesh.n_nodes, 3))

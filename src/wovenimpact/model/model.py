@@ -309,6 +309,8 @@ class Model:
         node_sets, elem_sets: named index arrays (outputs, BCs).
         shell_contact: parameters of the shell–shell contact between the surfaces
             (``ply`` labels the surfaces: plies, element sets or connected parts).
+        erode_inverted: an inverted element (non-positive area or Jacobian) is eroded
+            instead of stopping the run (LS-DYNA's erosion on negative volume).
         release_elems, release_time: elements eroded at ``release_time`` (s) — the
             tie between a blade's hub part and its fragment (theory §7.2); none by default.
         section_names, material_names: labels for reports.
@@ -345,6 +347,7 @@ class Model:
     node_sets: dict = field(default_factory=dict)
     elem_sets: dict = field(default_factory=dict)
     shell_contact: ShellContactParams = ShellContactParams()
+    erode_inverted: bool = False
     release_elems: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     release_time: float = math.inf
     section_names: tuple = ()
@@ -369,7 +372,7 @@ class Model:
             h.update(str(a.dtype).encode() + str(a.shape).encode())
             h.update(a.tobytes())
         h.update(repr((self.ramp_time, self.alpha, self.erode_dt_fraction,
-                       self.shell_contact, self.release_time)).encode())
+                       self.shell_contact, self.release_time, self.erode_inverted)).encode())
         h.update(np.ascontiguousarray(self.release_elems).tobytes())
         return h.hexdigest()
 
@@ -489,6 +492,7 @@ def build_model(
     shell_contact: ShellContactParams | None = None,
     release_elems=None,
     release_time: float = math.inf,
+    erode_inverted: bool = False,
 ) -> Model:
     """Assemble a :class:`Model` from a mesh, named sections and constraints.
 
@@ -614,5 +618,6 @@ def build_model(
         node_sets=dict(node_sets or {}), elem_sets=dict(elem_sets or {}),
         shell_contact=shell_contact or ShellContactParams(),
         release_elems=release_array(release_elems, len(q)), release_time=float(release_time),
+        erode_inverted=bool(erode_inverted),
         section_names=tuple(names), material_names=tuple(getattr(m, "name", "") for m in mats),
     )

@@ -107,7 +107,7 @@ def shell_forces(model, state: State, ws: Workspace) -> None:
         model.sections, model.mat_kind, model.mat_params, model.area0, model.ref_grad,
         model.gauss_grad, model.gauss_weight, state.elem, ws.elem, state.mat, ws.mat,
         model.point_width, ws.blocks, ws.status, ws.eroded_now, ws.alive,
-        model.erode_dt_fraction * state.dt_first / model.alpha,
+        model.erode_dt_fraction * state.dt_first / model.alpha, model.erode_inverted,
     )
     if n_failed:
         bad = np.flatnonzero(ws.status)

@@ -48,7 +48,7 @@ Schema (see README and examples/cases/)::
     [[initial_erosion]]  centre, radius, plies?: elements eroded at t = 0 (a hole: centroid
                       within radius of the axis through centre along cylinder_axis)
     [run]             end_time, field_interval, history_interval, checkpoint_interval,
-                      alpha, erode_dt_fraction, threads
+                      alpha, erode_dt_fraction, erode_inverted, threads
 """
 
 from __future__ import annotations
@@ -258,6 +258,8 @@ class RunSpec(BaseModel):
     checkpoint_interval: Time | None = None
     alpha: quantity("dimensionless", gt=0, le=1, example="0.9") = 0.9
     erode_dt_fraction: quantity("dimensionless", ge=0, lt=1, example="0.05") = 0.05
+    # an element crushed through itself is eroded (true) or stops the run (false)
+    erode_inverted: bool = False
     threads: int | None = Field(default=None, ge=1)
 
 

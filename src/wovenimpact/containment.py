@@ -1,4 +1,4 @@
-"""Engineering quantities of a containment run (thesis ch. 8; docs/theory.md §7.3).
+"""Engineering quantities of a containment run (thesis ch. 8; docs/theory.md §8.3).
 
 A containment model (``[mesh] kind = "containment"``) has node sets ``blade.fragment``
 and ``casing.layer{k}``. Per history row: the fragment's centre-of-mass speed, radial

@@ -312,7 +312,7 @@ class Model:
         erode_inverted: an inverted element (non-positive area or Jacobian) is eroded
             instead of stopping the run (LS-DYNA's erosion on negative volume).
         release_elems, release_time: elements eroded at ``release_time`` (s) — the
-            tie between a blade's hub part and its fragment (theory §7.2); none by default.
+            tie between a blade's hub part and its fragment (theory §8.2); none by default.
         section_names, material_names: labels for reports.
     """
 

@@ -1,4 +1,4 @@
-"""Steady spin state of a rotating structure by dynamic relaxation (docs/theory.md §7.1).
+"""Steady spin state of a rotating structure by dynamic relaxation (docs/theory.md §8.1).
 
 The thesis spins its fan blade up from rest over 9 s of implicit dynamics to get the
 centrifugal pre-stress and the nodal velocities at 1047 rad/s (its §8.2). The steady

@@ -190,8 +190,8 @@ class ContainmentMeshSpec(BaseModel):
 
 class SpinSpec(BaseModel):
     """``[spin]``: the blade turns at ``rate`` about the z axis: its centrifugal
-    pre-stress by dynamic relaxation, then ω × r velocities (theory §7.1); its root
-    keeps turning; the fragment is released at ``release_time`` (theory §7.2)."""
+    pre-stress by dynamic relaxation, then ω × r velocities (theory §8.1); its root
+    keeps turning; the fragment is released at ``release_time`` (theory §8.2)."""
 
     model_config = STRICT
     rate: Spin = 1047.0

@@ -67,6 +67,7 @@ import math
 from numba import prange
 
 from wovenimpact.jit import kernel, loop_kernel
+from wovenimpact.kernels.contact_law import pair_force
 
 GEO_XI, GEO_ETA, GEO_DIST, GEO_N, GEO_SIDE = 0, 1, 2, 3, 6  # columns of the pair table
 N_GEO = 7
@@ -291,22 +292,12 @@ def penalty_forces(
                 vx = v[p, 0] - (n1 * v[q0, 0] + n2 * v[q1, 0] + n3 * v[q2, 0] + n4 * v[q3, 0])
                 vy = v[p, 1] - (n1 * v[q0, 1] + n2 * v[q1, 1] + n3 * v[q2, 1] + n4 * v[q3, 1])
                 vz = v[p, 2] - (n1 * v[q0, 2] + n2 * v[q1, 2] + n3 * v[q2, 2] + n4 * v[q3, 2])
-                vn = vx * nx + vy * ny + vz * nz
             else:
-                vx = vy = vz = vn = 0.0
+                vx = vy = vz = 0.0
             # at most ½ m_red/Δt: the two passes of a pair then remove at most its whole
             # relative normal velocity in one step (a stable explicit dashpot)
             c_pen = min(2.0 * zeta * math.sqrt(k_pen * m_red), 0.5 * m_red / dt)
-            f_n = -k_pen * g - c_pen * vn
-            gx, gy, gz = f_n * nx, f_n * ny, f_n * nz
-            if mu > 0.0:
-                tx, ty, tz = vx - vn * nx, vy - vn * ny, vz - vn * nz
-                vt = math.sqrt(tx * tx + ty * ty + tz * tz)
-                if vt > 0.0:
-                    f_t = min(mu * abs(f_n), 0.5 * m_red * vt / dt)
-                    gx -= f_t * tx / vt
-                    gy -= f_t * ty / vt
-                    gz -= f_t * tz / vt
+            gx, gy, gz = pair_force(-k_pen * g, c_pen, vx, vy, vz, nx, ny, nz, mu, m_red, dt)
             pair_f[k, 0] = gx
             pair_f[k, 1] = gy
             pair_f[k, 2] = gz

@@ -18,6 +18,7 @@ import math
 from numba import prange
 
 from wovenimpact.jit import kernel, loop_kernel
+from wovenimpact.kernels.contact_law import pair_force
 
 
 @kernel
@@ -130,17 +131,7 @@ def rigid_contact_forces(
         vrx = v[i, 0] - (body_v[0] + body_w[1] * az_ - body_w[2] * ay_)
         vry = v[i, 1] - (body_v[1] + body_w[2] * ax_ - body_w[0] * az_)
         vrz = v[i, 2] - (body_v[2] + body_w[0] * ay_ - body_w[1] * ax_)
-        vn = vrx * nx + vry * ny + vrz * nzz
-        f = k * gap - c * vn
-        fx, fy, fz = f * nx, f * ny, f * nzz
-        if mu > 0.0:
-            tx, ty, tz = vrx - vn * nx, vry - vn * ny, vrz - vn * nzz
-            vt = math.sqrt(tx * tx + ty * ty + tz * tz)
-            if vt > 0.0:
-                f_t = min(mu * abs(f), 0.5 * m * vt / dt)
-                fx -= f_t * tx / vt
-                fy -= f_t * ty / vt
-                fz -= f_t * tz / vt
+        fx, fy, fz = pair_force(k * gap, c, vrx, vry, vrz, nx, ny, nzz, mu, m, dt)
         force[i, 0] = fx
         force[i, 1] = fy
         force[i, 2] = fz

@@ -4,8 +4,11 @@ Kept apart from the kernels so the Python side (materials/fabric.py, outputs,
 tests) can name entries without importing compiled code. Plain integer
 constants: Numba treats module-level ints as compile-time constants.
 
-Parameter vector ``p`` (float64, length ``N_PARAM``), SI units. Index 0/1 of a
-pair is warp/fill.
+Parameter vector ``p`` (float64, length ``N_PARAM``, followed by the crossover table
+when ``p[P_TAB_NW] > 0``: length ``N_PARAM + n_w + n_f + TAB_STRIDE n_w n_f``), SI units.
+Index 0/1 of a pair is warp/fill. The table rides in the same row of
+``Model.mat_params`` (rows are zero-padded to the longest), so it reaches every
+kernel without new arguments.
 """
 
 # --- parameters -------------------------------------------------------------
@@ -32,7 +35,27 @@ P_FRAME = 26  # frame option: FRAME_FIBRE or FRAME_GREEN_NAGHDI
 P_FAILURE = 27  # failure option: FAILURE_INSTANT or FAILURE_PROGRESSIVE
 P_AREAL_MASS = 28  # μ, areal mass (kg/m²) — derived or measured
 P_ERODE_STRETCH = 29  # erode once a broken family is stretched past this (—), 0: never
-N_PARAM = 30
+P_CROSSOVER = 30  # crossover evaluation: CROSSOVER_EXACT or CROSSOVER_TABLE (theory §1.9)
+P_TAB_NW = 31  # n_w, knots of the stored-energy table along λ_w (0: no table)
+P_TAB_NF = 32  # n_f, knots along λ_f
+P_TAB_START = 33  # index in the row where the table starts (= N_PARAM)
+N_PARAM = 34
+
+CROSSOVER_EXACT = 0
+CROSSOVER_TABLE = 1
+
+# --- tabulated crossover (theory §1.9), appended to the parameter row ----------------
+# From p[P_TAB_START] on, with s = P_TAB_START, n_w = p[P_TAB_NW], n_f = p[P_TAB_NF]:
+#   p[s : s + n_w]                   knots λ_w (increasing, non-uniform)
+#   p[s + n_w : s + n_w + n_f]       knots λ_f
+#   p[s + n_w + n_f + TAB_STRIDE (i n_f + j) + q], knot (i, j), entry q:
+T_W = 0  # W, crossover stored energy per unit reference area (J/m²), shear excluded
+T_W_W = 1  # ∂W/∂λ_w
+T_W_F = 2  # ∂W/∂λ_f
+T_W_WF = 3  # ∂²W/∂λ_w∂λ_f
+T_HW = 4  # H_w (m), then ∂H_w/∂λ_w, ∂H_w/∂λ_f, ∂²H_w/∂λ_w∂λ_f at T_HW + 1..3
+T_HF = 8  # H_f (m), and its three derivatives at T_HF + 1..3
+TAB_STRIDE = 12
 
 HOMOG_VIRIAL = 0
 HOMOG_THESIS = 1

@@ -61,6 +61,10 @@ class FabricOptions:
     # a point whose broken family is stretched beyond this erodes (0: only when both
     # families are broken); nothing holds the element together across broken yarns
     erode_broken_stretch: float = 2.0
+    # crossover evaluation (theory §1.9): "table" interpolates the tabulated stored
+    # energy while both families are intact and inside the table (fibre frame only),
+    # "exact" always runs the height solve (the reference)
+    crossover: Literal["table", "exact"] = "exact"
 
 
 @dataclass(frozen=True)
@@ -158,7 +162,9 @@ class FabricParameters:
         return out
 
     def to_array(self) -> np.ndarray:
-        """Pack into the flat parameter vector read by the kernels."""
+        """Pack into the flat parameter vector read by the kernels (with the crossover
+        table appended when ``options.crossover == "table"`` and the frame is the fibre
+        frame; the Green–Naghdi option keeps the exact solve)."""
         p = np.zeros(L.N_PARAM)
         for i, y in enumerate((self.warp, self.fill)):
             p[L.P_E + i] = y.modulus
@@ -185,6 +191,17 @@ class FabricParameters:
         ]
         p[L.P_AREAL_MASS] = self.areal_mass
         p[L.P_ERODE_STRETCH] = o.erode_broken_stretch
+        p[L.P_TAB_START] = L.N_PARAM
+        if o.crossover == "table" and o.frame == "fibre":
+            from wovenimpact.materials.fabric_table import crossover_table
+
+            nw, nf, block = crossover_table(self)
+            p[L.P_CROSSOVER] = L.CROSSOVER_TABLE
+            p[L.P_TAB_NW] = nw
+            p[L.P_TAB_NF] = nf
+            p = np.concatenate([p, block])
+        else:
+            p[L.P_CROSSOVER] = L.CROSSOVER_EXACT
         return p
 
 

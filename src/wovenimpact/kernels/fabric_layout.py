@@ -55,7 +55,9 @@ T_W_F = 2  # ∂W/∂λ_f
 T_W_WF = 3  # ∂²W/∂λ_w∂λ_f
 T_HW = 4  # H_w (m), then ∂H_w/∂λ_w, ∂H_w/∂λ_f, ∂²H_w/∂λ_w∂λ_f at T_HW + 1..3
 T_HF = 8  # H_f (m), and its three derivatives at T_HF + 1..3
-TAB_STRIDE = 12
+T_EXACT = 12  # 1.0: the cell [λ_w,i, λ_w,i+1] × [λ_f,j, λ_f,j+1] is solved exactly (its
+#              interpolant missed the accuracy target at build time), 0.0: interpolated
+TAB_STRIDE = 13
 
 HOMOG_VIRIAL = 0
 HOMOG_THESIS = 1

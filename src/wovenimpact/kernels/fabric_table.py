@@ -25,6 +25,7 @@ from wovenimpact.kernels.fabric_layout import (
     P_TAB_NW,
     P_TAB_START,
     T_HF,
+    T_EXACT,
     T_HW,
     T_W,
     TAB_STRIDE,
@@ -79,7 +80,8 @@ def crossover_from_table(p, m, lam_w, lam_f):
 
     Returns:
         (inside, W, ∂W/∂λ_w, ∂W/∂λ_f, H_w, H_f): inside is False (and the rest 0) when
-        the point lies outside the table (then the caller solves exactly).
+        the point lies outside the table or in a cell marked T_EXACT (then the caller
+        solves exactly).
     """
     nw = int(p[m, P_TAB_NW])
     nf = int(p[m, P_TAB_NF])
@@ -90,13 +92,15 @@ def crossover_from_table(p, m, lam_w, lam_f):
     j = knot_interval(p, m, start + nw, nf, lam_f)
     if i < 0 or j < 0:
         return False, 0.0, 0.0, 0.0, 0.0, 0.0
+    base = start + nw + nf
+    if p[m, base + TAB_STRIDE * (i * nf + j) + T_EXACT] != 0.0:
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0
     x0 = p[m, start + i]
     hx = p[m, start + i + 1] - x0
     y0 = p[m, start + nw + j]
     hy = p[m, start + nw + j + 1] - y0
     ax0, ax1, bx0, bx1, dax0, dax1, dbx0, dbx1 = hermite_basis((lam_w - x0) / hx, hx)
     ay0, ay1, by0, by1, day0, day1, dby0, dby1 = hermite_basis((lam_f - y0) / hy, hy)
-    base = start + nw + nf
     w = 0.0
     gw = 0.0
     gf = 0.0

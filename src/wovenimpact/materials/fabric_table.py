@@ -125,7 +125,7 @@ def family_knots(own, other, coarse=COARSE, dense=FINE) -> np.ndarray:
     hi = FAILURE_MARGIN * failure_stretch(own)
     taut = own.truss_length / own.half_length
     comp = compressed_onset(own, other)
-    fine = [(0.985, taut + 0.005)]
+    fine = [(0.985, taut + 0.012)]
     if comp > LAMBDA_MIN:
         fine.append((comp - 0.01, comp + 0.01))
     return knots(LAMBDA_MIN, hi, fine, coarse, dense, kinks=(taut, comp))
@@ -168,7 +168,74 @@ def tabulate(params, knots_w: np.ndarray, knots_f: np.ndarray, fd_step: float = 
         data[..., q + 1] = (h[xp] - h[xm]) / (2 * e)
         data[..., q + 2] = (h[yp] - h[ym]) / (2 * e)
         data[..., q + 3] = (h[pp] - h[pm] - h[mp] + h[mm]) / (4 * e * e)
-    return np.concatenate([knots_w, knots_f, data.ravel()])
+    block = np.concatenate([knots_w, knots_f, data.ravel()])
+    return block
+
+
+TOLERANCE = 1e-4  # accuracy target (theory §1.9 states the norms)
+BUILD_SAFETY = 0.5  # cells are marked exact above BUILD_SAFETY × TOLERANCE at build time
+CELL_SAMPLES = (0.05, 0.2, 0.35, 0.5, 0.65, 0.8, 0.95)  # sample points per cell and direction
+
+
+def reference_scales(params) -> dict[str, float]:
+    """Scales of the accuracy norms: T_u per family (tensions), h_i0 (heights), and
+    W_u = min_i T_ui² L_i0 / (E_i A_i A0), the energy of a straight family at failure
+    per unit reference area (energy)."""
+    w, f = params.warp, params.fill
+    area0 = 4.0 * w.half_length * f.half_length
+    wu = min(y.ultimate_tension**2 * y.truss_length / (y.modulus * y.area * area0) for y in (w, f))
+    return {"T_w": w.ultimate_tension, "T_f": f.ultimate_tension, "H_w": w.h0, "H_f": f.h0,
+            "W": wu}
+
+
+def table_errors(params, row: np.ndarray, lam_w, lam_f) -> dict[str, np.ndarray]:
+    """Errors of the table in ``row`` against the exact solve at (λ_w, λ_f), each divided
+    by its scale (:func:`reference_scales`); NaN where the norm does not apply: heights
+    while a yarn is slack (not unique), everything beyond failure (T_i ≥ T_ui) or where the
+    table defers to the exact solve. Tensions as the kernel derives them."""
+    from wovenimpact.kernels.fabric_table import crossover_from_table_for_points
+
+    lam_w = np.ascontiguousarray(lam_w, dtype=float).ravel()
+    lam_f = np.ascontiguousarray(lam_f, dtype=float).ravel()
+    out = np.empty((lam_w.size, 6))
+    crossover_from_table_for_points(row, lam_w, lam_f, out)
+    ex = exact_crossover(params, lam_w, lam_f)
+    w, f = params.warp, params.fill
+    area0 = 4.0 * w.half_length * f.half_length
+    sc = reference_scales(params)
+    hw, hf = np.maximum(out[:, 4], 0.0), np.maximum(out[:, 5], 0.0)
+    ell_w, ell_f = lam_w * w.half_length, lam_f * f.half_length
+    tw = np.maximum(out[:, 2] * area0 * np.hypot(ell_w, hw) / (2 * w.half_length * ell_w), 0.0)
+    tf = np.maximum(out[:, 3] * area0 * np.hypot(ell_f, hf) / (2 * f.half_length * ell_f), 0.0)
+    valid = (out[:, 0] == 1.0) & (ex["T_w"] < w.ultimate_tension) & (ex["T_f"] < f.ultimate_tension)
+    contact = valid & (ex["T_w"] > 0.0) & (ex["T_f"] > 0.0)
+    nan = np.nan
+    return {
+        "T_w": np.where(valid, np.abs(tw - ex["T_w"]) / sc["T_w"], nan),
+        "T_f": np.where(valid, np.abs(tf - ex["T_f"]) / sc["T_f"], nan),
+        "W": np.where(valid, np.abs(out[:, 1] - ex["W"]) / sc["W"], nan),
+        "H_w": np.where(contact, np.abs(hw - ex["H_w"]) / sc["H_w"], nan),
+        "H_f": np.where(contact, np.abs(hf - ex["H_f"]) / sc["H_f"], nan),
+    }
+
+
+def mark_exact_cells(params, knots_w, knots_f, block, tol=BUILD_SAFETY * TOLERANCE):
+    """Mark (T_EXACT) every cell whose interpolant misses ``tol`` at a CELL_SAMPLES² grid
+    of interior points; returns the marked fraction of the cells."""
+    nw, nf = len(knots_w), len(knots_f)
+    row = np.concatenate([np.zeros(L.N_PARAM), block])
+    row[L.P_TAB_NW], row[L.P_TAB_NF], row[L.P_TAB_START] = nw, nf, L.N_PARAM
+    sw = np.asarray(CELL_SAMPLES)
+    cw = knots_w[:-1, None] + np.diff(knots_w)[:, None] * sw[None, :]  # (nw − 1, s)
+    cf = knots_f[:-1, None] + np.diff(knots_f)[:, None] * sw[None, :]
+    lw = np.broadcast_to(cw[:, None, :, None], (nw - 1, nf - 1, sw.size, sw.size))
+    lf = np.broadcast_to(cf[None, :, None, :], (nw - 1, nf - 1, sw.size, sw.size))
+    err = table_errors(params, row, lw, lf)
+    worst = np.nanmax(np.stack([np.nan_to_num(e, nan=0.0) for e in err.values()]), axis=0)
+    bad = worst.reshape(nw - 1, nf - 1, -1).max(axis=2) > tol
+    data = block[nw + nf:].reshape(nw, nf, L.TAB_STRIDE)
+    data[:-1, :-1, L.T_EXACT] = bad.astype(float)
+    return float(bad.mean())
 
 
 def _options_free(params):
@@ -182,6 +249,7 @@ def _cached_table(params) -> tuple[int, int, np.ndarray]:
     kw = family_knots(params.warp, params.fill)
     kf = family_knots(params.fill, params.warp)
     block = tabulate(params, kw, kf)
+    mark_exact_cells(params, kw, kf, block)
     block.flags.writeable = False
     return len(kw), len(kf), block
 

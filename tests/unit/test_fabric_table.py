@@ -30,9 +30,7 @@ def exact_row(params):
 
 
 def layout(row):
-    nw, nf, s = int(row[L.P_TAB_NW]), int(row[L.P_TAB_NF]), int(row[L.P_TAB_START])
-    data = row[s + nw + nf:].reshape(nw, nf, L.TAB_STRIDE)
-    return row[s:s + nw], row[s + nw:s + nw + nf], data
+    return (*FT.table_knots(row), FT.table_data(row))
 
 
 @pytest.mark.parametrize("lam_w, lam_f", [(1.02, 1.0), (1.04, 1.01), (1.01, 1.035), (1.05, 0.95),

@@ -5,7 +5,8 @@ tests) can name entries without importing compiled code. Plain integer
 constants: Numba treats module-level ints as compile-time constants.
 
 Parameter vector ``p`` (float64, length ``N_PARAM``, followed by the crossover table
-when ``p[P_TAB_NW] > 0``: length ``N_PARAM + n_w + n_f + TAB_STRIDE n_w n_f``), SI units.
+when ``p[P_TAB_NW] > 0``: length ``N_PARAM + n_w + n_f + m_w + m_f + TAB_STRIDE n_w n_f``),
+SI units.
 Index 0/1 of a pair is warp/fill. The table rides in the same row of
 ``Model.mat_params`` (rows are zero-padded to the longest), so it reaches every
 kernel without new arguments.
@@ -38,17 +39,26 @@ P_ERODE_STRETCH = 29  # erode once a broken family is stretched past this (—),
 P_CROSSOVER = 30  # crossover evaluation: CROSSOVER_EXACT or CROSSOVER_TABLE (theory §1.9)
 P_TAB_NW = 31  # n_w, knots of the stored-energy table along λ_w (0: no table)
 P_TAB_NF = 32  # n_f, knots along λ_f
-P_TAB_START = 33  # index in the row where the table starts (= N_PARAM)
-N_PARAM = 34
+P_TAB_START = 33  # s, index in the row where the table starts (= N_PARAM)
+P_TAB_NBW = 34  # m_w, buckets of the uniform knot-lookup map along λ_w
+P_TAB_NBF = 35  # m_f, along λ_f
+P_TAB_IBW = 36  # 1 / bucket width along λ_w
+P_TAB_IBF = 37  # 1 / bucket width along λ_f
+P_TAB_DATA = 38  # index in the row of the first knot's data (= s + n_w + n_f + m_w + m_f)
+N_PARAM = 39
 
 CROSSOVER_EXACT = 0
 CROSSOVER_TABLE = 1
 
 # --- tabulated crossover (theory §1.9), appended to the parameter row ----------------
-# From p[P_TAB_START] on, with s = P_TAB_START, n_w = p[P_TAB_NW], n_f = p[P_TAB_NF]:
-#   p[s : s + n_w]                   knots λ_w (increasing, non-uniform)
-#   p[s + n_w : s + n_w + n_f]       knots λ_f
-#   p[s + n_w + n_f + TAB_STRIDE (i n_f + j) + q], knot (i, j), entry q:
+# From p[s] on (s = P_TAB_START; n_w, n_f, m_w, m_f as above):
+#   p[s : s + n_w]                    knots λ_w (increasing, non-uniform)
+#   p[s + n_w : s + n_w + n_f]        knots λ_f
+#   next m_w, then m_f entries        bucket maps: bucket b = ⌊(λ − λ_first)·(1/width)⌋
+#                                     holds the index of the knot interval containing its
+#                                     left edge (widths ≤ the smallest knot spacing / 2,
+#                                     so locating a point is O(1): no search)
+#   p[P_TAB_DATA + TAB_STRIDE (i n_f + j) + q]: knot (i, j), entry q:
 T_W = 0  # W, crossover stored energy per unit reference area (J/m²), shear excluded
 T_W_W = 1  # ∂W/∂λ_w
 T_W_F = 2  # ∂W/∂λ_f

@@ -193,13 +193,9 @@ class FabricParameters:
         p[L.P_ERODE_STRETCH] = o.erode_broken_stretch
         p[L.P_TAB_START] = L.N_PARAM
         if o.crossover == "table" and o.frame == "fibre":
-            from wovenimpact.materials.fabric_table import crossover_table
+            from wovenimpact.materials.fabric_table import with_table
 
-            nw, nf, block = crossover_table(self)
-            p[L.P_CROSSOVER] = L.CROSSOVER_TABLE
-            p[L.P_TAB_NW] = nw
-            p[L.P_TAB_NF] = nf
-            p = np.concatenate([p, block])
+            p = with_table(self, p)
         else:
             p[L.P_CROSSOVER] = L.CROSSOVER_EXACT
         return p

@@ -138,8 +138,47 @@ def kink_knots(own, other, k: np.ndarray) -> np.ndarray:
     return np.array([any(abs(x - m) < 1e-12 for m in marks) for x in k])
 
 
+def bucket_map(k: np.ndarray) -> tuple[np.ndarray, float]:
+    """Uniform lookup map of the knots ``k`` (layout in fabric_layout): buckets of width half
+    the smallest knot spacing, each holding the index of the knot interval that contains
+    its left edge; returns (map, 1/width)."""
+    width = 0.5 * float(np.min(np.diff(k)))
+    nb = int(math.ceil((k[-1] - k[0]) / width)) + 1
+    edges = k[0] + width * np.arange(nb)
+    idx = np.clip(np.searchsorted(k, edges, side="right") - 1, 0, len(k) - 2)
+    return idx.astype(float), 1.0 / width
+
+
+def install(head: np.ndarray, knots_w: np.ndarray, knots_f: np.ndarray, data: np.ndarray):
+    """The parameter row: ``head`` (N_PARAM entries) with the table header set, followed by
+    knots, bucket maps and knot data (nw, nf, TAB_STRIDE) — layout in fabric_layout."""
+    bw, ibw = bucket_map(knots_w)
+    bf, ibf = bucket_map(knots_f)
+    row = np.concatenate([head[: L.N_PARAM], knots_w, knots_f, bw, bf, data.ravel()])
+    row[L.P_CROSSOVER] = L.CROSSOVER_TABLE
+    row[L.P_TAB_NW], row[L.P_TAB_NF] = len(knots_w), len(knots_f)
+    row[L.P_TAB_START] = L.N_PARAM
+    row[L.P_TAB_NBW], row[L.P_TAB_NBF] = len(bw), len(bf)
+    row[L.P_TAB_IBW], row[L.P_TAB_IBF] = ibw, ibf
+    row[L.P_TAB_DATA] = L.N_PARAM + len(knots_w) + len(knots_f) + len(bw) + len(bf)
+    return row
+
+
+def table_data(row: np.ndarray) -> np.ndarray:
+    """View (nw, nf, TAB_STRIDE) of the knot data in a parameter row."""
+    nw, nf = int(row[L.P_TAB_NW]), int(row[L.P_TAB_NF])
+    s = int(row[L.P_TAB_DATA])
+    return row[s:s + nw * nf * L.TAB_STRIDE].reshape(nw, nf, L.TAB_STRIDE)
+
+
+def table_knots(row: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    nw, nf, s = int(row[L.P_TAB_NW]), int(row[L.P_TAB_NF]), int(row[L.P_TAB_START])
+    return row[s:s + nw], row[s + nw:s + nw + nf]
+
+
 def tabulate(params, knots_w: np.ndarray, knots_f: np.ndarray, fd_step: float = FD_STEP):
-    """Table block (flat array) for ``params`` on the given knots (layout in fabric_layout)."""
+    """Knot data (nw, nf, TAB_STRIDE) for ``params`` on the given knots (layout in
+    fabric_layout), T_EXACT entries 0."""
     nw, nf = len(knots_w), len(knots_f)
     e = fd_step
     gw, gf = np.meshgrid(knots_w, knots_f, indexing="ij")
@@ -168,8 +207,7 @@ def tabulate(params, knots_w: np.ndarray, knots_f: np.ndarray, fd_step: float = 
         data[..., q + 1] = (h[xp] - h[xm]) / (2 * e)
         data[..., q + 2] = (h[yp] - h[ym]) / (2 * e)
         data[..., q + 3] = (h[pp] - h[pm] - h[mp] + h[mm]) / (4 * e * e)
-    block = np.concatenate([knots_w, knots_f, data.ravel()])
-    return block
+    return data
 
 
 TOLERANCE = 1e-4  # accuracy target (theory §1.9 states the norms)
@@ -219,12 +257,11 @@ def table_errors(params, row: np.ndarray, lam_w, lam_f) -> dict[str, np.ndarray]
     }
 
 
-def mark_exact_cells(params, knots_w, knots_f, block, tol=BUILD_SAFETY * TOLERANCE):
-    """Mark (T_EXACT) every cell whose interpolant misses ``tol`` at a CELL_SAMPLES² grid
-    of interior points; returns the marked fraction of the cells."""
+def mark_exact_cells(params, row, tol=BUILD_SAFETY * TOLERANCE):
+    """Mark (T_EXACT, in place) every cell of the table in ``row`` whose interpolant misses
+    ``tol`` at a CELL_SAMPLES² grid of interior points; returns the marked fraction."""
+    knots_w, knots_f = table_knots(row)
     nw, nf = len(knots_w), len(knots_f)
-    row = np.concatenate([np.zeros(L.N_PARAM), block])
-    row[L.P_TAB_NW], row[L.P_TAB_NF], row[L.P_TAB_START] = nw, nf, L.N_PARAM
     sw = np.asarray(CELL_SAMPLES)
     cw = knots_w[:-1, None] + np.diff(knots_w)[:, None] * sw[None, :]  # (nw − 1, s)
     cf = knots_f[:-1, None] + np.diff(knots_f)[:, None] * sw[None, :]
@@ -233,8 +270,7 @@ def mark_exact_cells(params, knots_w, knots_f, block, tol=BUILD_SAFETY * TOLERAN
     err = table_errors(params, row, lw, lf)
     worst = np.nanmax(np.stack([np.nan_to_num(e, nan=0.0) for e in err.values()]), axis=0)
     bad = worst.reshape(nw - 1, nf - 1, -1).max(axis=2) > tol
-    data = block[nw + nf:].reshape(nw, nf, L.TAB_STRIDE)
-    data[:-1, :-1, L.T_EXACT] = bad.astype(float)
+    table_data(row)[:-1, :-1, L.T_EXACT] = bad.astype(float)
     return float(bad.mean())
 
 
@@ -244,17 +280,25 @@ def _options_free(params):
     return dataclasses.replace(params, options=FabricOptions(crossover="exact"))
 
 
+TABLE_HEADER = (L.P_CROSSOVER, L.P_TAB_NW, L.P_TAB_NF, L.P_TAB_START, L.P_TAB_NBW,
+                L.P_TAB_NBF, L.P_TAB_IBW, L.P_TAB_IBF, L.P_TAB_DATA)
+
+
 @functools.lru_cache(maxsize=64)
-def _cached_table(params) -> tuple[int, int, np.ndarray]:
+def _cached_table(params) -> np.ndarray:
     kw = family_knots(params.warp, params.fill)
     kf = family_knots(params.fill, params.warp)
-    block = tabulate(params, kw, kf)
-    mark_exact_cells(params, kw, kf, block)
-    block.flags.writeable = False
-    return len(kw), len(kf), block
+    row = install(np.zeros(L.N_PARAM), kw, kf, tabulate(params, kw, kf))
+    mark_exact_cells(params, row)
+    row.flags.writeable = False
+    return row
 
 
-def crossover_table(params) -> tuple[int, int, np.ndarray]:
-    """(n_w, n_f, block) of the material's table (cached per parameter set; options do
-    not enter it)."""
-    return _cached_table(_options_free(params))
+def with_table(params, head: np.ndarray) -> np.ndarray:
+    """The parameter row ``head`` (N_PARAM entries) with the material's crossover table
+    installed (built once per parameter set and cached; options do not enter it)."""
+    row = _cached_table(_options_free(params)).copy()
+    keep = np.ones(L.N_PARAM, bool)
+    keep[list(TABLE_HEADER)] = False
+    row[: L.N_PARAM][keep] = head[: L.N_PARAM][keep]
+    return row

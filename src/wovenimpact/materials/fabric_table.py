@@ -212,7 +212,7 @@ def tabulate(params, knots_w: np.ndarray, knots_f: np.ndarray, fd_step: float = 
 
 TOLERANCE = 1e-4  # accuracy target (theory §1.9 states the norms)
 BUILD_SAFETY = 0.5  # cells are marked exact above BUILD_SAFETY × TOLERANCE at build time
-CELL_SAMPLES = (0.05, 0.2, 0.35, 0.5, 0.65, 0.8, 0.95)  # sample points per cell and direction
+CELL_SAMPLES = tuple(np.linspace(0.0, 1.0, 9))  # 9 × 9 samples per cell, edges included
 
 
 def reference_scales(params) -> dict[str, float]:
@@ -254,12 +254,15 @@ def table_errors(params, row: np.ndarray, lam_w, lam_f) -> dict[str, np.ndarray]
         "W": np.where(valid, np.abs(out[:, 1] - ex["W"]) / sc["W"], nan),
         "H_w": np.where(contact, np.abs(hw - ex["H_w"]) / sc["H_w"], nan),
         "H_f": np.where(contact, np.abs(hf - ex["H_f"]) / sc["H_f"], nan),
+        "contact": (ex["T_w"] > 0.0) & (ex["T_f"] > 0.0),
     }
 
 
 def mark_exact_cells(params, row, tol=BUILD_SAFETY * TOLERANCE):
     """Mark (T_EXACT, in place) every cell of the table in ``row`` whose interpolant misses
-    ``tol`` at a CELL_SAMPLES² grid of interior points; returns the marked fraction."""
+    ``tol`` at a CELL_SAMPLES² grid of interior points, and every cell the onset of contact
+    crosses (yarns slack at some samples, in contact at others: the heights there have a
+    kink, and on the slack side they are not even unique); returns the marked fraction."""
     knots_w, knots_f = table_knots(row)
     nw, nf = len(knots_w), len(knots_f)
     sw = np.asarray(CELL_SAMPLES)
@@ -268,8 +271,10 @@ def mark_exact_cells(params, row, tol=BUILD_SAFETY * TOLERANCE):
     lw = np.broadcast_to(cw[:, None, :, None], (nw - 1, nf - 1, sw.size, sw.size))
     lf = np.broadcast_to(cf[None, :, None, :], (nw - 1, nf - 1, sw.size, sw.size))
     err = table_errors(params, row, lw, lf)
+    contact = err.pop("contact").reshape(nw - 1, nf - 1, -1)
     worst = np.nanmax(np.stack([np.nan_to_num(e, nan=0.0) for e in err.values()]), axis=0)
     bad = worst.reshape(nw - 1, nf - 1, -1).max(axis=2) > tol
+    bad |= contact.any(axis=2) & ~contact.all(axis=2)
     table_data(row)[:-1, :-1, L.T_EXACT] = bad.astype(float)
     return float(bad.mean())
 

@@ -8,7 +8,10 @@ current corotational frame), the kernel
 1. finds the stretches λ_i and yarn directions e_i (fibre frame, §1.7) or
    accumulates them incrementally (Green–Naghdi option, eq. 6.13–6.16);
 2. solves the crossover for the crimp heights H_w, H_f (eq. 6.19–6.25) with a
-   bracketed Newton iteration on one unknown (theory §1.3);
+   bracketed Newton iteration on one unknown (theory §1.3) — or, with the material's
+   crossover table (P_CROSSOVER, default), interpolates the stored energy W(λ_w, λ_f), its
+   gradient and the heights while both families are intact (theory §1.9,
+   ``kernels/fabric_table.py``);
 3. applies yarn failure (eq. 6.29, or progressive softening) and erosion;
 4. returns the membrane stress resultant N (force per unit current length,
    virial homogenisation §1.5 or the thesis's eq. 6.38), the trellis shear

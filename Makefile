@@ -14,22 +14,26 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
-# Flagship example: 4 Kevlar plies struck at 120 m/s (thesis ch. 7; ~30 s on 2 cores),
+# Flagship example: 4 Kevlar plies struck at 120 m/s (thesis ch. 7; its time: README),
 # and the single-element report of the crossover model.
 run: venv
 	$(BIN)/wovenimpact run examples/plate_impact/plies4_120.toml --out out/plies4_120
 	$(BIN)/wovenimpact element-test uniaxial --material examples/materials/kevlar_thesis.toml --out out/element_uniaxial
 	$(BIN)/wovenimpact element-test biaxial --material examples/materials/kevlar_thesis.toml --out out/element_biaxial
 	$(BIN)/wovenimpact element-test picture-frame --material examples/materials/kevlar_thesis.toml --out out/element_picture_frame
-	@echo "Report: out/plies4_120/ (summary.json, history.csv, plots/, fields/fields.pvd for ParaView)"
-	@echo "        out/element_*/history.csv and out/element_*/*.png"
+	@echo "Element tests: out/element_*/history.csv and out/element_*/*.png"
+	@echo "Flagship: out/plies4_120/ (summary.json, history.csv, plots/, fields/fields.pvd for ParaView)"
+	@echo "Report: out/plies4_120/report.html"
 
 test: venv
 	$(BIN)/python -m pytest -q
 
+# The machine line first; then the fabric kernel alone, the explicit step (the same as
+# `wovenimpact bench`) and the ply-on-ply contact.
 bench: venv
+	$(BIN)/python -c "from wovenimpact.benchmark import machine_line; print(machine_line())"
 	$(BIN)/python benchmarks/bench_fabric_kernel.py
-	$(BIN)/python benchmarks/bench_shell.py
+	$(BIN)/python benchmarks/bench_shell.py --no-machine-line
 	$(BIN)/python benchmarks/bench_contact.py
 
 clean:

@@ -2,7 +2,8 @@
 
 Options: ``--sizes=10000,100000``, ``--kinds=fabric,fabric_reduced``, ``--threads=1,2``, ``--steps=N``,
 ``--json`` (prints {"cases": [{"name", "elements", "threads", "ns_per_element_cycle",
-"shares"}]}). Same as ``wovenimpact bench``.
+"shares"}], "machine", "threading_layer"}), ``--no-machine-line`` (``make bench`` prints
+it first). Same as ``wovenimpact bench``.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ import sys
 
 import numba
 
-from wovenimpact.benchmark import DEFAULT_SIZES, case_line, run_cases
+from wovenimpact.benchmark import DEFAULT_SIZES, case_line, machine, machine_line, run_cases
 
 
 def main() -> None:
@@ -30,10 +31,13 @@ def main() -> None:
         elif arg.startswith("--steps="):
             steps = int(arg.split("=", 1)[1])
     quiet = "--json" in sys.argv
+    if not quiet and "--no-machine-line" not in sys.argv:
+        print(machine_line(), flush=True)
     cases = run_cases(kinds, sizes, thread_counts, steps,
                       report=None if quiet else (lambda c: print(case_line(c), flush=True)))
     if quiet:
-        print(json.dumps({"cases": cases, "threading_layer": numba.threading_layer()}))
+        print(json.dumps({"cases": cases, "machine": machine(),
+                          "threading_layer": numba.threading_layer()}))
     else:
         print(f"threading layer: {numba.threading_layer()}")
 

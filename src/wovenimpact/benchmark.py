@@ -1,5 +1,6 @@
 """Cost of the explicit step: ns per element-cycle for elastic and fabric shell plates
-(``wovenimpact bench``, ``make bench`` → benchmarks/bench_shell.py).
+(``wovenimpact bench``; ``make bench`` runs it between the fabric-kernel and the contact
+benchmarks of ``benchmarks/``). The first line printed is :func:`machine_line`.
 
 A clamped square plate, pre-stretched 2 % in-plane (so fabric yarns carry tension and
 the crossover solve does real work) and set moving with a smooth transverse velocity
@@ -89,6 +90,35 @@ def run_cases(kinds, sizes, thread_counts, steps: int = 20, report=None) -> list
                 if report is not None:
                     report(cases[-1])
     return cases
+
+
+def machine() -> dict:
+    """What a timing depends on: CPU model, cores, threads Numba may use, OS, versions, date."""
+    import os
+    import platform
+    from datetime import date
+
+    from wovenimpact import __version__
+
+    cpu = platform.processor() or platform.machine()
+    try:
+        with open("/proc/cpuinfo", encoding="utf-8") as f:
+            cpu = next(line.split(":", 1)[1].strip() for line in f if line.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
+    return {"cpu": cpu, "cores": os.cpu_count(), "numba_threads": numba.config.NUMBA_NUM_THREADS,
+            "system": platform.system(), "python": platform.python_version(),
+            "numba": numba.__version__, "wovenimpact": __version__,
+            "date": date.today().isoformat()}
+
+
+def machine_line(m: dict | None = None) -> str:
+    """The first line of ``wovenimpact bench`` / ``make bench``: where the numbers were taken
+    (the README quotes times with this line)."""
+    m = m or machine()
+    return (f"machine: {m['cpu']}, {m['cores']} cores ({m['numba_threads']} Numba threads), "
+            f"{m['system']}, Python {m['python']}, numba {m['numba']}, wovenimpact "
+            f"{m['wovenimpact']}, {m['date']}")
 
 
 def case_line(c: dict) -> str:

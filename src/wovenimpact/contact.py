@@ -33,7 +33,7 @@ class ShellContact:
     Usage in a time loop (nothing is written to the State; ``out_force`` is the
     caller's array)::
 
-        contact = ShellContact(model, beta=0.1, damping=1.0, friction=0.0)  # once
+        contact = ShellContact(model, beta=0.1, damping=0.3, friction=0.0)  # once
         ...
         energy, n_active = contact.forces(state.x, state.v, dt,
                                           state.elem[:, E_ALIVE], state.node_active,
@@ -81,8 +81,9 @@ class ShellContact:
 
     Keyword parameters:
         beta: penalty scale β of k = β min(m_node, m̄_segment) / Δt² (0 < β ≤ 0.5; 0.1).
-        damping: ζ, the pair dashpot as a fraction of critical 2 √(k m_red) (≥ 0;
-            default 1: struck surfaces come to rest on each other, theory §6.3).
+        damping: ζ, the pair dashpot as a fraction of critical 2 √(k m_red) (0–2;
+            default 0.3: struck plies part at about 15 % of their closing speed,
+            theory §6.3).
         friction: Coulomb coefficient μ ≥ 0 (0: frictionless, the default).
         plies: the plies taking part (default all); or
         elements: the element indices taking part (overrides ``plies``).
@@ -109,7 +110,7 @@ class ShellContact:
         model,
         *,
         beta: float = 0.1,
-        damping: float = 1.0,
+        damping: float = 0.3,
         friction: float = 0.0,
         plies=None,
         elements=None,

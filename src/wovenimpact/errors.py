@@ -8,6 +8,14 @@ class InputError(ValueError):
     """
 
 
+class InputWarning(UserWarning):
+    """An input that works but is probably not what was meant (an output interval longer
+    than the run, a quarter model without its symmetry constraints, more threads than
+    cores). The message names the input and what was done about it; the CLI prints it
+    as ``warning: …``.
+    """
+
+
 class MaterialPointError(RuntimeError):
     """A material point could not be updated (failed solve, inadmissible deformation).
 

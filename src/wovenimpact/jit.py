@@ -117,6 +117,21 @@ def set_threads(n: int) -> None:
     numba.set_num_threads(n)
 
 
+def capped_threads(n: int, source: str = "threads") -> int:
+    """``n`` threads, or NUMBA_NUM_THREADS (the cores of this machine unless set) if ``n``
+    is more, with an :class:`~wovenimpact.errors.InputWarning` naming ``source`` and the cap."""
+    top = numba.config.NUMBA_NUM_THREADS
+    if n > top:
+        import warnings
+
+        from wovenimpact.errors import InputWarning
+
+        warnings.warn(f"{source} = {n} is more than the {top} threads of this machine "
+                      f"(NUMBA_NUM_THREADS = {top}): using {top}", InputWarning, stacklevel=2)
+        return top
+    return n
+
+
 def _limit_threads(n: int) -> None:
     """Process-pool initializer: only ``n`` Numba threads exist in this worker."""
     os.environ["NUMBA_NUM_THREADS"] = str(n)

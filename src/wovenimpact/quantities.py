@@ -7,14 +7,23 @@ model, ``kernels.rigid_body.BP_FRACTION``); forces and energies returned here as
 
 from __future__ import annotations
 
+import math
+import weakref
+
 import numpy as np
 
+from wovenimpact.errors import InputError
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as S
 
 QUIET_TIME = 10e-6  # contact must have been light this long to call a perforation
 LIGHT_CONTACT = 0.01  # "light": below this fraction of the peak contact force
-STEADY_VELOCITY = 1e-3  # or the velocity changed by less than this fraction over it
+STEADY_VELOCITY = 1e-3  # a change between history rows above this fraction of the initial
+# speed is an engagement too (a contact that fell between the rows of a coarse history)
+REST_FRACTION = 0.01  # "at rest": speed along the travel below this fraction of the initial
+OUTCOMES = ("perforated", "stopped", "undecided", "no contact")
+OUTCOME_COLUMNS = ("time_s", "impactor_velocity_m_per_s", "contact_force_full_N",
+                   "intact_material_ahead")
 
 
 def symmetry_factor(model) -> float:
@@ -39,48 +48,155 @@ def impactor_row(model, state, b: int = 0) -> dict:
     return {
         "impactor_velocity_m_per_s": float(row[RB.B_V:RB.B_V + 3] @ d0),
         "impactor_displacement_m": float((row[RB.B_X:RB.B_X + 3] - x0) @ d0),
-        "contact_force_N": float(-(row[RB.B_F:RB.B_F + 3] @ d0) * factor),
+        "contact_force_full_N": float(-(row[RB.B_F:RB.B_F + 3] @ d0) * factor),
     }
 
 
-def residual_velocity(h: dict, quiet_time: float = QUIET_TIME) -> dict:
-    """Outcome of an impact from the impactor columns of a history.
+def impactor_radius(model, b: int = 0) -> float:
+    """Largest radius of impactor b's profile (its shank, or a sphere's radius; m)."""
+    n = int(model.body_params[b, RB.BP_NPTS])
+    return float(np.max(model.body_profiles[b, :n, 1]))
 
-    - stopped: the impactor's velocity along its travel reached zero; residual 0, and
-      the speed it bounced back with is reported as ``rebound_velocity_m_per_s``;
-    - perforated: still moving forward, and for the last ``quiet_time`` the contact force
-      has stayed below 1 % of its peak or the velocity has changed by less than 0.1 %
-      (torn yarns may still rub the shank; debris may strike it from behind);
-      residual = its final velocity;
-    - undecided: still moving forward and still (or recently) in contact: run longer;
-    - no contact: the impactor never touched anything (e.g. through a hole).
+
+def nose_tip(model, state, b: int = 0) -> np.ndarray:
+    """Position of impactor b's nose tip: the centre of mass plus ``BP_TIP`` along the
+    travel direction."""
+    return state.bodies[b, RB.B_X:RB.B_X + 3] + model.body_params[b, RB.BP_TIP] * travel_direction(
+        model, state, b)
+
+
+_ATTACHED_CACHE: dict = {}
+
+
+def attached_nodes(model, state) -> np.ndarray:
+    """(n_nodes,) bool: nodes of live elements connected, through live elements, to a
+    support — a node whose three translations are constrained (clamped, pinned or
+    driven; a symmetry plane constrains one and is no support). What is torn free (a
+    plug punched out, a fragment) is not attached. A model without any support (a free
+    target) counts all its live material as attached.
+
+    The components are recomputed only when the set of live elements changes (one
+    entry is kept: the model, held by a weak reference, and its alive flags)."""
+    alive = state.elem[:, S.E_ALIVE] != 0.0
+    ref = _ATTACHED_CACHE.get("model")
+    if (ref is not None and ref() is model
+            and np.array_equal(_ATTACHED_CACHE["alive"], alive)):
+        return _ATTACHED_CACHE["value"]
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    quads = model.quads[alive]
+    n = model.n_nodes
+    used = np.zeros(n, dtype=bool)
+    used[quads.ravel()] = True
+    support = np.all(model.bc_code[:, :3] != 0, axis=1)
+    if not np.any(support):
+        attached = used
+    else:
+        a = quads.ravel()
+        b = np.roll(quads, -1, axis=1).ravel()
+        graph = coo_matrix((np.ones(a.size, dtype=np.int8), (a, b)), shape=(n, n))
+        _, label = connected_components(graph, directed=False)
+        held = np.unique(label[support & used])
+        attached = used & np.isin(label, held)
+    _ATTACHED_CACHE.clear()
+    _ATTACHED_CACHE.update(model=weakref.ref(model), alive=alive, value=attached)
+    return attached
+
+
+def intact_material_ahead(model, state, b: int = 0) -> dict:
+    """Where the intact material is, seen from impactor b's nose (docs/theory.md §6).
+
+    Intact material: the nodes of live elements still attached to a support
+    (:func:`attached_nodes`: a plug carried ahead of the nose is not intact material),
+    each with its contact offset h (half the shell thickness), whose distance from the
+    impactor's axis is at most R + h (R its largest radius: what the body can touch).
+    With s the coordinate of a node along the travel direction measured from the nose
+    tip, the far surface of its shell is at s + h; the nose has passed the material
+    when every such surface lies behind it.
+
+    Returns:
+        ``impactor_nose_ahead_of_intact_m``: −max(s + h) over that material: positive
+        once the nose is past all of it, negative while material is ahead of the nose
+        (+inf when there is no intact material within the radius at all);
+        ``intact_material_ahead``: 1 if some of it is ahead of the nose (max(s + h) ≥ 0),
+        else 0.
     """
-    t = h["time_s"]
-    v = h["impactor_velocity_m_per_s"]
-    f = h["contact_force_N"]
-    v_end = float(v[-1])
+    d = travel_direction(model, state, b)
+    tip = nose_tip(model, state, b)
+    live = np.flatnonzero(attached_nodes(model, state) & (state.node_active != 0))
+    rel = state.x[live] - tip
+    s = rel @ d
+    rho = np.sqrt(np.maximum(np.sum(rel * rel, axis=1) - s * s, 0.0))
+    h = model.node_offset[live]
+    near = rho <= impactor_radius(model, b) + h
+    if not np.any(near):
+        return {"impactor_nose_ahead_of_intact_m": math.inf, "intact_material_ahead": 0}
+    lead = float(np.max(s[near] + h[near]))
+    return {"impactor_nose_ahead_of_intact_m": -lead, "intact_material_ahead": int(lead >= 0.0)}
+
+
+def _outcome(outcome: str, v_res: float, v_reb: float) -> dict:
+    return {"outcome": outcome, "perforated": outcome == "perforated",
+            "residual_velocity_m_per_s": float(v_res), "rebound_velocity_m_per_s": float(v_reb)}
+
+
+def residual_velocity(h: dict, quiet_time: float = QUIET_TIME) -> dict:
+    """Outcome of an impact from the impactor columns of a history (docs/theory.md §6).
+
+    Exactly one of:
+
+    - ``no contact``: the impactor never touched anything (no contact force in any row
+      and its velocity never changed); not perforated; residual = its velocity;
+    - ``stopped``: it turned back (its velocity along the travel reached zero) or came
+      to rest (below ``REST_FRACTION`` of its initial speed) with intact material ahead
+      of it; residual 0, and the speed it bounced back with as
+      ``rebound_velocity_m_per_s``;
+    - ``perforated``: at the end its nose is past every intact surface within its radius
+      (history column ``intact_material_ahead`` = 0, see :func:`intact_material_ahead`)
+      *and* contact has ended: every row for at least ``quiet_time`` (counted from the
+      first light row after the last engaged one, so a coarse history interval can only
+      make the call later) had a contact force below ``LIGHT_CONTACT`` of its peak and a
+      velocity within ``STEADY_VELOCITY`` × v0 of the row before (a contact shorter than
+      the history interval shows only there). Torn yarns rubbing the shank below that
+      are not an engagement, nor is debris striking it from behind (a force along the
+      travel). Residual = its final velocity;
+    - ``undecided``: anything else — still in contact or pushing intact material at the
+      end time (however little it has slowed): run longer. Residual = its velocity at
+      the end, for information only.
+
+    Args:
+        h: history columns (arrays) ``OUTCOME_COLUMNS``; the force is of the whole
+            problem but only its ratio to the peak matters.
+        quiet_time: how long contact must have been light (s).
+
+    Returns:
+        dict with ``outcome`` (one of ``OUTCOMES``), ``perforated`` (bool),
+        ``residual_velocity_m_per_s``, ``rebound_velocity_m_per_s``.
+    """
+    missing = [c for c in OUTCOME_COLUMNS if c not in h]
+    if missing:
+        raise InputError(f"history lacks the columns {missing} that the outcome rule needs "
+                         "(a history written by an older wovenimpact: run the case again)")
+    t = np.asarray(h["time_s"], dtype=float)
+    v = np.asarray(h["impactor_velocity_m_per_s"], dtype=float)
+    f = np.asarray(h["contact_force_full_N"], dtype=float)
+    ahead = np.asarray(h["intact_material_ahead"])
+    v0, v_end = float(v[0]), float(v[-1])
+    touched = np.any(f != 0.0) or np.ptp(v) > 1e-12 * abs(v0)
+    if not touched:
+        return _outcome("no contact", v_end, 0.0)
     if np.min(v) <= 0.0:
-        return {"outcome": "stopped", "perforated": False, "residual_velocity_m_per_s": 0.0,
-                "rebound_velocity_m_per_s": max(0.0, -v_end)}
-    touching = np.flatnonzero(np.abs(f) > 0.0)
-    if not touching.size:
-        return {"outcome": "no contact", "perforated": True, "residual_velocity_m_per_s": v_end,
-                "rebound_velocity_m_per_s": 0.0}
-    # rubbing of torn yarns on the shank is not an engagement: below 1 % of the peak,
-    # or too little to change the velocity (by 0.1 %) over the quiet time; nor is debris
-    # striking it from behind (a force along the travel, f < 0)
-    engaged = np.flatnonzero(f > LIGHT_CONTACT * np.max(np.abs(f)))
-    if not engaged.size:
-        engaged = touching
-    quiet = t[-1] - t[engaged[-1]]
-    window = t >= t[-1] - quiet_time
-    steady = (t[-1] - t[0] >= quiet_time
-              and np.ptp(v[window]) <= STEADY_VELOCITY * abs(v_end))
-    if quiet >= quiet_time or steady:
-        return {"outcome": "perforated", "perforated": True, "residual_velocity_m_per_s": v_end,
-                "rebound_velocity_m_per_s": 0.0}
-    return {"outcome": "undecided (still in contact: run longer)", "perforated": False,
-            "residual_velocity_m_per_s": v_end, "rebound_velocity_m_per_s": 0.0}
+        return _outcome("stopped", 0.0, max(0.0, -v_end))
+    if ahead[-1] and v_end <= REST_FRACTION * abs(v0):
+        return _outcome("stopped", 0.0, 0.0)
+    jump = np.abs(np.diff(v, prepend=v0)) > STEADY_VELOCITY * abs(v0)
+    engaged = np.flatnonzero((f > LIGHT_CONTACT * np.max(np.abs(f))) | jump)
+    first_light = 0 if not engaged.size else int(engaged[-1]) + 1
+    quiet = t[-1] - t[first_light] if first_light < t.size else -math.inf
+    if not ahead[-1] and quiet >= quiet_time:
+        return _outcome("perforated", v_end, 0.0)
+    return _outcome("undecided", v_end, 0.0)
 
 
 def ply_energies(model, state) -> list[float]:

@@ -2,14 +2,19 @@
 
 :func:`run_case` compiles a case file, steps it to ``run.end_time`` and writes
 
-- ``OUT/history.csv``: energies and time-step data every ``history_interval``;
+- ``OUT/history.csv``: energies and time-step data every ``history_interval``. A
+  column's name says its scope: ``*_part_J`` energies are of the modelled part (a
+  quarter of the problem in a quarter model), ``*_full_*`` values (the contact force)
+  of the whole problem; summary.json gives every energy for the whole problem
+  (modelled part × ``symmetry_factor``);
 - ``OUT/fields/step_*.vtu`` + ``fields.pvd``: ParaView series every ``field_interval``;
 - ``OUT/checkpoints/checkpoint_*.npz``: the State every ``checkpoint_interval``
   (history.csv is rewritten atomically at each checkpoint, so a killed run leaves
   consistent files); ``restart=True`` resumes from the newest one and the run ends
   bitwise identical to an uninterrupted one (the output schedule is a function of
   the State alone);
-- ``OUT/plots/energy.png`` and ``OUT/summary.json`` at the end.
+- ``OUT/plots/energy.png``, ``OUT/summary.json`` and ``OUT/report.html`` (one page:
+  verdicts, summary, plots, case, provenance; :mod:`wovenimpact.io.report`) at the end.
 """
 
 from __future__ import annotations
@@ -27,10 +32,12 @@ from wovenimpact.io.atomic import atomic_write_text
 from wovenimpact.io.checkpoint import latest_checkpoint, load_checkpoint, save_checkpoint
 from wovenimpact.io.fields import FieldWriter
 from wovenimpact.io.history import History
+from wovenimpact.io.report import write_run_report
 from wovenimpact.kernels import shell_layout as S
 from wovenimpact.model.compile import CompiledCase, compile_case
 from wovenimpact.quantities import (
     impactor_row,
+    intact_material_ahead,
     ply_deflections,
     ply_energies,
     residual_velocity,
@@ -41,19 +48,29 @@ from wovenimpact.spec.case import load_case
 from wovenimpact.state import KINETIC0, State
 
 HISTORY_COLUMNS = (
-    "time_s", "step", "dt_s", "kinetic_energy_J", "internal_work_J", "stored_energy_J",
-    "hourglass_energy_J", "external_work_J", "eroded_kinetic_energy_J",
-    "eroded_internal_energy_J", "energy_error_fraction", "max_displacement_m",
-    "eroded_elements",
+    "time_s", "step", "dt_s", "structure_kinetic_energy_part_J", "internal_work_part_J",
+    "stored_energy_part_J", "hourglass_energy_part_J", "external_work_part_J",
+    "eroded_kinetic_energy_part_J", "eroded_internal_energy_part_J", "contact_energy_part_J",
+    "contact_dissipated_part_J", "energy_error_fraction", "energy_normaliser_part_J",
+    "max_displacement_m", "eroded_elements",
 )
-IMPACT_COLUMNS = ("impactor_velocity_m_per_s", "impactor_displacement_m", "contact_force_N",
-                  "impactor_kinetic_energy_J", "contact_energy_J")
+IMPACT_COLUMNS = ("impactor_velocity_m_per_s", "impactor_displacement_m", "contact_force_full_N",
+                  "impactor_nose_ahead_of_intact_m", "intact_material_ahead",
+                  "impactor_kinetic_energy_part_J")
+SUMMARY_VERSION = 2  # 2: issue 9's outcome rule and energy keys; older summaries are re-run
 DEFAULT_OUTPUTS = {"history": 1000, "field": 20, "checkpoint": 10}  # per run, if not given
 
 
 def history_columns(model) -> tuple[str, ...]:
-    """history.csv columns: energies etc., plus the impactor's if there is one. Energies
-    are of the modelled part (a quarter of the problem in a quarter model)."""
+    """history.csv columns: energies etc., plus the impactor's if there is one.
+
+    Scope in the name: ``*_part_J`` is of the modelled part (a quarter of the problem
+    in a quarter model; × ``symmetry_factor`` of summary.json gives the whole), ``*_full_*``
+    of the whole problem; velocities, displacements, fractions and counts need neither.
+    ``energy_error_fraction`` = |drift| / ``energy_normaliser_part_J``
+    (solver.explicit.energy_balance). ``contact_energy_part_J`` is −(work of the contact
+    forces): the penalty springs' energy plus ``contact_dissipated_part_J``, what contact
+    dashpots and friction dissipated."""
     return HISTORY_COLUMNS + (IMPACT_COLUMNS if model.body_params.shape[0] else ())
 
 
@@ -63,15 +80,21 @@ def history_row(model, state: State) -> dict:
     disp = np.sqrt(np.max(np.sum((state.x - model.x0) ** 2, axis=1)))
     impact = {}
     if model.body_params.shape[0]:
-        impact = {**impactor_row(model, state), "impactor_kinetic_energy_J":
-                  eb["impactor_kinetic_J"], "contact_energy_J": eb["contact_energy_J"]}
-    return {**impact, 
+        impact = {**impactor_row(model, state), **intact_material_ahead(model, state),
+                  "impactor_kinetic_energy_part_J": eb["impactor_kinetic_J"]}
+    return {
+        **impact,
         "time_s": float(state.t), "step": int(state.step), "dt_s": float(state.dt),
-        "kinetic_energy_J": eb["kinetic_J"], "internal_work_J": eb["internal_work_J"],
-        "stored_energy_J": eb["stored_J"], "hourglass_energy_J": eb["hourglass_J"],
-        "external_work_J": eb["external_work_J"], "eroded_kinetic_energy_J": eb["eroded_kinetic_J"],
-        "eroded_internal_energy_J": eb["eroded_internal_J"],
-        "energy_error_fraction": eb["error_fraction"], "max_displacement_m": float(disp),
+        "structure_kinetic_energy_part_J": eb["kinetic_J"],
+        "internal_work_part_J": eb["internal_work_J"], "stored_energy_part_J": eb["stored_J"],
+        "hourglass_energy_part_J": eb["hourglass_J"],
+        "external_work_part_J": eb["external_work_J"],
+        "eroded_kinetic_energy_part_J": eb["eroded_kinetic_J"],
+        "eroded_internal_energy_part_J": eb["eroded_internal_J"],
+        "contact_energy_part_J": eb["contact_energy_J"],
+        "contact_dissipated_part_J": eb["contact_dissipated_J"],
+        "energy_error_fraction": eb["error_fraction"],
+        "energy_normaliser_part_J": eb["normaliser_J"], "max_displacement_m": float(disp),
         "eroded_elements": int(np.sum(state.elem[:, S.E_ALIVE] == 0.0)),
     }
 
@@ -120,8 +143,10 @@ def run_case(
         overrides: ``KEY=VALUE`` changes to the case (``--set``; spec.fields.parse_override).
     """
     spec, base = load_case(case_path, overrides)
+    source = {"case_text": Path(case_path).read_text(encoding="utf-8"), "case_path": case_path,
+              "overrides": tuple(overrides or ())}
     return run_spec(spec, base, out_dir, restart=restart, threads=threads, progress=progress,
-                    max_steps=max_steps)
+                    max_steps=max_steps, source=source)
 
 
 def run_spec(
@@ -133,19 +158,20 @@ def run_spec(
     threads: int | None = None,
     progress: Callable[[State, float], None] | None = None,
     max_steps: int | None = None,
+    source: dict | None = None,
 ) -> dict:
     """:func:`run_case` for a validated :class:`~wovenimpact.spec.case.CaseSpec` whose
-    relative paths (materials, mesh) are relative to ``base``."""
+    relative paths (materials, mesh) are relative to ``base``. ``source`` (case_text,
+    case_path, overrides) is what report.html shows as the case; without it, the spec."""
     compiled = compile_case(spec, Path(base))
     model = compiled.model
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     n_threads = threads or spec.run.threads
     if n_threads is not None:
-        from wovenimpact.jit import set_threads
-        import numba
+        from wovenimpact.jit import capped_threads, set_threads
 
-        set_threads(min(n_threads, numba.config.NUMBA_NUM_THREADS))
+        set_threads(capped_threads(n_threads, "--threads" if threads else "run.threads"))
     digest = model.digest()
     run = spec.run
     ckpt_dir = out / "checkpoints"
@@ -202,37 +228,55 @@ def run_spec(
     from wovenimpact.io.plots import deflection_plot, energy_plot, impactor_plot
 
     h = history.arrays()
-    energy_plot(h, out / "plots" / "energy.png", title=spec.case.name)
+    energy_plot(h, out / "plots" / "energy.png", title=spec.case.name,
+                symmetry_factor=symmetry_factor(model))
     deflection_plot(model, state, out / "plots" / "ply_deflection.png", title=spec.case.name)
     if "impactor_velocity_m_per_s" in h:
         impactor_plot(h, out / "plots" / "impactor.png", title=spec.case.name)
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n")
+    write_run_report(out, spec=spec, model_digest=digest, **(source or {}))  # report.html
     return summary
 
 
 def summarise(spec, compiled: CompiledCase, state: State, wall: float, steps: int,
               max_error: float, h: dict) -> dict:
     """The numbers a user wants from a finished run (summary.json). Energies here are
-    of the whole problem (× ``symmetry_factor`` in symmetric models)."""
+    of the whole problem (the modelled part's × ``symmetry_factor``):
+
+    - ``structure_kinetic_energy_J`` (nodes), ``impactor_kinetic_energy_J`` (rigid
+      bodies) and ``total_kinetic_energy_J`` (both) at the end;
+      ``initial_total_kinetic_energy_J`` (both, t = 0) with its parts
+      ``initial_structure_kinetic_energy_J`` and ``initial_impactor_kinetic_energy_J``;
+    - ``internal_work_J`` = stored (live elements) + hourglass (live elements) + eroded
+      internal (energies of eroded elements at erosion) + dissipated, each joule once;
+    - ``hourglass_fraction`` = (``hourglass_energy_J`` of live elements +
+      ``eroded_hourglass_energy_J``, what eroded ones held at erosion) / internal work
+      (docs/theory.md §5);
+    - ``energy_error_fraction``: the largest of the history's.
+    """
     model = compiled.model
     eb = energy_balance(model, state)
     cycles = steps * model.n_elems
     factor = symmetry_factor(model)
     impact = {}
+    ke_body0 = 0.0
     if model.body_params.shape[0]:
-        ke0 = factor * float(h["impactor_kinetic_energy_J"][0])
+        ke_body0 = factor * float(h["impactor_kinetic_energy_part_J"][0])
         ke1 = factor * eb["impactor_kinetic_J"]
         per_ply = ply_energies(model, state)
         impact = {
             **residual_velocity(h),
             "initial_velocity_m_per_s": float(h["impactor_velocity_m_per_s"][0]),
-            "absorbed_energy_J": ke0 - ke1,
+            "absorbed_energy_J": ke_body0 - ke1,
             "absorbed_energy_per_ply_J": per_ply,
             "max_deflection_m": max(ply_deflections(model, state)),
             "max_deflection_per_ply_m": ply_deflections(model, state),
-            "peak_contact_force_N": float(np.max(h["contact_force_N"])),
+            "peak_contact_force_N": float(np.max(h["contact_force_full_N"])),
         }
+    w_int = eb["internal_work_J"]
+    hg_all = eb["hourglass_J"] + eb["eroded_hourglass_J"]
     return {**impact,
+        "summary_version": SUMMARY_VERSION,
         "case": spec.case.name,
         "end_time_s": float(state.t),
         "steps": int(state.step),
@@ -243,11 +287,21 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, steps: in
         "wall_time_s": wall,
         "element_cycles": int(cycles),
         "ns_per_element_cycle": wall / cycles * 1e9 if cycles else None,
-        "kinetic_energy_J": factor * eb["kinetic_J"],
-        "initial_kinetic_energy_J": factor * float(state.energy[KINETIC0]),
-        "internal_work_J": factor * eb["internal_work_J"],
-        "external_work_J": factor * eb["external_work_J"],
+        "structure_kinetic_energy_J": factor * eb["kinetic_J"],
+        "impactor_kinetic_energy_J": factor * eb["impactor_kinetic_J"],
+        "total_kinetic_energy_J": factor * (eb["kinetic_J"] + eb["impactor_kinetic_J"]),
+        "initial_total_kinetic_energy_J": factor * float(state.energy[KINETIC0]),
+        "initial_structure_kinetic_energy_J": factor * float(state.energy[KINETIC0]) - ke_body0,
+        "initial_impactor_kinetic_energy_J": ke_body0,
+        "internal_work_J": factor * w_int,
+        "stored_energy_J": factor * eb["stored_J"],
         "hourglass_energy_J": factor * eb["hourglass_J"],
+        "eroded_internal_energy_J": factor * eb["eroded_internal_J"],
+        "eroded_hourglass_energy_J": factor * eb["eroded_hourglass_J"],
+        "eroded_kinetic_energy_J": factor * eb["eroded_kinetic_J"],
+        "hourglass_fraction": hg_all / w_int if w_int > 0.0 else 0.0,
+        "external_work_J": factor * eb["external_work_J"],
+        "contact_energy_J": factor * eb["contact_energy_J"],
         "eroded_elements": int(np.sum(state.elem[:, S.E_ALIVE] == 0.0)),
         "energy_error_fraction": float(max_error),
         "symmetry_factor": factor,

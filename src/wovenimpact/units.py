@@ -47,6 +47,7 @@ DIMENSIONS: dict[str, Dimension] = {
     "velocity": Dimension("m/s", "a velocity", "120 m/s"),
     "acceleration": Dimension("m/s^2", "an acceleration", "9.81 m/s^2"),
     "time": Dimension("s", "a time", "60 us"),
+    "strain_rate": Dimension("1/s", "a strain rate", "1 1/s"),
     "angular_velocity": Dimension("rad/s", "an angular velocity", "1047 rad/s"),
     "angle": Dimension("rad", "an angle", "90 deg"),
     "energy": Dimension("J", "an energy", "12 J"),

@@ -10,9 +10,11 @@ from typer.testing import CliRunner
 from wovenimpact.cli.app import app
 
 
-def write_results(path, key, values, residual):
-    lines = [f"id,{key},status,error,residual_velocity_m_per_s"]
-    lines += [f"x{i},{v},done,,{r}" for i, (v, r) in enumerate(zip(values, residual))]
+def write_results(path, key, values, residual, outcomes=None):
+    outcomes = outcomes or ["perforated" if r > 0 else "stopped" for r in residual]
+    lines = [f"id,{key},status,error,outcome,residual_velocity_m_per_s"]
+    lines += [f"x{i},{v},done,,{o},{r}"
+              for i, (v, r, o) in enumerate(zip(values, residual, outcomes))]
     path.write_text("\n".join(lines) + "\n")
 
 
@@ -33,3 +35,29 @@ def test_plies_regression_and_its_error_when_too_few_perforate(tmp_path):
     write_results(tmp_path / "s.csv", "mesh.plies", [1, 2, 4], [5.0, 0.0, 0.0])
     bad = CliRunner().invoke(app, ["ballistics", "plies", str(tmp_path / "s.csv")])
     assert bad.exit_code == 2 and "three perforated" in bad.output
+
+
+def test_fits_refuse_undecided_and_no_contact_runs_naming_them(tmp_path):
+    """A run that ended still in contact (undecided) or never arrived (no contact) does
+    not enter a fit: the command fails naming the variant by its parameter and id."""
+    vs = [80.0, 100.0, 120.0, 150.0, 200.0, 300.0]
+    vr = [0.0, 0.0, 30.0, 96.0, 164.0, 279.0]
+    outcomes = ["stopped", "stopped", "undecided", "perforated", "perforated", "no contact"]
+    write_results(tmp_path / "r.csv", "impactor.velocity", [f"{v} m/s" for v in vs], vr,
+                  outcomes)
+    result = CliRunner().invoke(app, ["ballistics", "v50", str(tmp_path / "r.csv")])
+    assert result.exit_code == 2
+    text = " ".join(result.output.split())
+    assert "2 run(s) are not decided" in text
+    assert "impactor.velocity = 120.0 m/s (variant x2): undecided" in text
+    assert "impactor.velocity = 300.0 m/s (variant x5): no contact" in text
+    write_results(tmp_path / "p.csv", "mesh.plies", [1, 2, 4, 6], [82.0, 58.0, 18.0, 0.0],
+                  ["perforated", "perforated", "undecided", "stopped"])
+    result = CliRunner().invoke(app, ["ballistics", "plies", str(tmp_path / "p.csv")])
+    assert result.exit_code == 2
+    assert "mesh.plies = 4 (variant x2): undecided" in " ".join(result.output.split())
+    # a table without outcomes (written before they were recorded) is refused too
+    (tmp_path / "old.csv").write_text("id,mesh.plies,status,error,residual_velocity_m_per_s\n"
+                                      "a,1,done,,82.0\nb,2,done,,58.0\nc,4,done,,18.0\n")
+    result = CliRunner().invoke(app, ["ballistics", "plies", str(tmp_path / "old.csv")])
+    assert result.exit_code == 2 and "no outcome recorded" in " ".join(result.output.split())

@@ -14,8 +14,17 @@ def test_bench_json_shape():
     result = CliRunner().invoke(app, ["bench", "--sizes", "400", "--kinds", "elastic,fabric",
                                       "--threads", "1", "--steps", "2", "--json"])
     assert result.exit_code == 0, result.output
-    cases = json.loads(result.stdout.strip().splitlines()[-1])["cases"]
+    doc = json.loads(result.stdout.strip().splitlines()[-1])
+    cases = doc["cases"]
+    assert {"cpu", "cores", "numba", "wovenimpact", "date"} <= set(doc["machine"])
     assert [c["name"] for c in cases] == ["elastic_plate", "fabric_plate"]
     for c in cases:
         assert {"name", "elements", "threads", "ns_per_element_cycle"} <= set(c)
         assert c["elements"] == 400 and c["threads"] == 1 and c["ns_per_element_cycle"] > 0
+
+
+def test_bench_prints_the_machine_line_first():
+    result = CliRunner().invoke(app, ["bench", "--sizes", "100", "--kinds", "elastic",
+                                      "--threads", "1", "--steps", "1"])
+    assert result.exit_code == 0, result.output
+    assert result.stdout.splitlines()[0].startswith("machine: ")

@@ -2,12 +2,17 @@
 
 from __future__ import annotations
 
+import math
+from pathlib import Path
+
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
 from wovenimpact.errors import InputError
 from wovenimpact.studies.design import search_plies
+
+ROOT = Path(__file__).resolve().parents[2]
 
 
 @given(threshold=st.integers(1, 40), start=st.integers(1, 8))
@@ -40,3 +45,49 @@ def test_a_larger_pack_that_perforates_is_reported():
     assert monotonic_warning(5, {1: False, 2: False, 4: False, 5: True, 8: True}) == ""
     text = monotonic_warning(5, {1: False, 2: False, 4: False, 5: True, 7: False, 8: True})
     assert text.startswith("7 plies did not stop the impactor although 5 did")
+
+
+def _fake_runs(threshold: int, slow: dict[int, int]):
+    """A stand-in for the runs: n plies stop the impactor iff n ≥ threshold, but a pack
+    in ``slow`` needs that many doublings of the end time to be decided."""
+    calls = []
+
+    def run_batch(docs, base, dirs, workers):
+        out = []
+        for d, where in zip(docs, dirs):
+            n = d["mesh"]["plies"]
+            doublings = round(math.log2(float(d["run"]["end_time"].split()[0]) / 250.0))
+            calls.append((n, where.rsplit("/", 1)[-1], d["run"]["end_time"]))
+            if doublings < slow.get(n, 0):
+                out.append("undecided")
+            else:
+                out.append("stopped" if n >= threshold else "perforated")
+        return out
+
+    return run_batch, calls
+
+
+def test_design_runs_an_undecided_pack_again_with_twice_the_end_time(tmp_path, monkeypatch):
+    """A pack that ends undecided is run once more with twice run.end_time (its own
+    directory), the search goes on with the decided outcome and says so."""
+    from wovenimpact.studies import design
+
+    run_batch, calls = _fake_runs(threshold=3, slow={2: 1})
+    monkeypatch.setattr(design, "_run_batch", run_batch)
+    heard = []
+    case = ROOT / "examples" / "plate_impact" / "plies1_100.toml"
+    result = design.design_plies(case, tmp_path, log=heard.append)
+    assert result["plies_to_stop"] == 3
+    assert result["runs"]["2"] == "perforated"
+    assert result["reruns"] == {"2": "undecided → perforated with twice the end time"}
+    assert (2, "plies_2_end2x", "500.0 us") in calls
+    assert len(heard) == 1 and heard[0].startswith("2 plies: undecided at run.end_time = 250 us")
+
+
+def test_design_stops_when_a_pack_is_undecided_even_twice_as_long(tmp_path, monkeypatch):
+    from wovenimpact.studies import design
+
+    run_batch, _ = _fake_runs(threshold=3, slow={2: 2})
+    monkeypatch.setattr(design, "_run_batch", run_batch)
+    with pytest.raises(InputError, match=r"2 plies: undecided even with twice run.end_time"):
+        design.design_plies(ROOT / "examples" / "plate_impact" / "plies1_100.toml", tmp_path)

@@ -9,6 +9,7 @@ import tomllib
 import warnings
 from pathlib import Path
 
+import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
@@ -339,6 +340,87 @@ def test_bad_metal_values(path, value, expect):
     msg = error_of(edited(aluminium_doc(), path, value))
     assert msg.startswith(f"case.toml: material.{path}: ")
     assert expect in msg and f"got {value!r}" in msg
+
+
+def jc_doc(name: str = "al2024t3_johnson_cook") -> dict:
+    return tomllib.loads((MATERIALS / f"{name}.toml").read_text(encoding="utf-8"))
+
+
+@pytest.mark.parametrize(
+    ("name", "a", "b", "n", "c", "d", "table_gap"),
+    [
+        # Lesuer (2000), UCRL-ID-138586; table gaps as stated in the files' comments
+        ("al2024t3_johnson_cook", 369e6, 684e6, 0.73, 0.0083, (0.13, 0.13, -1.5, 0.011, 0.0),
+         1.33e-4),
+        ("ti6al4v_johnson_cook", 1098e6, 1092e6, 0.93, 0.014, (-0.09, 0.25, -0.5, 0.014, 3.87),
+         1.85e-5),
+    ],
+)
+def test_johnson_cook_files_tabulate_a_plus_b_eps_n(name, a, b, n, c, d, table_gap):
+    m = load_material(MATERIALS / f"{name}.toml")
+    assert m.kind == "j2_plastic" and m.fracture_strain is None
+    assert (m.rate.c, m.rate.reference_rate) == (c, 1.0)
+    assert m.damage.d == d and m.damage.reference_rate == 1.0
+    eps = np.array([r[0] for r in m.hardening])
+    assert eps[-1] == 1.0 and len(eps) == 48
+    exact = a + b * eps**n
+    assert np.max(np.abs(np.array([r[1] for r in m.hardening]) - exact)) <= 0.0005e6
+    grid = np.linspace(0.0, 1.0, 200001)
+    gap = np.max(np.abs(m.flow_stress(grid) - (a + b * grid**n)) / (a + b * grid**n))
+    assert gap <= table_gap
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "expect"),
+    [
+        ("rate.c", -0.01, "must be ≥ 0"),
+        ("rate.reference_rate", "0 1/s", "must be > 0"),
+        ("rate.reference_rate", "1", "has no unit"),
+        ("rate.reference_rate", "1 m/s", "wrong dimension"),
+        ("damage.d2", "nan", "could not be read"),
+        ("damage.d4", -0.1, "makes the rate term"),
+        ("plasticity.fracture_strain", -0.1, "must be > 0"),
+    ],
+)
+def test_bad_johnson_cook_values(path, value, expect):
+    msg = error_of(edited(jc_doc(), path, value))
+    assert msg.startswith(f"case.toml: material.{path}: ")
+    assert expect in msg and repr(value) in msg
+
+
+def test_jc_fracture_strain_must_stay_positive_over_plane_stress_triaxialities():
+    doc = edited(jc_doc("ti6al4v_johnson_cook"), "damage.d1", -0.2)  # ε_f(2/3) = −0.02
+    msg = error_of(doc)
+    assert msg.startswith("case.toml: material.damage: gives a fracture strain")
+    assert "η = +0.6667" in msg and "'d1': -0.2" in msg
+
+
+def test_jc_rate_term_needs_a_reference_rate():
+    doc = edited(jc_doc(), "rate", ...)
+    msg = error_of(doc)
+    assert msg.startswith("case.toml: material.damage.reference_rate: is required when d4 ≠ 0")
+    doc = edited(doc, "damage.reference_rate", "10 1/s")
+    assert material_from_dict(doc).damage.reference_rate == 10.0
+    doc = edited(edited(jc_doc(), "rate", ...), "damage.d4", 0)
+    assert material_from_dict(doc).damage.reference_rate == 1.0  # irrelevant without d4
+
+
+def test_unknown_key_in_the_johnson_cook_tables():
+    assert "material.damage.d6: unknown key 'd6'" in error_of(edited(jc_doc(), "damage.d6", 1))
+    assert "material.rate.m: unknown key 'm'" in error_of(edited(jc_doc(), "rate.m", 1.7))
+
+
+def test_missing_hardening_table_names_the_key():
+    msg = error_of(edited(aluminium_doc(), "plasticity.hardening", ...))
+    assert msg.startswith("case.toml: material.plasticity.hardening: is missing")
+    msg = error_of(edited(aluminium_doc(), "plasticity", ...))
+    assert msg.startswith("case.toml: material.plasticity: is missing")
+
+
+def test_hardening_table_longer_than_the_kernel_takes():
+    rows = [[f"{k * 0.01:g}", f"{100 + k} MPa"] for k in range(70)]
+    msg = error_of(edited(aluminium_doc(), "plasticity.hardening", rows))
+    assert msg.startswith("case.toml: material.plasticity.hardening: has 70 rows, more than")
 
 
 def test_elastic_material_has_no_plasticity_table():

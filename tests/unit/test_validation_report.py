@@ -18,13 +18,13 @@ def test_full_plate_drops_only_the_symmetry_conditions_and_validates():
 
 
 def _row(variant, residual, rebound, delta_residual=0.0, delta_rebound=0.0):
-    return {"case": "c", "changes": {}, "variant": variant, "outcome": "x",
+    return {"case": "c", "changes": {}, "variant": variant, "outcome": "perforated",
             "residual_velocity_m_per_s": residual, "rebound_velocity_m_per_s": rebound,
             "delta_residual": delta_residual, "delta_rebound": delta_rebound}
 
 
 CASES = {"plies1_100": {"outcome": "stopped", "perforated": False,
-                        "initial_kinetic_energy_J": 5.5}}
+                        "initial_total_kinetic_energy_J": 5.5}}
 
 
 def test_convergence_verdicts_follow_the_acceptance_limits():
@@ -44,9 +44,42 @@ def test_convergence_verdicts_follow_the_acceptance_limits():
 
 def test_spread_line_reports_the_extremes():
     rows = [{"status": "done", "rebound_velocity_m_per_s": v, "absorbed_energy_J": e,
-             "hourglass_energy_J": h, "internal_work_J": 4.0}
+             "hourglass_fraction": h / 4.0}
             for v, e, h in ((23.0, 7.6, 1.0), (24.5, 7.5, 2.0))]
     rows.append({"status": "failed"})
     line = spread_line(rows)
     assert "2 runs" in line and "23.00–24.50 m/s" in line and "7.500–7.600 J" in line
     assert "from 25% to 50%" in line
+
+
+def test_undecided_runs_get_no_verdict_and_are_named():
+    """Only decided runs are judged: an undecided convergence run and an undecided case
+    are named as such instead of entering the comparison."""
+    rows = [_row("ref", 100.0, 0.0), _row("fine", 0.0, 0.0, -100.0),
+            _row("full", 99.0, 0.0, -1.0)]
+    for r in rows:
+        r["outcome"] = "perforated"
+    rows[1]["outcome"] = "undecided"
+    cases = {**CASES, "plies2_100": {"outcome": "undecided", "perforated": False,
+                                     "initial_total_kinetic_energy_J": 5.5}}
+    text = commentary(cases, rows)
+    assert any("no convergence verdict — fine undecided" in line for line in text)
+    assert not any("moves by" in line for line in text)
+    assert any(line.startswith("- Not decided at their end time") and "plies2_100 (undecided)"
+               in line for line in text)
+
+
+def test_a_summary_of_an_older_rule_is_not_taken_as_finished(tmp_path):
+    """A variant's summary written before issue 9's outcome rule (no summary_version) is
+    run again; one of the current version is kept."""
+    import json
+
+    from wovenimpact.runs import SUMMARY_VERSION
+    from wovenimpact.studies.sweep import finished
+
+    (tmp_path / "parameters.json").write_text(json.dumps({"a": 1}))
+    (tmp_path / "summary.json").write_text(json.dumps({"outcome": "perforated"}))
+    assert finished(tmp_path, {"a": 1}) is None
+    (tmp_path / "summary.json").write_text(json.dumps({"outcome": "perforated",
+                                                       "summary_version": SUMMARY_VERSION}))
+    assert finished(tmp_path, {"a": 1})["outcome"] == "perforated"

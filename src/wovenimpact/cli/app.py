@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 from collections.abc import Mapping
 
 import typer
@@ -23,6 +24,34 @@ app.add_typer(calibrate_app, name="calibrate")
 
 console = Console()
 err_console = Console(stderr=True)
+_python_showwarning = warnings.showwarning
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None):
+    """Input warnings as ``warning: …`` lines on stderr (no source line); others as usual."""
+    from wovenimpact.errors import InputWarning
+
+    if issubclass(category, InputWarning):
+        err_console.print(f"[bold yellow]warning:[/] {escape(str(message))}", soft_wrap=True)
+    else:
+        _python_showwarning(message, category, filename, lineno, file, line)
+
+
+def _print_version(value: bool) -> None:
+    if value:
+        from wovenimpact import __version__
+
+        typer.echo(f"wovenimpact {__version__}")
+        raise typer.Exit()
+
+
+@app.callback()
+def _main(
+    version: bool = typer.Option(False, "--version", callback=_print_version, is_eager=True,
+                                 help="Print the version and exit."),
+) -> None:
+    """Explicit dynamics of impacts on dry woven fabric and metal."""
+    warnings.showwarning = _show_warning
 
 
 def _jsonable(v):

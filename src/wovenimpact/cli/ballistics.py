@@ -1,4 +1,5 @@
-"""``wovenimpact ballistics``: V50 and plies-to-stop from a sweep's results.csv."""
+"""``wovenimpact ballistics``: V50 and plies-to-stop from a sweep's results.csv (decided
+runs only: an undecided or no-contact run is refused, naming the variant)."""
 
 from __future__ import annotations
 
@@ -41,12 +42,13 @@ def v50(
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
 ) -> None:
     """Lambert–Jonas fit V_r = a (V_s^p − V50^p)^(1/p) of residual against striking velocity."""
-    from wovenimpact.studies.ballistics import lambert_jonas_fit
+    from wovenimpact.studies.ballistics import lambert_jonas_fit, require_decided
 
     try:
         rows = _rows(results)
         vs = [to_si(json.loads(v) if v.startswith('"') else v, "velocity", key)
               for v in _column(rows, key, results)]
+        require_decided(rows, key, str(results))
         vr = [float(r["residual_velocity_m_per_s"]) for r in rows]
         fit = lambert_jonas_fit(vs, vr)
     except InputError as err:
@@ -62,11 +64,12 @@ def plies(
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
 ) -> None:
     """Quadratic regression of residual velocity against plies (thesis eq. 7.1 method)."""
-    from wovenimpact.studies.ballistics import quadratic_ply_regression
+    from wovenimpact.studies.ballistics import quadratic_ply_regression, require_decided
 
     try:
         rows = _rows(results)
         n = [float(v) for v in _column(rows, key, results)]
+        require_decided(rows, key, str(results))
         vr = [float(r["residual_velocity_m_per_s"]) for r in rows]
         perforated = [(a, b) for a, b in zip(n, vr) if b > 0]
         reg = quadratic_ply_regression(*zip(*perforated)) if len(perforated) >= 3 else None

@@ -1,4 +1,9 @@
-"""``wovenimpact bench``: ns per element-cycle of the explicit step (elastic and fabric plates)."""
+"""``wovenimpact bench``: ns per element-cycle of the explicit step (elastic and fabric plates).
+
+The second of ``make bench``'s three benchmarks (the first is the fabric kernel alone,
+benchmarks/bench_fabric_kernel.py; the third the ply-on-ply contact,
+benchmarks/bench_contact.py). It prints the machine line first.
+"""
 
 from __future__ import annotations
 
@@ -18,12 +23,22 @@ def bench(
     steps: int = typer.Option(20, min=1, help="Timed steps per case."),
     as_json: bool = typer.Option(False, "--json", help='Print {"cases": [...]} as one JSON object.'),
 ) -> None:
-    """Time the explicit step on square plates; prints ns per element-cycle and stage shares."""
-    from wovenimpact.benchmark import case_line, run_cases
+    """Time the explicit step on square plates (the machine first); prints ns per
+    element-cycle and stage shares. ``make bench`` also times the fabric kernel alone and
+    the ply-on-ply contact."""
+    from wovenimpact.benchmark import case_line, machine, machine_line, run_cases
 
-    counts = ([int(t) for t in threads.split(",")] if threads
-              else sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)}))
+    from wovenimpact.jit import capped_threads
+
+    counts = (list(dict.fromkeys(capped_threads(int(t), "--threads") for t in threads.split(",")))
+              if threads else sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)}))
+    if not as_json:
+        console.print(machine_line(), highlight=False, soft_wrap=True)
     cases = run_cases(kinds.split(","), [int(s) for s in sizes.split(",")], counts, steps,
-                      report=None if as_json else (lambda c: console.print(case_line(c))))
+                      report=None if as_json else
+                      (lambda c: console.print(case_line(c), soft_wrap=True)))
     if as_json:
-        typer.echo(json.dumps({"cases": cases}))
+        typer.echo(json.dumps({"cases": cases, "machine": machine(),
+                               "threading_layer": numba.threading_layer()}))
+    else:
+        console.print(f"threading layer: {numba.threading_layer()}", highlight=False)

@@ -31,7 +31,8 @@ def plies(
 
     try:
         result = design_plies(case, out or Path("out") / f"design_{case.stem}", workers=workers,
-                              start=start, overrides=overrides or (), check=check)
+                              start=start, overrides=overrides or (), check=check,
+                              log=lambda m: err_console.print(f"[yellow]{m}[/]"))
     except InputError as err:
         fail(str(err))
     shown = dict(result)
@@ -39,6 +40,10 @@ def plies(
         shown["runs"] = ", ".join(f"{k}: {v}" for k, v in result["runs"].items())
         if not shown["warning"]:
             del shown["warning"]
+        if shown["reruns"]:
+            shown["reruns"] = ", ".join(f"{k}: {v}" for k, v in result["reruns"].items())
+        else:
+            del shown["reruns"]
     emit(shown, as_json, f"{case.name}: plies to stop the impactor")
     if result["warning"] and not as_json:
         err_console.print(f"[bold yellow]warning:[/] {result['warning']}")

@@ -1,4 +1,10 @@
-"""``wovenimpact element-test``: single-element tests of the crossover model (thesis ch. 6.3)."""
+"""``wovenimpact element-test``: single-element tests of a material.
+
+A ``woven_fabric`` material runs the crossover-model tests of thesis ch. 6.3
+(:mod:`wovenimpact.calibration.single_element`); a ``j2_plastic`` metal runs
+plane-stress uniaxial, biaxial or shear tests to fracture
+(:mod:`wovenimpact.calibration.metal_element`).
+"""
 
 from __future__ import annotations
 
@@ -22,36 +28,127 @@ class Test(str, Enum):
     picture_frame = "picture-frame"
 
 
+class Homogenisation(str, Enum):
+    """``--homogenisation``: how crossover forces become membrane resultants."""
+
+    virial = "virial"
+    thesis = "thesis"
+
+
+class ShearLaw(str, Enum):
+    """``--shear-law``: the trellis shear law."""
+
+    true = "true"
+    thesis = "thesis"
+
+
+class Frame(str, Enum):
+    """``--frame``: the frame the yarn directions follow."""
+
+    fibre = "fibre"
+    green_naghdi = "green-naghdi"
+
+
+class Failure(str, Enum):
+    """``--failure``: yarn failure, instantaneous or with softening."""
+
+    instant = "instant"
+    progressive = "progressive"
+
+
 @app.command("element-test")
 def element_test(
     test: Test = typer.Argument(..., help="Which deformation history to apply."),
-    material: Path = typer.Option(..., "--material", help="Fabric material TOML file."),
+    material: Path = typer.Option(
+        ..., "--material", help="Material TOML file: woven_fabric or j2_plastic."
+    ),
     out: Path = typer.Option(..., "--out", help="Output directory (history.csv, PNG figures)."),
     displacement: str = typer.Option(
-        "0.06 mm", help="Maximum edge displacement of the extension tests (with unit)."
+        None, help="Fabric: maximum edge displacement of the extension tests (with unit; "
+        "default 0.06 mm)."
     ),
-    angle: str = typer.Option("60 deg", help="Maximum shear angle of the shear tests (with unit)."),
-    steps: int = typer.Option(600, min=1, help="Number of load steps."),
-    homogenisation: str = typer.Option(None, help="Override: 'virial' or 'thesis'."),
-    shear_law: str = typer.Option(None, "--shear-law", help="Override: 'true' or 'thesis'."),
-    frame: str = typer.Option(None, help="Override: 'fibre' or 'green-naghdi'."),
-    failure: str = typer.Option(None, help="Override: 'instant' or 'progressive'."),
+    angle: str = typer.Option(
+        "60 deg", help="Fabric: maximum shear angle of the shear tests (with unit)."
+    ),
+    strain: float = typer.Option(
+        None, help="Metal: final log strain (uniaxial 0.4, biaxial 0.25) or shear γ (1.0); "
+        "the test stops at fracture."
+    ),
+    strain_rate: str = typer.Option(
+        "0.001 1/s", "--strain-rate", help="Metal: rate of the applied strain (with unit)."
+    ),
+    thickness: str = typer.Option("1 mm", help="Metal: reference thickness t0 (with unit)."),
+    steps: int = typer.Option(None, min=1, help="Number of load steps (fabric 600, metal 400)."),
+    homogenisation: Homogenisation = typer.Option(None, help="Fabric: override the material's."),
+    shear_law: ShearLaw = typer.Option(
+        None, "--shear-law", help="Fabric: override the material's."
+    ),
+    frame: Frame = typer.Option(None, help="Fabric: override the material's."),
+    failure: Failure = typer.Option(None, help="Fabric: override the material's."),
     softening_strain: float = typer.Option(None, help="Override Δε_s of progressive failure."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object with the results."),
 ) -> None:
-    """Drive one unit cell (side 2ℓ0) through TEST; write history.csv, summary.json and figures."""
-    from wovenimpact.calibration.element_plots import plot_element_test
+    """Drive one point through TEST; write history.csv, summary.json and figures.
+
+    Fabric: one unit cell (side 2ℓ0). Metal: one plane-stress J2 point at a constant
+    strain rate until it fails (uniaxial: the lateral resultant solved to zero).
+    """
+    from wovenimpact.calibration.element_plots import plot_element_test, plot_metal_element_test
+    from wovenimpact.calibration.metal_element import METAL_TESTS, run_metal_element_test
+    from wovenimpact.calibration.metal_element import write_history_csv as write_metal_csv
     from wovenimpact.calibration.single_element import run_element_test, write_history_csv
     from wovenimpact.materials.fabric import FabricParameters
+    from wovenimpact.materials.metal import MetalParameters
     from wovenimpact.spec import load_material
     from wovenimpact.units import to_si
 
     try:
         params = load_material(material)
+        if isinstance(params, MetalParameters):
+            fabric_only = dict(displacement=displacement, homogenisation=homogenisation,
+                               shear_law=shear_law, frame=frame, failure=failure,
+                               softening_strain=softening_strain)
+            given = [k.replace("_", "-") for k, v in fabric_only.items() if v is not None]
+            if given:
+                raise InputError(
+                    f"--{', --'.join(given)}: fabric options, not valid with the metal "
+                    f"{material} (use --strain, --strain-rate, --thickness)"
+                )
+            if params.kind != "j2_plastic":
+                raise InputError(
+                    f"--material {material}: kind {params.kind!r} has no plasticity to test; "
+                    "element tests need woven_fabric or j2_plastic"
+                )
+            if test.value not in METAL_TESTS:
+                raise InputError(
+                    f"test {test.value!r} is not valid for a metal: choose one of "
+                    f"{', '.join(METAL_TESTS)}"
+                )
+            if strain is not None and not strain > 0.0:
+                raise InputError(f"--strain = {strain} is not valid: it must be > 0")
+            metal = run_metal_element_test(
+                params,
+                test.value,
+                strain=strain,
+                n_steps=400 if steps is None else steps,
+                strain_rate=to_si(strain_rate, "strain_rate", "--strain-rate", gt=0),
+                thickness=to_si(thickness, "length", "--thickness", gt=0),
+            )
+    except (InputError, ValueError, MaterialPointError) as err:
+        fail(str(err))
+        return
+    if isinstance(params, MetalParameters):
+        _write_outputs(out, metal, write_metal_csv, plot_metal_element_test, test, as_json)
+        return
+    try:
         if not isinstance(params, FabricParameters):
             raise InputError(f"--material {material}: element tests need a woven_fabric material")
+        if strain is not None:
+            raise InputError("--strain is a metal option: give --displacement or --angle")
+        displacement = "0.06 mm" if displacement is None else displacement
+        steps = 600 if steps is None else steps
         overrides = {
-            k: v
+            k: (v.value if isinstance(v, Enum) else v)
             for k, v in dict(
                 homogenisation=homogenisation,
                 shear=shear_law,
@@ -62,15 +159,6 @@ def element_test(
             if v is not None
         }
         if overrides:
-            allowed = {
-                "homogenisation": ("virial", "thesis"),
-                "shear": ("true", "thesis"),
-                "frame": ("fibre", "green-naghdi"),
-                "failure": ("instant", "progressive"),
-            }
-            for k, v in overrides.items():
-                if k in allowed and v not in allowed[k]:
-                    raise InputError(f"--{k} = {v!r} is not valid: choose one of {allowed[k]}")
             opts = dataclasses.replace(params.options, **overrides)
             if opts.failure == "progressive" and not opts.softening_strain > 0.0:
                 raise InputError(
@@ -86,9 +174,14 @@ def element_test(
     except (InputError, ValueError, MaterialPointError) as err:
         fail(str(err))
         return
+    _write_outputs(out, result, write_history_csv, plot_element_test, test, as_json)
+
+
+def _write_outputs(out: Path, result, write_csv, plot, test: Test, as_json: bool) -> None:
+    """history.csv, the figures and summary.json into ``out``; print the summary."""
     out.mkdir(parents=True, exist_ok=True)
-    csv_path = write_history_csv(result, out / "history.csv")
-    figures = plot_element_test(result, out)
+    csv_path = write_csv(result, out / "history.csv")
+    figures = plot(result, out)
     summary = result.summary()
     summary["history_csv"] = str(csv_path)
     summary["figures"] = [str(f) for f in figures]
@@ -98,4 +191,5 @@ def element_test(
                     for k, v in summary.items()}, indent=2)
     )
     tmp.replace(out / "summary.json")
-    emit({k: v for k, v in summary.items() if k != "figures"}, as_json, f"element test: {test.value}")
+    shown = {k: v for k, v in summary.items() if k != "figures"}
+    emit(shown, as_json, f"element test: {test.value}")

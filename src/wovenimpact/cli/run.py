@@ -8,7 +8,7 @@ from pathlib import Path
 import typer
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-from wovenimpact.cli.app import app, emit, err_console, fail
+from wovenimpact.cli.app import app, console, emit, err_console, fail
 from wovenimpact.errors import InputError, MaterialPointError, SimulationError
 
 
@@ -33,13 +33,16 @@ def run(
     case: Path = typer.Argument(..., help="Case file (TOML)."),
     out: Path = typer.Option(..., "--out", help="Output directory."),
     restart: bool = typer.Option(False, "--restart", help="Resume from the last checkpoint in OUT."),
-    threads: int = typer.Option(None, "--threads", min=1, help="Kernel threads (default: all)."),
+    threads: int = typer.Option(
+        None, "--threads", min=1,
+        help="Kernel threads (default: all cores; more than the cores is warned of and capped)."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object (summary) on stdout."),
     overrides: list[str] = typer.Option(
         None, "--set", help="Change a case value: KEY=VALUE with a dotted key, e.g. "
         "--set 'impactor.velocity=200 m/s' (repeatable)."),
 ) -> None:
-    """Run CASE to its end time; write history.csv, summary.json, fields/, plots/, checkpoints/."""
+    """Run CASE to its end time; write history.csv, summary.json, report.html, fields/,
+    plots/, checkpoints/."""
     from wovenimpact.runs import run_case
 
     bar = _bar(quiet=as_json)
@@ -71,3 +74,5 @@ def run(
         fail(f"the run stopped: {err}", code=3)
     bar.stop()
     emit(summary, as_json, f"{case.name}: summary (also in {out / 'summary.json'})")
+    if not as_json:
+        console.print(f"report: {out / 'report.html'}")

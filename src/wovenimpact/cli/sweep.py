@@ -20,8 +20,12 @@ def sweep(
     scheduler: str = typer.Option(None, "--scheduler", help="Dask scheduler address (tcp://host:8786)."),
     workers: int = typer.Option(2, "--workers", min=1, help="Local worker processes."),
     as_json: bool = typer.Option(False, "--json", help="Print the results as one JSON object."),
+    overrides: list[str] = typer.Option(
+        None, "--set", help="Change a value of the study's case for every variant: KEY=VALUE "
+        "with a dotted key, e.g. --set 'run.end_time=20 us' (repeatable)."),
 ) -> None:
-    """Run every variant of STUDY (finished ones are kept), write results.csv and plots/."""
+    """Run every variant of STUDY (finished ones are kept), write results.csv, plots/ and
+    report.html (linking each variant's page)."""
     from wovenimpact.studies.sweep import run_study
 
     out_dir = out or Path("out") / study.stem
@@ -37,7 +41,7 @@ def sweep(
     try:
         with bar:
             rows = run_study(study, out_dir, scheduler=scheduler, workers=workers,
-                             progress=report)
+                             progress=report, overrides=overrides or ())
     except InputError as err:
         fail(str(err))
     failed = [r for r in rows if r["status"] != "done"]
@@ -50,5 +54,6 @@ def sweep(
         for r in rows:
             table.add_row(*(f"{v:.6g}" if isinstance(v, float) else str(v) for v in r.values()))
         console.print(table)
+        console.print(f"report: {out_dir / 'report.html'}")
     if failed:
         raise typer.Exit(1)

@@ -30,3 +30,4 @@ def validate(
     except InputError as err:
         fail(str(err))
     console.print(f"validation report: {path}")
+    console.print(f"pages of every run and study: {work / 'report.html'}")

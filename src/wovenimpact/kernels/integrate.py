@@ -3,7 +3,9 @@
 v^{n+1/2} = v^{n−1/2} + Δt^n M⁻¹ (f_ext^n − f_int^n), Δt^n = ½(Δt^{n−1/2} + Δt^{n+1/2}),
 x^{n+1} = x^n + Δt^{n+1/2} v^{n+1/2}, with the lumped translational mass and an
 isotropic lumped rotary inertia for the spins. Constrained degrees of freedom
-get their prescribed velocity; the force that imposes it is the support reaction,
+get their prescribed velocity (or, for a node turning rigidly about an axis, the chord
+velocity that keeps it on its circle, ``rotation_step``); the force that imposes it is
+the support reaction,
 which enters the external work. Work is integrated by the trapezoid rule,
 W += ½ (f^{n−1} + f^n) · (x^n − x^{n−1}), per node; the caller sums the per-node
 terms (a deterministic reduction). The kinetic energy at t^n is the leapfrog form
@@ -30,6 +32,30 @@ from wovenimpact.kernels.gather import node_force_sum
 
 FIXED = 1
 PRESCRIBED = 2
+ROTATING = 3  # the node turns rigidly: bc_velocity holds ω (0–2, rad/s) and the centre (3–5)
+
+
+@kernel
+def rotation_step(bc_velocity, n, x, amplitude, dt_new):
+    """The chord velocity (x^{n+1} − x^n)/Δt of a node turning rigidly by θ = A |ω| Δt
+    about the axis ω/|ω| through c (Rodrigues), so that it stays on its circle:
+    x^{n+1} = c + R(θ)(x^n − c). Returns (v_x, v_y, v_z, ω_x, ω_y, ω_z) with ω × A."""
+    wx, wy, wz = bc_velocity[n, 0] * amplitude, bc_velocity[n, 1] * amplitude, (
+        bc_velocity[n, 2] * amplitude)
+    rate = math.sqrt(wx * wx + wy * wy + wz * wz)
+    if rate == 0.0 or dt_new <= 0.0:
+        return 0.0, 0.0, 0.0, wx, wy, wz
+    kx, ky, kz = wx / rate, wy / rate, wz / rate
+    px = x[n, 0] - bc_velocity[n, 3]
+    py = x[n, 1] - bc_velocity[n, 4]
+    pz = x[n, 2] - bc_velocity[n, 5]
+    th = rate * dt_new
+    c, s = math.cos(th), math.sin(th)
+    kp = kx * px + ky * py + kz * pz
+    qx = px * c + (ky * pz - kz * py) * s + kx * kp * (1.0 - c)
+    qy = py * c + (kz * px - kx * pz) * s + ky * kp * (1.0 - c)
+    qz = pz * c + (kx * py - ky * px) * s + kz * kp * (1.0 - c)
+    return (qx - px) / dt_new, (qy - py) / dt_new, (qz - pz) / dt_new, wx, wy, wz
 
 
 @kernel
@@ -105,6 +131,11 @@ def update_node(
             f_ext[n, d] = 0.0
         return
     k = 0.0
+    turning = bc_code[n, 0] == ROTATING
+    if turning:
+        r0, r1, r2, r3, r4, r5 = rotation_step(bc_velocity, n, x, amplitude, dt_new)
+    else:
+        r0 = r1 = r2 = r3 = r4 = r5 = 0.0
     for d in range(6):
         m_d = m if d < 3 else inert
         old = v[n, d] if d < 3 else omega[n, d - 3]
@@ -114,6 +145,9 @@ def update_node(
             new = 0.0
         elif code == PRESCRIBED:
             new = bc_velocity[n, d] * amplitude
+        elif code == ROTATING:
+            new = (r0 if d == 0 else r1 if d == 1 else r2 if d == 2 else r3 if d == 3
+                   else r4 if d == 4 else r5)
         else:
             new = old + dt_mid * (load - f_int[n, d]) / m_d
         if code != 0 and dt_mid > 0.0:

@@ -43,6 +43,7 @@ from numba import prange
 from wovenimpact.jit import inline_kernel, kernel, loop_kernel
 from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels.fabric import fabric_point
+from wovenimpact.kernels.j2 import j2_point
 from wovenimpact.kernels.shell_layout import (
     C_AREAL_MASS,
     C_BEND_E,
@@ -73,6 +74,7 @@ from wovenimpact.kernels.shell_layout import (
     EL_NAN,
     EL_OK,
     MAT_FABRIC,
+    MAT_J2,
     MEMBRANE_FULL,
     N_ELEM_STATE,
 )
@@ -218,12 +220,13 @@ def through_thickness_f(z, kx, ky, kxy2, f11, f12, f21, f22):
 
 
 @kernel
-def point_response(kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, thick,
+def point_response(kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, dt, thick,
                    rows_in, rows_out, row):
-    """The material at one point: F_old → F_new (o.., g..), dispatched on its kind.
+    """The material at one point: F_old → F_new (o.., g..) over Δt, dispatched on its kind.
 
-    Fabric points keep their state in row ``row`` of the material rows (the
-    crossover kernel); elastic points have none.
+    Fabric and J2 points keep their state in row ``row`` of the material rows (the
+    crossover kernel, kernels.j2; both have their alive flag and stored energy in the
+    same columns); elastic points have none.
 
     Returns:
         (status, alive, C_m, W, N_xx, N_yy, N_xy): 0 if the point updated; False once
@@ -238,6 +241,14 @@ def point_response(kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, 
         if st != 0:
             return st, False, 0.0, 0.0, 0.0, 0.0, 0.0
         return 0, rows_out[row, FL.S_ALIVE] != 0.0, c, rows_out[row, FL.S_ENERGY], a, b, c12
+    if kind == MAT_J2:
+        st, c, a, b, c12 = j2_point(
+            mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, dt, thick, rows_in,
+            rows_out, row,
+        )
+        if st != 0:
+            return st, False, 0.0, 0.0, 0.0, 0.0, 0.0
+        return 0, rows_out[row, FL.S_ALIVE] != 0.0, c, rows_out[row, FL.S_ENERGY], a, b, c12
     energy, c, a, b, c12 = elastic_membrane(
         g11, g12, g21, g22, mat_params[m, E_MOD], mat_params[m, E_NU], thick
     )
@@ -247,7 +258,7 @@ def point_response(kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, 
 @kernel
 def section_response(
     n_pts, thick, kind, mat_params, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22,
-    ko_x, ko_y, ko_xy2, k_x, k_y, k_xy2, rows_in, rows_out, row0,
+    ko_x, ko_y, ko_xy2, k_x, k_y, k_xy2, dt, rows_in, rows_out, row0,
 ):
     """The section at one in-plane point: its n through-thickness points (theory §4).
 
@@ -281,7 +292,7 @@ def section_response(
             return EL_INVERTED, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
         o11, o12, o21, o22 = through_thickness_f(z, ko_x, ko_y, ko_xy2, fo11, fo12, fo21, fo22)
         st, live, c, energy, a, b, c12 = point_response(
-            kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, thick,
+            kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, dt, thick,
             rows_in, rows_out, row0 + np.uint64(k),
         )
         if st != 0:
@@ -324,7 +335,7 @@ def sync_yarn_damage(rows_out, row0, n_pts):
 @kernel
 def full_membrane(
     e, lx, ly, gauss_grad, gauss_weight, a0, n_pts, thick, kind, mat_params, m, el_in, el_out,
-    ko_x, ko_y, ko_xy2, k_x, k_y, k_xy2, rows_in, rows_out, row0,
+    ko_x, ko_y, ko_xy2, k_x, k_y, k_xy2, dt, rows_in, rows_out, row0,
 ):
     """Fully integrated membrane: the section at the 2×2 Gauss points (theory §4.5).
 
@@ -362,7 +373,7 @@ def full_membrane(
         st, n_alive, c, w, a, b, c12, ma, mb, mc = section_response(
             n_pts, thick, kind, mat_params, m,
             el_in[e, col], el_in[e, col + 1], el_in[e, col + 2], el_in[e, col + 3],
-            f11, f12, f21, f22, ko_x, ko_y, ko_xy2, k_x, k_y, k_xy2,
+            f11, f12, f21, f22, ko_x, ko_y, ko_xy2, k_x, k_y, k_xy2, dt,
             rows_in, rows_out, row0 + np.uint64(g * n_pts),
         )
         if st != 0:
@@ -521,7 +532,7 @@ def shell_force(
             full_membrane(
                 e, lx, ly, gauss_grad, gauss_weight, a0, n_pts, thick, kind, mat_params, m,
                 el_in, el_out, el_in[e, E_KAPPA], el_in[e, E_KAPPA + 1], el_in[e, E_KAPPA + 2],
-                kap_x, kap_y, kap_xy2, rows_in, rows_out, row0,
+                kap_x, kap_y, kap_xy2, dt, rows_in, rows_out, row0,
             )
         )
         full = True
@@ -530,7 +541,7 @@ def shell_force(
             n_pts, thick, kind, mat_params, m,
             el_in[e, E_F], el_in[e, E_F + 1], el_in[e, E_F + 2], el_in[e, E_F + 3],
             f11, f12, f21, f22, el_in[e, E_KAPPA], el_in[e, E_KAPPA + 1],
-            el_in[e, E_KAPPA + 2], kap_x, kap_y, kap_xy2, rows_in, rows_out, row0,
+            el_in[e, E_KAPPA + 2], kap_x, kap_y, kap_xy2, dt, rows_in, rows_out, row0,
         )
         eroded = status == 0 and n_alive == 0
         w_memb *= a0
@@ -663,14 +674,14 @@ def shell_force(
 @loop_kernel
 def internal_force_for_shells(
     x, v, omega, dt, quads, elem_section, sections, mat_kind, mat_params, area0, ref_grad,
-    gauss_grad, gauss_weight, el_in, el_out, m_in, m_out, blocks, status, eroded_now, alive,
-    dt_erode,
+    gauss_grad, gauss_weight, el_in, el_out, m_in, m_out, point_width, blocks, status,
+    eroded_now, alive, dt_erode,
 ):
     """``shell_force`` for every element (prange; each element writes its own rows).
 
     Args: positions/velocities/spins (n_nodes, 3); dt; Model arrays; element and
     material state in/out (m_in, m_out: (n_elems, width), an element's points' state
-    blocks side by side); blocks (n_elems, 4, 6) written; status, eroded_now
+    blocks of ``point_width`` values side by side); blocks (n_elems, 4, 6) written; status, eroded_now
     (n_elems,) written; alive (n_elems,) uint8 written: 1 for an element alive at
     the end of the step (a compact copy of ``el_out[:, E_ALIVE]`` for the node
     kernels); dt_erode: an element whose own stable step L_e/c_e falls below it is
@@ -689,12 +700,12 @@ def internal_force_for_shells(
     n_eroded = 0
     dt_min = math.inf
     # the material state as one row per point: an element's row of m_in holds its
-    # points' state blocks side by side (fabric); elastic-only models have none
+    # points' state blocks side by side; elastic-only models have none (point_width 0)
     width = m_in.shape[1]
-    point_blocks = width // FL.N_STATE
-    if point_blocks > 0 and point_blocks * FL.N_STATE == width:
-        rows_in = m_in.reshape((ne * point_blocks, FL.N_STATE))
-        rows_out = m_out.reshape((ne * point_blocks, FL.N_STATE))
+    point_blocks = width // point_width if point_width > 0 else 0
+    if point_blocks > 0 and point_blocks * point_width == width:
+        rows_in = m_in.reshape((ne * point_blocks, point_width))
+        rows_out = m_out.reshape((ne * point_blocks, point_width))
     else:
         rows_in = m_in
         rows_out = m_out

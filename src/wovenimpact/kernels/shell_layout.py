@@ -19,8 +19,9 @@ Sections (``Model.sections``, one row per section, SI):
   4 = 2×2 Gauss points, no in-plane hourglass modes (``MEMBRANE_FULL``; theory §4.5).
 
 Material kinds (``Model.mat_kind``): ``MAT_ELASTIC`` (params E, ν, ρ in columns
-``E_MOD``, ``E_NU``, ``E_RHO``) and ``MAT_FABRIC`` (the crossover parameter vector of
-:mod:`wovenimpact.kernels.fabric_layout`).
+``E_MOD``, ``E_NU``, ``E_RHO``), ``MAT_FABRIC`` (the crossover parameter vector of
+:mod:`wovenimpact.kernels.fabric_layout`) and ``MAT_J2`` (plane-stress J2 plasticity,
+:mod:`wovenimpact.kernels.j2_layout`; E, ν, ρ in the same first columns).
 
 Per-element state (``State.elem``, one row per element):
 
@@ -39,9 +40,10 @@ Per-element state (``State.elem``, one row per element):
 - ``E_FG``: the in-plane F at the four Gauss points of a fully integrated membrane
   (4 × 4 values, point g at ``E_FG + 4 g``).
 
-The material state of an element is ``n_inplane × n_points`` consecutive blocks of the
-material's state vector, block ``g · n_points + k`` for in-plane point g and
-through-thickness point k (one block for a one-point resultant section).
+The material state of an element is ``n_inplane × n_points`` consecutive blocks of
+``Model.point_width`` values (the longest state vector of the model's material kinds;
+a shorter one uses the first columns), block ``g · n_points + k`` for in-plane point g
+and through-thickness point k (one block for a one-point resultant section).
 """
 
 from __future__ import annotations
@@ -65,6 +67,7 @@ MEMBRANE_FULL = 4
 # material kinds and the elastic parameter vector
 MAT_ELASTIC = 0
 MAT_FABRIC = 1
+MAT_J2 = 2
 E_MOD = 0
 E_NU = 1
 E_RHO = 2

@@ -9,6 +9,7 @@ the case key that is wrong.
 from __future__ import annotations
 
 import copy
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -28,10 +29,24 @@ from wovenimpact.model.model import (
     ShellContactParams,
     build_model,
 )
-from wovenimpact.spec.case import DOFS, AbaqusMeshSpec, CaseSpec, PlateMeshSpec
+from wovenimpact.spec.case import (
+    DOFS,
+    AbaqusMeshSpec,
+    CaseSpec,
+    ContainmentMeshSpec,
+    PlateMeshSpec,
+)
 from wovenimpact.spec.fields import read_toml
 from wovenimpact.spec.material import load_material, material_from_dict
-from wovenimpact.state import State, initial_state, rigid_rotation_velocity
+from wovenimpact.model.casing import blade_mesh, casing_mesh, circumferential_directions, join
+from wovenimpact.state import (
+    BODY_KINETIC,
+    KINETIC,
+    KINETIC0,
+    State,
+    initial_state,
+    rigid_rotation_velocity,
+)
 
 SYMMETRY_AXIS = {"symmetry_x": 0, "symmetry_y": 1, "symmetry_z": 2}
 
@@ -199,6 +214,83 @@ def check_impactor_clearance(model: Model) -> None:
             )
 
 
+def containment_mesh(m, sections) -> tuple[Mesh, list[str], np.ndarray]:
+    """Casing layers and blade of a containment case (model.casing), each element's
+    section and warp direction (circumferential on the casing, radial on the blade)."""
+    c, b = m.casing, m.blade
+    radii, names = [], []
+    outer = c.inner_radius
+    if c.inner_section is not None:
+        t_in = section_thickness(sections[c.inner_section], "mesh.casing.inner_section")
+        radii.append(c.inner_radius + 0.5 * t_in)
+        names.append(c.inner_section)
+        outer = c.inner_radius + t_in
+    t_layer = section_thickness(sections[c.layer_section], "mesh.casing.layer_section")
+    spacing = t_layer if c.layer_spacing is None else c.layer_spacing
+    radii += [outer + (k + 0.5) * spacing for k in range(c.layers)]
+    names += [c.layer_section] * c.layers
+    if not b.tip_radius < c.inner_radius:
+        raise InputError(f"mesh.blade.tip_radius = {b.tip_radius:g} m must be inside the "
+                         f"casing (mesh.casing.inner_radius = {c.inner_radius:g} m)")
+    try:
+        casing = casing_mesh(radii, c.length, m.element_size, sector=math.degrees(c.sector),
+                             centre_angle=math.degrees(c.centre_angle))
+        blade = blade_mesh(b.root_radius, b.tip_radius, b.crack_radius, b.root_chord,
+                           b.tip_chord, m.element_size, angle=math.degrees(b.angle),
+                           stagger=math.degrees(b.stagger))
+    except InputError as err:
+        raise InputError(f"mesh: {err}") from None
+    mesh = join(casing, blade, prefixes=("casing.", "blade."))
+    elem_sections = [names[k] for k in casing.ply] + [b.section] * blade.n_elems
+    e_r = np.array([math.cos(b.angle), math.sin(b.angle), 0.0])
+    warp = np.concatenate([circumferential_directions(casing),
+                           np.tile(e_r, (blade.n_elems, 1))])
+    return mesh, elem_sections, warp
+
+
+def section_thickness(section: Section, key: str) -> float:
+    t = section.thickness if section.thickness is not None else getattr(
+        section.material, "shell_thickness", None)
+    if t is None:
+        raise InputError(f"{key}: the section has no thickness")
+    return float(t)
+
+
+def spin_blade(model: Model, state: State, mesh: Mesh, section: Section, omega, tol,
+               warp) -> None:
+    """The blade's steady spin state (solver.relaxation) written into ``state``: the
+    blade alone, clamped at its root and loaded by ω² r⊥, relaxed; its configuration,
+    element and material state copied in, with v = ω × x and spins ω."""
+    from wovenimpact.solver.relaxation import centrifugal_acceleration, spin_state
+
+    elems = mesh.elem_sets["blade.blade"]
+    nodes = np.unique(mesh.quads[elems])
+    local = np.searchsorted(nodes, mesh.quads[elems])
+    x = mesh.nodes[nodes]
+    root = np.searchsorted(nodes, mesh.node_sets["blade.root"])
+    es = np.zeros(len(elems), dtype=np.int64)
+    bc = BoundaryConditions(len(x)).fix(root)
+    free = build_model(x, local, {"blade": section}, es, bcs=bc, alpha=model.alpha,
+                       warp_direction=warp[elems])
+    held = build_model(x, local, {"blade": section}, es, bcs=bc, alpha=model.alpha,
+                       warp_direction=warp[elems], body_accel=centrifugal_acceleration(x, omega))
+    spun, _ = spin_state(held, free, omega, tol=tol)
+    state.x[nodes] = spun.x
+    state.v[nodes] = spun.v
+    state.omega[nodes] = spun.omega
+    state.elem[elems] = spun.elem
+    width = min(free.point_width, model.point_width)
+    if width:
+        blocks = spun.mat.shape[1] // free.point_width
+        dst = state.mat[elems].reshape(len(elems), -1, model.point_width)
+        dst[:, :blocks, :width] = spun.mat.reshape(len(elems), blocks, free.point_width)[..., :width]
+        state.mat[elems] = dst.reshape(len(elems), -1)
+    ke = 0.5 * float(np.sum(model.node_mass[:, None] * state.v**2)
+                     + np.sum(model.node_inertia[:, None] * state.omega**2))
+    state.energy[KINETIC] = ke
+    state.energy[KINETIC0] = ke + state.energy[BODY_KINETIC]
+
+
 def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     """Build the Model and the State at t = 0 of a case (paths relative to ``base``)."""
     base = Path(base)
@@ -213,7 +305,11 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         )
         for name, s in spec.sections.items()
     }
-    mesh, elem_sections = make_mesh(spec, base)
+    warp = getattr(spec.mesh, "warp_direction", None)
+    if isinstance(spec.mesh, ContainmentMeshSpec):
+        mesh, elem_sections, warp = containment_mesh(spec.mesh, sections)
+    else:
+        mesh, elem_sections = make_mesh(spec, base)
     bcs = BoundaryConditions(mesh.n_nodes, ramp_time=spec.amplitude.ramp_time)
     for i, b in enumerate(spec.boundary):
         nodes = node_set(mesh, b.nodes, f"boundary[{i}].nodes")
@@ -225,6 +321,12 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
             bcs.symmetry(nodes, SYMMETRY_AXIS[b.type])
         else:
             bcs.prescribe(nodes, DOFS.index(b.dof), b.velocity)
+    spin = None if spec.spin is None else np.array([0.0, 0.0, spec.spin.rate])
+    if spin is not None:
+        if not isinstance(spec.mesh, ContainmentMeshSpec):
+            raise InputError("spin: only a containment mesh (mesh.kind = 'containment') has a "
+                             "blade to spin")
+        bcs.rotate(mesh.node_sets["blade.root"], spin)
     accel = None if spec.body_force is None else spec.body_force.acceleration
     bodies = []
     if spec.impactor is not None:
@@ -249,13 +351,15 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     model = build_model(
         mesh.nodes, mesh.quads, {s: sections[s] for s in used},
         np.array([used[s] for s in elem_sections], dtype=np.int64), bcs=bcs,
-        warp_direction=spec.mesh.warp_direction, body_accel=accel, alpha=spec.run.alpha,
+        warp_direction=warp, body_accel=accel, alpha=spec.run.alpha,
         erode_dt_fraction=spec.run.erode_dt_fraction, ply=mesh.ply, bodies=bodies,
         node_sets=mesh.node_sets, elem_sets=mesh.elem_sets,
         shell_contact=ShellContactParams(
             enabled=spec.contact.surfaces != "none" or spec.contact.self_contact,
             beta=spec.contact.penalty_scale, damping=spec.contact.damping,
             friction=spec.contact.friction, self_contact=spec.contact.self_contact),
+        release_elems=mesh.elem_sets.get("blade.release") if spin is not None else None,
+        release_time=spec.spin.release_time if spin is not None else math.inf,
     )
     v = np.zeros((mesh.n_nodes, 3))
     w = np.zeros((mesh.n_nodes, 3))
@@ -278,6 +382,9 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     w[model.bc_code[:, 3:] == 1] = 0.0
     check_impactor_clearance(model)
     state = initial_state(model, velocity=v, angular_velocity=w)
+    if spin is not None:
+        spin_blade(model, state, mesh, sections[spec.mesh.blade.section], spin,
+                   spec.spin.relaxation_tolerance, warp)
     for i, er in enumerate(spec.initial_erosion):
         erode_at_start(model, state, er, f"initial_erosion[{i}]")
     return CompiledCase(model=model, state=state, mesh=mesh, materials=materials)

@@ -11,6 +11,7 @@ docs/theory.md §2 (element) and §3 (integration).
 from __future__ import annotations
 
 import hashlib
+import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -22,10 +23,16 @@ from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as S
 from wovenimpact.materials.fabric import FabricParameters
 from wovenimpact.materials.fabric import initial_state as fabric_initial_state
-from wovenimpact.materials.metal import MetalParameters
+from wovenimpact.materials.metal import MetalParameters, j2_parameter_row
+from wovenimpact.materials.metal import initial_state as j2_initial_state
 
-FREE, FIXED, PRESCRIBED = 0, 1, 2  # boundary-condition codes per degree of freedom
+FREE, FIXED, PRESCRIBED, ROTATING = 0, 1, 2, 3  # boundary-condition codes per degree of freedom
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
+
+
+def is_plastic(material) -> bool:
+    """A J2 plastic metal (kernels.j2)."""
+    return isinstance(material, MetalParameters) and material.kind == "j2_plastic"
 MEMBRANE_POINTS = {"full": S.MEMBRANE_FULL, "reduced": S.MEMBRANE_REDUCED}
 GAUSS = 1.0 / np.sqrt(3.0)  # 2×2 Gauss points at (±1/√3, ±1/√3), weights 1
 GAUSS_XI = np.array([-GAUSS, GAUSS, GAUSS, -GAUSS])  # point g next to corner g
@@ -52,8 +59,8 @@ class Section:
         points: 1 = resultant section (membrane from the material at the mid-surface,
             elastic bending M = D κ with the bending modulus); an odd n ≥ 3 = the
             material evaluated at n Simpson points through the thickness (the
-            thesis's S4R + VUMAT section; metals' default in Abaqus is 5), its
-            bending stiffness then comes from the material itself.
+            thesis's S4R + VUMAT section), its bending stiffness then comes from the
+            material itself. Default 5 for plastic metals (which need it), else 1.
         membrane: ``"full"`` = 2×2 Gauss points in the plane (no in-plane hourglass
             modes, theory §4.5), ``"reduced"`` = one point and hourglass springs;
             default full for fabric sections, reduced for metals.
@@ -67,8 +74,15 @@ class Section:
     shear_factor: float = 5.0 / 6.0
     hourglass: float = 0.05
     areal_mass: float | None = None
-    points: int = 1
+    points: int | None = None
     membrane: str | None = None
+
+    def points_for(self, m) -> int:
+        """Through-thickness points: as given, else 5 for a plastic metal (MODEL.md §2)
+        and 1 (resultant section) otherwise."""
+        if self.points is not None:
+            return self.points
+        return 5 if is_plastic(m) else 1
 
     def row(self, mat_index: int, name: str) -> np.ndarray:
         """The section's row of ``Model.sections`` (layout in shell_layout)."""
@@ -78,7 +92,7 @@ class Section:
             t = m.shell_thickness if self.thickness is None else self.thickness
             mu = m.areal_mass if self.areal_mass is None else self.areal_mass
             if self.transverse_shear_modulus is None or (
-                self.bending_modulus is None and self.points == 1
+                self.bending_modulus is None and self.points_for(m) == 1
             ):
                 raise InputError(
                     f"section {name!r}: a fabric section needs transverse_shear_modulus "
@@ -90,11 +104,6 @@ class Section:
             nu_b = self.bending_poisson or 0.0
             g = self.transverse_shear_modulus
         else:
-            if m.kind != "elastic":
-                raise InputError(
-                    f"section {name!r}: material {m.name!r} is {m.kind!r}; the shell solver "
-                    "supports 'elastic' metals and woven fabrics so far"
-                )
             if self.thickness is None:
                 raise InputError(f"section {name!r}: a metal section needs a thickness")
             t = self.thickness
@@ -108,9 +117,14 @@ class Section:
                              ("transverse_shear_modulus", g), ("shear_factor", self.shear_factor)):
             if not value > 0.0:
                 raise InputError(f"section {name!r}: {label} = {value!r} must be > 0")
-        if not (self.points == 1 or (self.points >= 3 and self.points % 2 == 1)):
-            raise InputError(f"section {name!r}: points = {self.points!r}; valid: 1 (resultant "
+        points = self.points_for(m)
+        if not (points == 1 or (points >= 3 and points % 2 == 1)):
+            raise InputError(f"section {name!r}: points = {points!r}; valid: 1 (resultant "
                              "section) or an odd number ≥ 3 (Simpson integration)")
+        if points == 1 and is_plastic(m):
+            raise InputError(f"section {name!r}: material {m.name!r} is plastic; its section "
+                             "is integrated through the thickness: points must be an odd "
+                             "number ≥ 3 (default 5)")
         if not 0.0 <= self.hourglass < 1.0:
             raise InputError(f"section {name!r}: hourglass = {self.hourglass!r}; valid: 0 ≤ r < 1")
         membrane = self.membrane or ("full" if isinstance(m, FabricParameters) else "reduced")
@@ -125,7 +139,7 @@ class Section:
         r[S.C_SHEAR_G] = g
         r[S.C_SHEAR_K] = self.shear_factor
         r[S.C_HOURGLASS] = self.hourglass
-        r[S.C_POINTS] = self.points
+        r[S.C_POINTS] = points
         r[S.C_INPLANE] = MEMBRANE_POINTS[membrane]
         return r
 
@@ -159,6 +173,15 @@ class BoundaryConditions:
         """Symmetry plane with normal along axis 0/1/2: u_n = 0 and the two in-plane rotations."""
         rot = [3 + a for a in range(3) if a != normal_axis]
         return self.fix(nodes, (normal_axis, *rot))
+
+    def rotate(self, nodes, omega, centre=(0.0, 0.0, 0.0)) -> BoundaryConditions:
+        """Turn ``nodes`` rigidly at ``omega`` (rad/s vector) about the axis through
+        ``centre`` (all six DOFs; times the amplitude): a driven hub, a blade root."""
+        idx = np.asarray(nodes, dtype=np.int64)
+        self.code[idx, :] = ROTATING
+        self.velocity[idx, :3] = np.asarray(omega, dtype=float)
+        self.velocity[idx, 3:] = np.asarray(centre, dtype=float)
+        return self
 
     def prescribe(self, nodes, dof: int, velocity: float) -> BoundaryConditions:
         """Drive ``dof`` of ``nodes`` at ``velocity`` (m/s or rad/s) times the amplitude."""
@@ -241,7 +264,7 @@ class ShellContactParams:
 
     enabled: bool = True
     beta: float = 0.1
-    damping: float = 1.0
+    damping: float = 0.3
     friction: float = 0.0
     self_contact: bool = False
 
@@ -259,6 +282,8 @@ class Model:
         mat_params: (n_mats, n_params) parameter vectors, zero-padded.
         section_state0: (n_sections, n_mat_state) initial material state of an element
             of each section (its points' state blocks side by side).
+        point_width: length of one point's state block (the longest state vector of
+            the model's material kinds; 0 if none has a state).
         gauss_grad, gauss_weight: (n_elems, 4, 2, 4) ∂N_I/∂X at the 2×2 Gauss points
             and (n_elems, 4) their weights det J (fully integrated membranes).
         ref_grad: (n_elems, 2, 4) ∂N_I/∂X at the element centre in its reference
@@ -284,6 +309,8 @@ class Model:
         node_sets, elem_sets: named index arrays (outputs, BCs).
         shell_contact: parameters of the shell–shell contact between the surfaces
             (``ply`` labels the surfaces: plies, element sets or connected parts).
+        release_elems, release_time: elements eroded at ``release_time`` (s) — the
+            tie between a blade's hub part and its fragment (theory §7.2); none by default.
         section_names, material_names: labels for reports.
     """
 
@@ -294,6 +321,7 @@ class Model:
     mat_kind: np.ndarray
     mat_params: np.ndarray
     section_state0: np.ndarray
+    point_width: int
     ref_grad: np.ndarray
     area0: np.ndarray
     gauss_grad: np.ndarray
@@ -317,6 +345,8 @@ class Model:
     node_sets: dict = field(default_factory=dict)
     elem_sets: dict = field(default_factory=dict)
     shell_contact: ShellContactParams = ShellContactParams()
+    release_elems: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    release_time: float = math.inf
     section_names: tuple = ()
     material_names: tuple = ()
 
@@ -339,7 +369,8 @@ class Model:
             h.update(str(a.dtype).encode() + str(a.shape).encode())
             h.update(a.tobytes())
         h.update(repr((self.ramp_time, self.alpha, self.erode_dt_fraction,
-                       self.shell_contact)).encode())
+                       self.shell_contact, self.release_time)).encode())
+        h.update(np.ascontiguousarray(self.release_elems).tobytes())
         return h.hexdigest()
 
 
@@ -388,6 +419,15 @@ def material_frame_gradients(x0, quads, warp_direction):
                            X[:, 2] - X[:, 0]], axis=1) / a2[:, None]
     g_grad, g_weight = gauss_gradients(X, Y)
     return grad, area, g_grad, g_weight
+
+
+def release_array(elems, n_elems: int) -> np.ndarray:
+    """The released elements as a sorted int64 array, checked against the mesh."""
+    idx = np.unique(np.asarray([] if elems is None else elems, dtype=np.int64))
+    if idx.size and (idx[0] < 0 or idx[-1] >= n_elems):
+        raise InputError(f"release elements refer to element {int(idx[-1])}; the mesh has "
+                         f"{n_elems}")
+    return idx
 
 
 def gauss_gradients(X, Y):
@@ -447,6 +487,8 @@ def build_model(
     node_sets: dict | None = None,
     elem_sets: dict | None = None,
     shell_contact: ShellContactParams | None = None,
+    release_elems=None,
+    release_time: float = math.inf,
 ) -> Model:
     """Assemble a :class:`Model` from a mesh, named sections and constraints.
 
@@ -465,6 +507,7 @@ def build_model(
         ply: (n_elems,) part index for per-ply outputs; default all 0.
         bodies: rigid impactors.
         shell_contact: shell–shell contact parameters (default ShellContactParams()).
+        release_elems, release_time: elements eroded at that time (a blade's release).
     """
     x0 = np.ascontiguousarray(nodes, dtype=float)
     q = np.ascontiguousarray(quads, dtype=np.int64)
@@ -504,6 +547,10 @@ def build_model(
             kinds.append(S.MAT_FABRIC)
             params.append(m.to_array())
             states.append(fabric_initial_state(m)[0])
+        elif is_plastic(m):
+            kinds.append(S.MAT_J2)
+            params.append(j2_parameter_row(m))
+            states.append(j2_initial_state(m)[0])
         else:
             kinds.append(S.MAT_ELASTIC)
             params.append(np.array([m.modulus, m.poisson, m.density]))
@@ -512,9 +559,12 @@ def build_model(
     mat_params = np.zeros((len(mats), n_par))
     for i, p in enumerate(params):
         mat_params[i, : len(p)] = p
-    # per section: its points' state blocks side by side (width: the widest section)
-    blocks = [np.tile(states[int(r[S.C_MAT])], int(r[S.C_POINTS]) * int(r[S.C_INPLANE]))
-              for r in sec_table]
+    # per section: its points' state blocks side by side, each padded to the longest
+    # state vector of the model's kinds (width of the table: the widest section)
+    point_width = max(len(st) for st in states)
+    padded = [np.pad(st, (0, point_width - len(st))) for st in states]
+    blocks = [np.tile(padded[int(r[S.C_MAT])], int(r[S.C_POINTS]) * int(r[S.C_INPLANE]))
+              if point_width else np.zeros(0) for r in sec_table]
     section_state0 = np.zeros((len(blocks), max(1, max(len(b) for b in blocks))))
     for i, b in enumerate(blocks):
         section_state0[i, : len(b)] = b
@@ -552,7 +602,7 @@ def build_model(
     return Model(
         x0=x0, quads=q, elem_section=es, sections=sec_table,
         mat_kind=np.array(kinds, dtype=np.int64), mat_params=mat_params,
-        section_state0=section_state0,
+        section_state0=section_state0, point_width=int(point_width),
         ref_grad=ref_grad, area0=area0, gauss_grad=gauss_grad, gauss_weight=gauss_weight,
         node_mass=node_mass, node_inertia=node_inertia,
         bc_code=bcs.code.copy(), bc_velocity=bcs.velocity.copy(), ramp_time=float(bcs.ramp_time),
@@ -563,5 +613,6 @@ def build_model(
         body_state0=body_state0,
         node_sets=dict(node_sets or {}), elem_sets=dict(elem_sets or {}),
         shell_contact=shell_contact or ShellContactParams(),
+        release_elems=release_array(release_elems, len(q)), release_time=float(release_time),
         section_names=tuple(names), material_names=tuple(getattr(m, "name", "") for m in mats),
     )

@@ -105,7 +105,8 @@ def shell_forces(model, state: State, ws: Workspace) -> None:
     n_failed, ws.n_eroded, ws.dt_min = internal_force_for_shells(
         state.x, state.v, state.omega, state.dt, model.quads, model.elem_section,
         model.sections, model.mat_kind, model.mat_params, model.area0, model.ref_grad,
-        model.gauss_grad, model.gauss_weight, state.elem, ws.elem, state.mat, ws.mat, ws.blocks, ws.status, ws.eroded_now, ws.alive,
+        model.gauss_grad, model.gauss_weight, state.elem, ws.elem, state.mat, ws.mat,
+        model.point_width, ws.blocks, ws.status, ws.eroded_now, ws.alive,
         model.erode_dt_fraction * state.dt_first / model.alpha,
     )
     if n_failed:
@@ -152,8 +153,24 @@ def stable_step(model, state: State, ws: Workspace, dt_cap: float) -> float:
     return dt
 
 
+def release(model, state: State) -> None:
+    """Erode the model's release elements still alive (a blade's fragment breaking free
+    of its hub part at ``model.release_time``); their energies are booked as eroded
+    internal energy, once. Their nodes left without a live element leave the model in
+    the node update that follows."""
+    idx = model.release_elems
+    live = idx[state.elem[idx, S.E_ALIVE] != 0.0]
+    if not live.size:
+        return
+    state.energy[ERODED_INTERNAL] += float(np.sum(
+        state.elem[live, S.E_U_MEMB] + state.elem[live, S.E_U_BEND] + state.elem[live, S.E_U_HG]))
+    state.elem[live, S.E_ALIVE] = 0.0
+
+
 def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     """Advance ``state`` from t^n to t^{n+1} in place (stages 1–5 of the module docstring)."""
+    if state.t >= model.release_time:
+        release(model, state)
     t0 = time.perf_counter()
     shell_forces(model, state, ws)
     t0 = ws.tick("shell forces", t0)
@@ -191,9 +208,12 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     en[KINETIC] = float(np.sum(ws.ke))
     en[ERODED_KINETIC] += float(np.sum(ws.ke_eroded))
     if ws.n_eroded:
+        # booked once: the energies an element holds at its erosion (ws.elem, the state it
+        # keeps frozen from now on), which energy_balance no longer counts as stored or
+        # hourglass energy
         gone = ws.eroded_now != 0
         en[ERODED_INTERNAL] += float(np.sum(
-            state.elem[gone, S.E_U_MEMB] + state.elem[gone, S.E_U_BEND] + state.elem[gone, S.E_U_HG]
+            ws.elem[gone, S.E_U_MEMB] + ws.elem[gone, S.E_U_BEND] + ws.elem[gone, S.E_U_HG]
         ))
     state.elem, ws.elem = ws.elem, state.elem
     state.mat, ws.mat = ws.mat, state.mat
@@ -217,17 +237,27 @@ def advance(model, state: State, ws: Workspace, t_stop: float, max_steps: int | 
 
 
 def energy_balance(model, state: State) -> dict[str, float]:
-    """Energies (J) at the last whole step and the balance error.
+    """Energies (J) of the modelled part at the last whole step and the balance error.
 
     total = kinetic (nodes + impactors) + internal work + eroded kinetic − external
     work − work of the contact forces (= + contact energy, the penalty springs' energy
     and what sliding dissipated), which the exact solution keeps at the initial kinetic
-    energy; ``drift`` is total minus its initial value, ``error_fraction`` the drift
-    over the largest energy in play.
+    energy; ``drift`` is total minus its initial value, ``error_fraction`` = |drift| /
+    ``normaliser``, the largest energy in play: max(KE0, |W_ext|, |W_int|, KE).
+
+    The internal work is split, each joule once: ``stored_J`` and ``hourglass_J`` are
+    held by live elements; an eroded element keeps its energies at erosion frozen in its
+    state and they count only in ``eroded_internal_J`` (booked by ``step``), of which
+    ``eroded_hourglass_J`` was hourglass energy. The rest of W_int was dissipated
+    (broken yarns, damping of the contact's or the material's).
     """
     en = state.energy
-    stored = float(np.sum(state.elem[:, S.E_U_MEMB] + state.elem[:, S.E_U_BEND]))
-    hourglass = float(np.sum(state.elem[:, S.E_U_HG]))
+    live = state.elem[:, S.E_ALIVE] != 0.0
+    u_memb, u_bend, u_hg = (state.elem[:, S.E_U_MEMB], state.elem[:, S.E_U_BEND],
+                            state.elem[:, S.E_U_HG])
+    stored = float(np.sum(np.where(live, u_memb + u_bend, 0.0)))
+    hourglass = float(np.sum(np.where(live, u_hg, 0.0)))
+    eroded_hg = float(np.sum(np.where(live, 0.0, u_hg)))
     external = en[W_EXT] - en[NODE_CONTACT_WORK]
     contact = -en[CONTACT_WORK]
     kinetic = en[KINETIC] + en[BODY_KINETIC]
@@ -237,6 +267,7 @@ def energy_balance(model, state: State) -> dict[str, float]:
     return {
         "kinetic_J": float(en[KINETIC]),
         "impactor_kinetic_J": float(en[BODY_KINETIC]),
+        "initial_kinetic_J": float(en[KINETIC0]),
         "internal_work_J": float(en[W_INT]),
         "stored_J": stored,
         "hourglass_J": hourglass,
@@ -246,7 +277,9 @@ def energy_balance(model, state: State) -> dict[str, float]:
         "contact_dissipated_J": float(contact - en[CONTACT_PENALTY]),
         "eroded_kinetic_J": float(en[ERODED_KINETIC]),
         "eroded_internal_J": float(en[ERODED_INTERNAL]),
+        "eroded_hourglass_J": eroded_hg,
         "total_J": float(total),
         "drift_J": float(drift),
+        "normaliser_J": float(scale),
         "error_fraction": float(abs(drift) / scale),
     }

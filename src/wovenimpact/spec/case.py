@@ -8,6 +8,11 @@ together, one line each, naming the key::
 
     plate.toml: run.end_time: has no unit (got '200'; valid: a time > 0 such as '60 us')
 
+Two things are warnings (:class:`~wovenimpact.errors.InputWarning`), not errors: an
+output interval longer than ``run.end_time`` (clipped to it, so that a run shortened
+with ``--set run.end_time=…`` just runs) and a quarter plate whose ``symmetry_x`` /
+``symmetry_y`` node sets no boundary constrains.
+
 Schema (see README and examples/cases/)::
 
     [case]            name, description
@@ -23,6 +28,11 @@ Schema (see README and examples/cases/)::
                       = {ELSET = SECTION}, warp_direction
     [[boundary]]      nodes = SET, type = clamped | pinned | symmetry_x | symmetry_y |
                       symmetry_z | velocity (with dof and velocity)
+                      | kind = "containment": element_size, [mesh.casing] (inner_radius,
+                      length, sector, centre_angle, inner_section, layer_section, layers,
+                      layer_spacing), [mesh.blade] (section, root/crack/tip_radius,
+                      root/tip_chord, angle, stagger)
+    [spin]            rate, release_time, relaxation_tolerance (containment cases)
     [amplitude]       ramp_time (smooth step of prescribed velocities, thesis Fig. 8-3)
     [[initial_velocity]]  nodes = SET, velocity = [vx, vy, vz] and/or
                       angular_velocity = [wx, wy, wz] about centre; optional radius
@@ -33,7 +43,7 @@ Schema (see README and examples/cases/)::
                       contact_stiffness (penalty factor β of k = β m / Δt²),
                       contact_damping (ζ, fraction of critical; 1), friction (μ; 0)
     [contact]         shell–shell contact: surfaces = plies | parts | element_sets |
-                      none, self_contact, penalty_scale (β; 0.1), damping (ζ; 1),
+                      none, self_contact, penalty_scale (β; 0.1), damping (ζ; 0.3),
                       friction (μ; 0)
     [[initial_erosion]]  centre, radius, plies?: elements eroded at t = 0 (a hole: centroid
                       within radius of the axis through centre along cylinder_axis)
@@ -44,12 +54,13 @@ Schema (see README and examples/cases/)::
 from __future__ import annotations
 
 import dataclasses
+import warnings
 from pathlib import Path
 from typing import Any, Literal
 
 from pydantic import BaseModel, Field, ValidationError, model_validator
 
-from wovenimpact.errors import InputError
+from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.spec.fields import (
     STRICT,
     Problem,
@@ -89,7 +100,8 @@ class SectionSpec(BaseModel):
     shear_factor: quantity("dimensionless", gt=0, le=1, example="0.8333") = 5.0 / 6.0
     hourglass: quantity("dimensionless", ge=0, lt=1, example="0.05") = 0.05
     areal_mass: quantity("areal_density", gt=0, example="0.477 kg/m^2") | None = None
-    points: int = Field(default=1, ge=1)  # 1: resultant section; odd ≥ 3: Simpson points
+    # 1: resultant section; odd ≥ 3: Simpson points (default 5 for plastic metals, else 1)
+    points: int | None = Field(default=None, ge=1)
     # in-plane membrane integration: "full" 2×2 Gauss points (default for fabric) or
     # "reduced" one point + hourglass springs (default for metals); theory §4.5
     membrane: Literal["full", "reduced"] | None = None
@@ -117,6 +129,74 @@ class AbaqusMeshSpec(BaseModel):
     file: str = Field(min_length=1)
     sections: dict[str, str] = Field(min_length=1)  # element set → section name
     warp_direction: tuple[float, float, float] = (1.0, 0.0, 0.0)
+
+
+Angle = quantity("angle", example="90 deg")
+
+
+class CasingSpec(BaseModel):
+    """``[mesh.casing]``: coaxial cylindrical layers about the z axis (MODEL.md §6).
+
+    The inner metal shell (``inner_section``; omit it for an all-metal casing of
+    layers) has its inner surface at ``inner_radius``; ``layers`` layers of
+    ``layer_section`` follow outwards, their mid-surfaces ``layer_spacing`` apart
+    (default: the layer section's thickness, touching), the first one
+    ``layer_spacing``/2 outside the inner shell's outer surface.
+    """
+
+    model_config = STRICT
+    inner_radius: Length = 0.25
+    length: Length = 0.15
+    sector: Angle = 2.0 * 3.141592653589793
+    centre_angle: quantity("angle", example="90 deg") = 0.0
+    inner_section: str | None = None
+    layer_section: str = Field(min_length=1)
+    layers: int = Field(ge=1, le=200)
+    layer_spacing: Length | None = None
+
+
+class BladeSpec(BaseModel):
+    """``[mesh.blade]``: a flat tapered blade in the plane of the z axis (model.casing).
+
+    Defaults (MODEL.md §7: the thesis's blade is not in its text): root 40 mm, split at
+    60 mm (the released fragment is the airfoil outboard of it: 0.237 kg of titanium
+    4.98 mm thick, centre of mass at r = 142.9 mm, so ω r_cm = 149.6 m/s at 1047 rad/s),
+    tip 245 mm (5 mm inside a 250 mm casing), chords 80 mm at the root and 40 mm at the
+    tip, radial along ``angle`` (from +x), no stagger.
+    """
+
+    model_config = STRICT
+    section: str = Field(min_length=1)
+    root_radius: Length = 0.04
+    crack_radius: Length = 0.06
+    tip_radius: Length = 0.245
+    root_chord: Length = 0.08
+    tip_chord: Length = 0.04
+    angle: quantity("angle", example="90 deg") = 0.0
+    stagger: quantity("angle", example="30 deg") = 0.0
+
+
+class ContainmentMeshSpec(BaseModel):
+    """``[mesh] kind = "containment"``: a casing and a fan blade (thesis ch. 8). Node
+    sets ``casing.ends``, ``casing.end_low``, ``casing.end_high``, ``casing.cut_edges``,
+    ``casing.layer{k}``, ``blade.root``, ``blade.hub``, ``blade.fragment``."""
+
+    model_config = STRICT
+    kind: Literal["containment"]
+    element_size: Length
+    casing: CasingSpec
+    blade: BladeSpec
+
+
+class SpinSpec(BaseModel):
+    """``[spin]``: the blade turns at ``rate`` about the z axis: its centrifugal
+    pre-stress by dynamic relaxation, then ω × r velocities (theory §7.1); its root
+    keeps turning; the fragment is released at ``release_time`` (theory §7.2)."""
+
+    model_config = STRICT
+    rate: Spin = 1047.0
+    release_time: quantity("time", ge=0, example="0 us") = 0.0
+    relaxation_tolerance: quantity("dimensionless", gt=0, lt=0.1, example="1e-5") = 1e-5
 
 
 class BoundarySpec(BaseModel):
@@ -229,7 +309,7 @@ class ContactSpec(BaseModel):
     surfaces: Literal["plies", "parts", "element_sets", "none"] = "plies"
     self_contact: bool = False
     penalty_scale: quantity("dimensionless", gt=0, le=0.5, example="0.1") = 0.1
-    damping: quantity("dimensionless", ge=0, le=2, example="1") = 1.0
+    damping: quantity("dimensionless", ge=0, le=2, example="0.3") = 0.3
     friction: quantity("dimensionless", ge=0, le=10, example="0.2") = 0.0
 
 
@@ -261,15 +341,29 @@ class CaseSpec(BaseModel):
     case: CaseInfo
     materials: dict[str, str | MaterialRef] = Field(min_length=1)
     sections: dict[str, SectionSpec] = Field(min_length=1)
-    mesh: PlateMeshSpec | AbaqusMeshSpec = Field(discriminator="kind")
+    mesh: PlateMeshSpec | AbaqusMeshSpec | ContainmentMeshSpec = Field(discriminator="kind")
     boundary: list[BoundarySpec] = []
     amplitude: AmplitudeSpec = AmplitudeSpec()
     initial_velocity: list[InitialVelocitySpec] = []
     body_force: BodyForceSpec | None = None
     impactor: ImpactorSpec | None = None
+    spin: SpinSpec | None = None
     contact: ContactSpec = ContactSpec()
     initial_erosion: list[InitialErosionSpec] = []
     run: RunSpec
+
+
+def mesh_sections(mesh) -> list[tuple[str, str]]:
+    """(key, section name) of every section the mesh table names."""
+    if isinstance(mesh, PlateMeshSpec):
+        return [("mesh.section", mesh.section)]
+    if isinstance(mesh, AbaqusMeshSpec):
+        return [("mesh.sections", s) for s in mesh.sections.values()]
+    out = [("mesh.casing.layer_section", mesh.casing.layer_section),
+           ("mesh.blade.section", mesh.blade.section)]
+    if mesh.casing.inner_section is not None:
+        out.append(("mesh.casing.inner_section", mesh.casing.inner_section))
+    return out
 
 
 def check_references(spec: CaseSpec) -> list[Problem]:
@@ -279,27 +373,68 @@ def check_references(spec: CaseSpec) -> list[Problem]:
         if sec.material not in spec.materials:
             problems.append(Problem(f"sections.{name}.material", "names no material",
                                     sec.material, f"one of {sorted(spec.materials)}"))
-    used = [spec.mesh.section] if isinstance(spec.mesh, PlateMeshSpec) else list(
-        spec.mesh.sections.values())
-    key = "mesh.section" if isinstance(spec.mesh, PlateMeshSpec) else "mesh.sections"
-    for s in used:
+    for key, s in mesh_sections(spec.mesh):
         if s not in spec.sections:
             problems.append(Problem(key, "names no section", s, f"one of {sorted(spec.sections)}"))
+    if isinstance(spec.mesh, ContainmentMeshSpec) and spec.spin is None:
+        problems.append(Problem("spin", "is missing", valid="a [spin] table (rate, "
+                                "release_time) for a containment case"))
     if isinstance(spec.mesh, PlateMeshSpec) and spec.mesh.plies > 1 and spec.mesh.spacing is None:
         problems.append(Problem("mesh.spacing", "is missing", valid="the distance between ply "
                                 "mid-planes, e.g. '0.5 mm', needed when plies > 1"))
-    run = spec.run
-    for k in ("field_interval", "history_interval", "checkpoint_interval"):
-        v = getattr(run, k)
-        if v is not None and v > run.end_time:
-            problems.append(Problem(f"run.{k}", "is longer than run.end_time", v,
-                                    f"at most {run.end_time:g} s"))
     return problems
+
+
+INTERVALS = ("field_interval", "history_interval", "checkpoint_interval")
+QUARTER_SETS = ("symmetry_x", "symmetry_y")
+
+
+def _time_text(seconds: float) -> str:
+    """A time for a message, in µs below a millisecond (case files mostly say "us")."""
+    return f"{seconds * 1e6:g} us" if seconds < 1e-3 else f"{seconds:g} s"
+
+
+def clipped_intervals(spec: CaseSpec, source: str = "<dict>") -> CaseSpec:
+    """``spec`` with every output interval longer than ``run.end_time`` set to the end time
+    (a shortened run, e.g. ``--set run.end_time="5 us"``, just writes its outputs at the
+    end), each change told by an :class:`~wovenimpact.errors.InputWarning` naming the key."""
+    run = spec.run
+    changes = {}
+    for key in INTERVALS:
+        value = getattr(run, key)
+        if value is not None and value > run.end_time:
+            changes[key] = run.end_time
+            warnings.warn(f"{source}: run.{key} = {_time_text(value)} is longer than "
+                          f"run.end_time = {_time_text(run.end_time)}: clipped to the end time",
+                          InputWarning, stacklevel=3)
+    if not changes:
+        return spec
+    return spec.model_copy(update={"run": run.model_copy(update=changes)})
+
+
+def missing_symmetry_sets(spec: CaseSpec) -> list[str]:
+    """The symmetry node sets of a quarter plate (``mesh.quarter = true``) that no
+    ``[[boundary]]`` constrains: without them the quarter is a free-edged small plate."""
+    if not (isinstance(spec.mesh, PlateMeshSpec) and spec.mesh.quarter):
+        return []
+    constrained = {b.nodes for b in spec.boundary}
+    return [name for name in QUARTER_SETS if name not in constrained]
+
+
+def warn_missing_symmetry(spec: CaseSpec, source: str = "<dict>") -> None:
+    """An :class:`~wovenimpact.errors.InputWarning` naming the sets of
+    :func:`missing_symmetry_sets`, with the boundary tables that would constrain them."""
+    missing = missing_symmetry_sets(spec)
+    if missing:
+        tables = " ".join(f'[[boundary]] nodes = "{m}", type = "{m}";' for m in missing)
+        warnings.warn(f"{source}: mesh.quarter = true but no boundary constrains "
+                      f"{' and '.join(missing)} (add {tables.rstrip(';')})",
+                      InputWarning, stacklevel=3)
 
 
 def _without_mesh_kind(p: Problem) -> Problem:
     """``mesh.plate.side`` → ``mesh.side``: the kind selects the table, it is not a key."""
-    for kind in ("plate", "abaqus"):
+    for kind in ("plate", "abaqus", "containment"):
         if p.path.startswith(f"mesh.{kind}."):
             return dataclasses.replace(p, path="mesh." + p.path[len(kind) + 6:])
     return p
@@ -315,7 +450,8 @@ def case_from_dict(doc: dict[str, Any], source: str = "<dict>") -> CaseSpec:
     problems = check_references(spec)
     if problems:
         raise input_error(problems, source)
-    return spec
+    warn_missing_symmetry(spec, source)
+    return clipped_intervals(spec, source)
 
 
 def load_case(path: str | Path, overrides=()) -> tuple[CaseSpec, Path]:

@@ -29,8 +29,9 @@ from pydantic import BaseModel, Field, ValidationError
 
 from wovenimpact.calibration.crimp import crimp_amplitude, half_length_from_thread_count
 from wovenimpact.errors import InputError
+from wovenimpact.kernels.j2_layout import N_HARD_MAX
 from wovenimpact.materials.fabric import FabricOptions, FabricParameters, YarnFamily
-from wovenimpact.materials.metal import MetalParameters
+from wovenimpact.materials.metal import DamageParameters, MetalParameters, RateParameters
 from wovenimpact.spec.fields import (
     STRICT,
     InputWarning,
@@ -46,6 +47,8 @@ from wovenimpact.spec.fields import (
 WIDTH_TOLERANCE = 1e-3  # width may exceed the yarn pitch by 0.1 %: rounding of printed tables
 LENTICULAR_TOLERANCE = 0.05  # warn if A differs from (2/π)·width·thickness by more than 5 %
 H0_TOLERANCE = 0.01  # warn if a given h0 differs from eq. (5.5) by more than 1 %
+PLANE_STRESS_TRIAXIALITY = 2.0 / 3.0  # |η| = |σ_m / σ_eq| ≤ 2/3 in plane stress
+MAX_RATE_RATIO = 1e8  # Johnson–Cook rate terms must stay positive up to ε̇/ε̇0 = 1e8
 
 # --- woven fabric -------------------------------------------------------------------
 
@@ -134,6 +137,28 @@ class PlasticitySpec(BaseModel):
     fracture_strain: quantity("dimensionless", gt=0, example="0.18") | None = None
 
 
+class RateSpec(BaseModel):
+    """``[material.rate]``: Johnson–Cook rate factor 1 + C ln(ε̇p/ε̇0) for ε̇p > ε̇0."""
+
+    model_config = STRICT
+    c: quantity("dimensionless", ge=0, example="0.014")
+    reference_rate: quantity("strain_rate", gt=0, example="1 1/s")
+
+
+class DamageSpec(BaseModel):
+    """``[material.damage]``: Johnson–Cook fracture strain
+    ε_f = (d1 + d2 exp(d3 η))(1 + d4 ln ε̇*)(1 + d5 T*), T* = 0 (temperature not modelled)."""
+
+    model_config = STRICT
+    d1: quantity("dimensionless", example="-0.09")
+    d2: quantity("dimensionless", example="0.25")
+    d3: quantity("dimensionless", example="-0.5")
+    d4: quantity("dimensionless", example="0.014")
+    d5: quantity("dimensionless", example="3.87") = 0.0
+    # ε̇0 of the rate term; default: [material.rate] reference_rate
+    reference_rate: quantity("strain_rate", gt=0, example="1 1/s") | None = None
+
+
 class J2Spec(BaseModel):
     """``[material]`` with ``kind = "j2_plastic"`` (aluminium casing, titanium blade)."""
 
@@ -144,6 +169,8 @@ class J2Spec(BaseModel):
     modulus: quantity("pressure", gt=0, example="72 GPa")
     poisson: quantity("dimensionless", ge=0, lt=0.5, example="0.3")
     plasticity: PlasticitySpec
+    rate: RateSpec | None = None
+    damage: DamageSpec | None = None
 
 
 class ElasticSpec(BaseModel):
@@ -343,11 +370,20 @@ def _check_fabric(spec: FabricSpec, raw: dict) -> list[Problem]:
 def _metal_parameters(spec: J2Spec | ElasticSpec, raw: dict, source: str) -> MetalParameters:
     hardening: tuple[tuple[float, float], ...] = ()
     fracture = None
+    rate = damage = None
     if isinstance(spec, J2Spec):
         table = spec.plasticity.hardening
-        raise_problems(_check_hardening(table, raw), source)
+        raise_problems(_check_hardening(table, raw) + _check_damage(spec, raw), source)
         hardening = tuple((float(e), float(s)) for e, s in table)
         fracture = spec.plasticity.fracture_strain
+        if spec.rate is not None:
+            rate = RateParameters(c=spec.rate.c, reference_rate=spec.rate.reference_rate)
+        if spec.damage is not None:
+            d = spec.damage
+            ref = d.reference_rate
+            if ref is None:
+                ref = spec.rate.reference_rate if spec.rate is not None else 1.0
+            damage = DamageParameters(d=(d.d1, d.d2, d.d3, d.d4, d.d5), reference_rate=ref)
     return MetalParameters(
         name=spec.name,
         kind=spec.kind,
@@ -356,14 +392,60 @@ def _metal_parameters(spec: J2Spec | ElasticSpec, raw: dict, source: str) -> Met
         poisson=spec.poisson,
         hardening=hardening,
         fracture_strain=fracture,
+        rate=rate,
+        damage=damage,
     )
 
 
+def _check_damage(spec: J2Spec, raw: dict) -> list[Problem]:
+    """Johnson–Cook damage: ε_f > 0 over the plane-stress triaxialities and rates."""
+    d = spec.damage
+    if d is None:
+        return []
+    problems = []
+    for eta in (-PLANE_STRESS_TRIAXIALITY, PLANE_STRESS_TRIAXIALITY):
+        ef = d.d1 + d.d2 * math.exp(d.d3 * eta)
+        if not ef > 0.0:
+            problems.append(
+                Problem(
+                    "material.damage",
+                    f"gives a fracture strain d1 + d2 exp(d3 η) = {ef:.4g} ≤ 0 at triaxiality "
+                    f"η = {eta:+.4g} (plane stress reaches |η| = 2/3)",
+                    {k: _raw(raw, "damage", k) for k in ("d1", "d2", "d3")},
+                    "d1, d2, d3 with d1 + d2 exp(d3 η) > 0 for -2/3 ≤ η ≤ 2/3",
+                )
+            )
+            break
+    if 1.0 + d.d4 * math.log(MAX_RATE_RATIO) <= 0.0:
+        problems.append(
+            Problem(
+                "material.damage.d4",
+                f"makes the rate term 1 + d4 ln(ε̇/ε̇0) ≤ 0 below ε̇/ε̇0 = {MAX_RATE_RATIO:g}",
+                _raw(raw, "damage", "d4"),
+                f"a number > {-1.0 / math.log(MAX_RATE_RATIO):.4g}",
+            )
+        )
+    if d.d4 != 0.0 and d.reference_rate is None and spec.rate is None:
+        problems.append(
+            Problem(
+                "material.damage.reference_rate",
+                "is required when d4 ≠ 0 and there is no [material.rate] table to take it from",
+                valid="a strain rate > 0 such as '1 1/s'",
+            )
+        )
+    return problems
+
+
 def _check_hardening(table: list[tuple[float, float]], raw: dict) -> list[Problem]:
-    """ε_p starts at 0 and strictly increases; σ_y never decreases."""
+    """ε_p starts at 0 and strictly increases; σ_y never decreases; at most N_HARD_MAX rows."""
     loc = ("material", "plasticity", "hardening")
     rows = _raw(raw, "plasticity", "hardening")
     problems = []
+    if len(table) > N_HARD_MAX:
+        problems.append(
+            Problem(dotted(loc), f"has {len(table)} rows, more than the kernel's {N_HARD_MAX}",
+                    f"{len(table)} rows", f"at most {N_HARD_MAX} rows")
+        )
     if table[0][0] != 0.0:
         problems.append(
             Problem(dotted((*loc, 0, 0)), "must be 0 (the table starts at yield)", rows[0][0], "0")

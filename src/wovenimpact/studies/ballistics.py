@@ -8,6 +8,10 @@ Two estimates a designer compares (issue 4, point 6):
 - the Lambert–Jonas relation between striking velocity V_s and residual velocity V_r,
   V_r = a (V_s^p − V_bl^p)^{1/p} for V_s > V_bl and 0 below, fitted by least squares;
   V_bl estimates the ballistic limit V50.
+
+Both take decided runs only (:func:`require_decided`): a run whose outcome is
+``undecided`` (it ended still in contact) or ``no contact`` (it never arrived) says
+nothing about the residual velocity and is refused, with the variants named.
 """
 
 from __future__ import annotations
@@ -19,6 +23,37 @@ import numpy as np
 from scipy.optimize import least_squares
 
 from wovenimpact.errors import InputError
+
+
+DECIDED = ("perforated", "stopped")
+
+
+def require_decided(rows: list[dict], key: str, source: str) -> None:
+    """Refuse study rows that are not decided runs.
+
+    Args:
+        rows: finished rows of a study's results (``id``, the parameter ``key``,
+            ``outcome``).
+        key: the parameter column that names a variant (e.g. ``impactor.velocity``).
+        source: what the rows come from (a path), for the message.
+
+    Raises:
+        InputError: a row lacks an outcome, or its outcome is neither ``perforated``
+            nor ``stopped``; the message names each such variant by ``key`` and id.
+    """
+    if any("outcome" not in r or r["outcome"] in ("", None) for r in rows):
+        raise InputError(f"{source}: no outcome recorded for some runs (results written "
+                         "before outcomes were recorded, or not impact runs): run the study "
+                         "again into a new output directory")
+    bad = [r for r in rows if r["outcome"] not in DECIDED]
+    if bad:
+        names = "; ".join(f"{key} = {r.get(key, '?')} (variant {r.get('id', '?')}): "
+                          f"{r['outcome']}" for r in bad)
+        raise InputError(
+            f"{source}: {len(bad)} run(s) are not decided, so they cannot enter the fit — "
+            f"{names}. An undecided run ended still in contact with intact material ahead: "
+            "lengthen run.end_time and run the study again into a new output directory; a "
+            "'no contact' run never reached the target.")
 
 
 @dataclass(frozen=True)

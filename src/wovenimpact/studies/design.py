@@ -4,8 +4,11 @@
 ``[impactor]``), re-runs it with N plies (the impactor keeps its clearance above the
 top ply) and searches N: first by doubling until a pack stops the impactor, then by
 bisection between the largest pack that is perforated and the smallest that stops it.
-Each round runs its candidates in parallel (local processes). An ``undecided`` run
-(still in contact at the end time) stops the search with advice to run longer.
+Each round runs its candidates in parallel (local processes). Only decided runs count:
+a pack whose run ends ``undecided`` (still in contact, or intact plies ahead of the
+impactor, at the end time) or ``no contact`` is run once more with twice the end time
+(in ``plies_N_end2x``, saying so through ``log``); if it is still not decided the
+search stops with advice to run longer.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ from wovenimpact.errors import InputError
 from wovenimpact.jit import process_pool
 from wovenimpact.kernels.shell_layout import C_AREAL_MASS
 from wovenimpact.spec.fields import apply_overrides, read_toml
+from wovenimpact.studies.ballistics import DECIDED
 from wovenimpact.units import to_si
 
 MAX_PLIES = 64
@@ -103,12 +107,36 @@ def _run_one(doc: dict, base: str, out: str) -> str:
     return summary["outcome"]
 
 
+def _run_batch(docs: list[dict], base: str, dirs: list[str], workers: int) -> list[str]:
+    """Outcomes of the case documents ``docs`` run (or resumed) in ``dirs``, in parallel."""
+    with process_pool(min(workers, len(docs)), threads=1) as pool:
+        return list(pool.map(_run_one, docs, [base] * len(docs), dirs))
+
+
+def _quiet(message: str) -> None:
+    """The default ``log`` of :func:`design_plies`: says nothing."""
+
+
+def _longer(doc: dict) -> dict:
+    """The case document with twice its ``run.end_time``."""
+    d = copy.deepcopy(doc)
+    run = d.setdefault("run", {})
+    if "end_time" not in run:
+        raise InputError("design plies: the case has no run.end_time to lengthen")
+    end = to_si(run["end_time"], "time", "run.end_time", gt=0)
+    run["end_time"] = f"{2e6 * end!r} us"
+    return d
+
+
 def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
-                 start: int | None = None, overrides=(), check: int = 0) -> dict:
+                 start: int | None = None, overrides=(), check: int = 0,
+                 log: Callable[[str], None] = _quiet) -> dict:
     """Fewest plies that stop the impactor of a plate-impact case (with the ``KEY=VALUE``
     ``overrides`` of ``--set``); runs in out_dir/plies_N. ``check`` > 0 also runs the
     ``check`` packs just above the answer that the search did not run, so that a
-    non-monotonic outcome near the limit shows in the warning."""
+    non-monotonic outcome near the limit shows in the warning. A pack whose run is not
+    decided is run again with twice the end time (out_dir/plies_N_end2x), and ``log``
+    is told so; the result lists these under ``reruns``."""
     if isinstance(check, bool) or not isinstance(check, int) or check < 0:
         raise InputError(f"check = {check!r}; valid: a whole number of packs ≥ 0")
     path = Path(case_path)
@@ -116,18 +144,32 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
     base = str(path.resolve().parent)
     out = Path(out_dir)
     outcomes: dict[int, str] = {}
+    reruns: dict[str, str] = {}
+
+    def run_batch(docs: list[dict], dirs: list[str]) -> list[str]:
+        return _run_batch(docs, base, dirs, workers)
 
     def stops(batch: list[int]) -> dict[int, bool]:
         docs = [_case_with_plies(doc, n) for n in batch]
-        with process_pool(min(workers, len(batch)), threads=1) as pool:
-            results = list(pool.map(_run_one, docs, [base] * len(batch),
-                                    [str(out / f"plies_{n}") for n in batch]))
-        for n, r in zip(batch, results):
-            outcomes[n] = r
-            if r.startswith("undecided"):
-                raise InputError(f"{n} plies: the impactor is still in contact at run.end_time; "
-                                 "lengthen the run and search again")
-        return {n: r == "stopped" for n, r in zip(batch, results)}
+        results = dict(zip(batch, run_batch(docs, [str(out / f"plies_{n}") for n in batch])))
+        again = [n for n in batch if results[n] not in DECIDED]
+        if again:
+            longer = [_longer(d) for n, d in zip(batch, docs) if n in again]
+            for n, d in zip(again, longer):
+                log(f"{n} plies: {results[n]} at run.end_time = {docs[batch.index(n)]['run']['end_time']}"
+                    f"; running it again to {d['run']['end_time']} (plies_{n}_end2x)")
+            for n, r in zip(again, run_batch(longer, [str(out / f"plies_{n}_end2x")
+                                                      for n in again])):
+                reruns[str(n)] = f"{results[n]} → {r} with twice the end time"
+                results[n] = r
+        for n in batch:
+            outcomes[n] = results[n]
+            if results[n] not in DECIDED:
+                raise InputError(
+                    f"{n} plies: {results[n]} even with twice run.end_time (the impactor is "
+                    "still in contact or intact plies are ahead of it): lengthen run.end_time "
+                    "in the case and search again")
+        return {n: results[n] == "stopped" for n in batch}
 
     n0 = int(doc.get("mesh", {}).get("plies", 1))
     plies, seen = search_plies(stops, start=start or n0)
@@ -146,6 +188,7 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
         "areal_mass_kg_per_m2": plies * areal,
         "pack_mass_kg": plies * areal * side * side,
         "runs": {str(k): v for k, v in sorted(outcomes.items())},
+        "reruns": reruns,
         "warning": monotonic_warning(plies, seen),
     }
 

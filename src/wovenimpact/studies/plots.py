@@ -13,7 +13,7 @@ from wovenimpact.io.atomic import atomic_path  # noqa: E402
 from wovenimpact.io.history import read_csv  # noqa: E402
 
 # the history column overlaid across variants, first one present wins
-HISTORY_PREFERENCE = ("impactor_velocity_m_per_s", "kinetic_energy_J")
+HISTORY_PREFERENCE = ("impactor_velocity_m_per_s", "structure_kinetic_energy_part_J")
 
 
 def _save(fig, path: Path) -> None:

@@ -125,10 +125,10 @@ def strip_impact(problem: StripImpact | None = None) -> dict:
         step(model, st, ws)
         row = impactor_row(model, st)
         travel = float(row["impactor_displacement_m"]) - 0.02e-3  # face travel since contact
-        if t_contact is None and row["contact_force_N"] > 0.0:
+        if t_contact is None and row["contact_force_full_N"] > 0.0:
             t_contact = st.t
         times.append(st.t)
-        forces.append(row["contact_force_N"])
+        forces.append(row["contact_force_full_N"])
         w = -(st.x[axis_nodes, 2] - x0[axis_nodes, 2])
         x = st.x[axis_nodes, 0]  # laboratory positions: U is the kink's lab speed
         kinks.append(half_deflection_point(x, w, 0.5 * travel, p.face_radius))

@@ -16,8 +16,11 @@ addressed by its dotted path in the case document::
 ``grid`` runs every combination, ``zip`` the i-th value of every parameter together.
 Every variant is validated like a case file (a bad value fails that variant, with the
 key named, and the others still run), run in ``OUT/runs/<id>/`` and summarised in
-``OUT/results.csv``. A variant whose ``summary.json`` exists with the same parameters
-is not run again (the study resumes). Runs go to a local process pool by default, or
+``OUT/results.csv`` (and ``OUT/report.html``, linking each run's page). A variant
+whose ``summary.json`` exists with the same parameters is not run again (the study
+resumes). For impact runs results.csv always records the ``outcome`` (perforated,
+stopped, undecided, no contact), which the ballistic fits require to be decided. Runs
+go to a local process pool by default, or
 to a Dask cluster when a scheduler address is given.
 
 The local pool's workers are spawned (:func:`wovenimpact.jit.process_pool`), so a
@@ -36,6 +39,7 @@ import io
 import itertools
 import json
 import traceback
+import warnings
 from concurrent.futures import as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -43,11 +47,13 @@ from typing import Any, Literal
 
 from pydantic import BaseModel, Field, ValidationError
 
-from wovenimpact.errors import InputError
+from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.jit import process_pool
 from wovenimpact.io.atomic import atomic_write_text
+from wovenimpact.io.report import write_study_report
 from wovenimpact.spec.fields import (
     STRICT,
+    apply_overrides,
     input_error,
     problems_from_validation,
     read_toml,
@@ -86,8 +92,9 @@ def variant_id(values: dict) -> str:
     return hashlib.sha256(text.encode()).hexdigest()[:10]
 
 
-def load_study(path: str | Path) -> tuple[StudyInfo, list[Variant], Path]:
-    """Read a study file; returns its header, its variants and the base case's directory."""
+def load_study(path: str | Path, overrides=()) -> tuple[StudyInfo, list[Variant], Path]:
+    """Read a study file; returns its header, its variants and the base case's directory.
+    ``overrides`` (``--set KEY=VALUE``) change the base case before the parameters do."""
     path = Path(path)
     doc = read_toml(path, "study file")
     try:
@@ -95,7 +102,7 @@ def load_study(path: str | Path) -> tuple[StudyInfo, list[Variant], Path]:
     except ValidationError as err:
         raise input_error(problems_from_validation(err, StudyFile), str(path)) from None
     case_path = (path.parent / spec.study.case).resolve()
-    base_doc = read_toml(case_path, "case file named by study.case")
+    base_doc = apply_overrides(read_toml(case_path, "case file named by study.case"), overrides)
     keys = list(spec.parameters)
     columns = [spec.parameters[k] for k in keys]
     if spec.study.combine == "zip":
@@ -124,23 +131,50 @@ def run_variant(document: dict, base: str, out_dir: str, values: dict, threads: 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     atomic_write_text(out / "parameters.json", json.dumps(values, indent=2, default=str) + "\n")
-    try:
-        spec = case_from_dict(document, source=f"variant {out.name}")
-        summary = run_spec(spec, base, out, threads=threads)
-        return {"status": "done", **summary}
-    except Exception as err:  # one failing case is reported, the others finish
-        message = f"{type(err).__name__}: {err}"
-        atomic_write_text(out / "error.txt", message + "\n\n" + traceback.format_exc())
-        return {"status": "failed", "error": message}
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", InputWarning)
+        try:
+            spec = case_from_dict(document, source=f"variant {out.name}")
+            summary = run_spec(spec, base, out, threads=threads)
+            result = {"status": "done", **summary}
+        except Exception as err:  # one failing case is reported, the others finish
+            message = f"{type(err).__name__}: {err}"
+            atomic_write_text(out / "error.txt", message + "\n\n" + traceback.format_exc())
+            result = {"status": "failed", "error": message}
+    notes = [str(w.message).split(": ", 1)[-1] for w in caught
+             if issubclass(w.category, InputWarning)]
+    for w in caught:
+        if not issubclass(w.category, InputWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    if notes:  # told once per study by run_study, not once per variant and worker
+        result["warnings"] = list(dict.fromkeys(notes))
+    return result
+
+
+def warn_once(results: dict[str, dict], total: int) -> None:
+    """Each distinct input warning of the variants (``warnings`` of their results) as one
+    :class:`~wovenimpact.errors.InputWarning` saying how many variants it concerns."""
+    seen: dict[str, int] = {}
+    for r in results.values():
+        for note in r.get("warnings", ()):
+            seen[note] = seen.get(note, 0) + 1
+    for note, count in seen.items():
+        warnings.warn(f"{count} of {total} variants: {note}", InputWarning, stacklevel=3)
 
 
 def finished(out: Path, values: dict) -> dict | None:
-    """The summary of a variant already run with these values, else None."""
+    """The summary of a variant already run with these values, else None (also when the
+    summary was written by an older wovenimpact whose outcome rule or energy keys differ:
+    ``summary_version`` below ``runs.SUMMARY_VERSION``)."""
+    from wovenimpact.runs import SUMMARY_VERSION
+
     try:
         same = json.loads((out / "parameters.json").read_text()) == json.loads(
             json.dumps(values, default=str))
         summary = json.loads((out / "summary.json").read_text())
     except (OSError, ValueError):
+        return None
+    if summary.get("summary_version", 1) < SUMMARY_VERSION:
         return None
     return {"status": "done", **summary} if same else None
 
@@ -153,26 +187,31 @@ def run_study(
     workers: int = 2,
     threads_per_run: int = 1,
     progress=None,
+    overrides=(),
 ) -> list[dict]:
     """Run every variant of a study (resuming), write results.csv and plots; returns the rows.
 
     ``progress(done, total, variant_id, result)`` is called as each variant finishes
-    (resumed ones count as done from the start)."""
+    (resumed ones count as done from the start). ``overrides`` (``--set KEY=VALUE``)
+    change the base case of every variant; a variant is resumed only if it was run with
+    the same ones."""
     progress = progress or (lambda done, total, vid, result: None)
-    info, variants, base = load_study(study_path)
+    info, variants, base = load_study(study_path, overrides)
+    extra = {"--set": list(overrides)} if overrides else {}
     out = Path(out_dir)
     (out / "runs").mkdir(parents=True, exist_ok=True)
     results: dict[str, dict] = {}
     todo = []
     for v in variants:
-        done = finished(out / "runs" / v.id, v.values)
+        done = finished(out / "runs" / v.id, {**v.values, **extra})
         if done is not None:
             results[v.id] = {**done, "resumed": True}
         else:
             todo.append(v)
     if results:
         progress(len(results), len(variants), "", {"status": "finished earlier"})
-    args = [(v.document, str(base), str(out / "runs" / v.id), v.values, threads_per_run)
+    args = [(v.document, str(base), str(out / "runs" / v.id), {**v.values, **extra},
+             threads_per_run)
             for v in todo]
     if todo and scheduler:
         try:
@@ -192,11 +231,15 @@ def run_study(
             for fut in as_completed(futures):
                 results[futures[fut].id] = fut.result()
                 progress(len(results), len(variants), futures[fut].id, results[futures[fut].id])
+    warn_once(results, len(variants))
     rows = []
+    impact = any("outcome" in r for r in results.values())
     for v in variants:
         r = results[v.id]
         row = {"id": v.id, **{k: _short(val) for k, val in v.values.items()},
                "status": r.get("status"), "error": r.get("error", "")}
+        if impact:  # the outcome of an impact run, always recorded (the fits need it)
+            row["outcome"] = r.get("outcome", "")
         for m in info.metrics:
             row[m] = r.get(m, "")
         rows.append(row)
@@ -205,6 +248,7 @@ def run_study(
     from wovenimpact.studies.plots import study_plots
 
     study_plots(info, variants, rows, out)
+    write_study_report(out, info.name, rows)  # OUT/report.html: variants linked, plots
     return rows
 
 

@@ -4,7 +4,8 @@ Runs the chapter-7 plate-impact cases and studies of ``examples/`` (resuming wha
 is already in the work directory), then writes a Markdown report with our numbers next
 to the thesis's, the ballistic fits and the comparison figures. The thesis's own units
 were inconsistent (MODEL.md §7): its numbers are trends to compare with, not targets,
-and nothing here is tuned to them.
+and nothing here is tuned to them. Only decided runs (perforated or stopped) enter a fit
+or a convergence verdict; the others are named as not decided.
 """
 
 from __future__ import annotations
@@ -17,6 +18,8 @@ from pathlib import Path
 
 from wovenimpact.errors import InputError
 from wovenimpact.io.atomic import atomic_write_text
+from wovenimpact.io.report import write_index
+from wovenimpact.studies.ballistics import DECIDED
 from wovenimpact.spec.fields import read_toml, set_dotted
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -132,8 +135,7 @@ def spread_line(rows: list[dict]) -> str:
         vals = [float(r[key]) * scale for r in done]
         return min(vals), max(vals)
 
-    share = [float(r["hourglass_energy_J"]) / max(float(r["internal_work_J"]), 1e-300)
-             for r in done]
+    share = [float(r["hourglass_fraction"]) for r in done]
     rb, ab = span("rebound_velocity_m_per_s"), span("absorbed_energy_J")
     return (f"Across the {len(done)} runs the rebound velocity spans {rb[0]:.2f}–{rb[1]:.2f} "
             f"m/s and the absorbed energy {ab[0]:.3f}–{ab[1]:.3f} J, while the hourglass "
@@ -184,8 +186,9 @@ def study_commentary(study_rows: dict[str, list[dict]]) -> list[str]:
 def commentary(cases: dict[str, dict], convergence: list[dict]) -> list[str]:
     """The report's closing bullets, from the numbers of this run."""
     stopped = [n for n, c in cases.items() if c["outcome"] == "stopped"]
-    through = [n for n, c in cases.items() if c["perforated"]]
-    ke = {n: c["initial_kinetic_energy_J"] for n, c in cases.items()}
+    through = [n for n, c in cases.items() if c["outcome"] == "perforated"]
+    open_ = [f"{n} ({c['outcome']})" for n, c in cases.items() if c["outcome"] not in DECIDED]
+    ke = {n: c["initial_total_kinetic_energy_J"] for n, c in cases.items()}
     out = [
         f"- With the FSP assumption {', '.join(stopped) or 'no case'} stop the impactor"
         + (f" and {', '.join(through)} perforate" if through else "")
@@ -195,11 +198,21 @@ def commentary(cases: dict[str, dict], convergence: list[dict]) -> list[str]:
         "the thesis's impactor must have been heavier or sharper; the comparison waits for "
         "its geometry and mass, and nothing is tuned to close the gap.",
     ]
+    if open_:
+        out.append(f"- Not decided at their end time, so left out of the comparison: "
+                   f"{', '.join(open_)}; lengthen run.end_time.")
     by_case: dict[str, list[dict]] = {}
     for r in convergence:
         by_case.setdefault(r["case"], []).append(r)
     for name, rows in by_case.items():
         ref, fine, full = rows[0], rows[1], rows[2]
+        open_ = [r for r in rows if r["outcome"] not in DECIDED]
+        if open_:
+            out.append(
+                f"- {name}{''.join(', ' + v for v in ref['changes'].values())}: no convergence "
+                "verdict — " + ", ".join(f"{r['variant']} {r['outcome']}" for r in open_)
+                + " (an undecided run ended still in contact: lengthen run.end_time).")
+            continue
         v_ref = ref["residual_velocity_m_per_s"] or ref["rebound_velocity_m_per_s"]
         what = "residual" if ref["residual_velocity_m_per_s"] else "rebound"
         d_mesh = abs(fine["delta_residual"] if what == "residual" else fine["delta_rebound"])
@@ -226,8 +239,8 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
     """Run (or resume) everything and write the report; returns its path. ``log(message)``
     hears of each case, convergence run and study as it starts (the whole takes about
     half an hour on 2 cores)."""
-    from wovenimpact.runs import run_case
-    from wovenimpact.studies.ballistics import lambert_jonas_fit
+    from wovenimpact.runs import SUMMARY_VERSION, run_case
+    from wovenimpact.studies.ballistics import lambert_jonas_fit, require_decided
     from wovenimpact.studies.sweep import run_study
     from wovenimpact.units import to_si
 
@@ -250,13 +263,12 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
     for name in CASES:
         out = work / "cases" / name
         summary_path = out / "summary.json"
-        if summary_path.exists():
-            s = json.loads(summary_path.read_text())
-        else:
+        s = json.loads(summary_path.read_text()) if summary_path.exists() else {}
+        if s.get("summary_version", 1) < SUMMARY_VERSION:  # none, or an older rule's
             log(f"case {name} → {out}")
             s = run_case(ROOT / "examples" / "plate_impact" / f"{name}.toml", out)
         cases[name] = s
-        hg = s["hourglass_energy_J"] / max(s["internal_work_J"], 1e-300)
+        hg = s["hourglass_fraction"]
         lines.append(
             f"| {name} | {s['outcome']} | {s['residual_velocity_m_per_s']:.1f} | "
             f"{THESIS_RESIDUAL[name]} | {s['rebound_velocity_m_per_s']:.1f} | "
@@ -288,11 +300,12 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
         if "v50" in study:
             done = [r for r in rows if r["status"] == "done"]
             try:
+                require_decided(done, "impactor.velocity", f"study {study}")
                 fit = lambert_jonas_fit(
                     [to_si(r["impactor.velocity"], "velocity", "velocity") for r in done],
                     [float(r["residual_velocity_m_per_s"]) for r in done])
                 stopped = [to_si(r["impactor.velocity"], "velocity", "v") for r in done
-                           if float(r["residual_velocity_m_per_s"]) == 0.0]
+                           if r["outcome"] == "stopped"]
                 lines += ["", f"Lambert–Jonas: V50 = {fit.v_bl:.1f} m/s (a = {fit.a:.3f}, "
                           f"p = {fit.p:.2f}, rms {fit.rms:.2f} m/s); bracketed by the runs "
                           f"between {max(stopped, default=0):.0f} m/s (stopped) and the "
@@ -309,4 +322,5 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
     lines += ["## Commentary", "", *commentary(cases, convergence),
               *study_commentary(study_rows)]
     atomic_write_text(report, "\n".join(lines) + "\n")
+    write_index(work, "wovenimpact validate: every run and study")  # WORK/report.html
     return report

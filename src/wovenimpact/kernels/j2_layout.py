@@ -1,0 +1,55 @@
+"""Index layout of the J2 (metal) parameter vector and state vector.
+
+Kept apart from the kernels so the Python side (materials/metal.py, outputs,
+tests) can name entries without importing compiled code. Plain integer
+constants: Numba treats module-level ints as compile-time constants.
+
+Parameter vector ``p`` (float64, length ``N_PARAM``), SI units. Columns 0–2 are
+E, ν, ρ as in the elastic row of :mod:`wovenimpact.kernels.shell_layout`
+(``E_MOD``, ``E_NU``, ``E_RHO``), so code that only needs the elastic constants
+(bending of a resultant section, wave speeds) reads a metal row unchanged.
+"""
+
+# --- parameters -------------------------------------------------------------
+P_E = 0  # E, Young's modulus (Pa)
+P_NU = 1  # ν, Poisson's ratio (—)
+P_RHO = 2  # ρ, density (kg/m³)
+P_FRACTURE = 3  # ε_f, equivalent plastic strain at failure (—); 0: no such criterion
+P_RATE_C = 4  # C of the Johnson–Cook rate factor 1 + C ln(ε̇p/ε̇0) (—)
+P_RATE_REF = 5  # ε̇0, its reference plastic strain rate (1/s); 0: no rate effect
+P_DAMAGE = 6  # 1.0: Johnson–Cook damage on, 0.0: off
+P_D = 7  # D1..D5 of the Johnson–Cook fracture strain (P_D + 0 … P_D + 4)
+P_DAMAGE_REF = 12  # ε̇0 of the damage rate term (1/s)
+P_N_HARD = 13  # number of rows of the hardening table (1 … N_HARD_MAX)
+P_HARD = 14  # row k: ε_p at P_HARD + 2k, σ_y (Pa) at P_HARD + 2k + 1
+N_HARD_MAX = 64
+N_PARAM = P_HARD + 2 * N_HARD_MAX
+
+# --- state (history variables and outputs of one material point) -------------
+# S_ALIVE and S_ENERGY sit at the same columns as in fabric_layout, so a section
+# kernel reads a point's alive flag and stored energy the same way for both kinds
+# (tests/unit/test_j2_kernel.py checks it).
+S_SIG = 0  # rotated Cauchy stress σ_xx, σ_yy, σ_xy (Pa), Green–Naghdi frame: S_SIG + 0..2
+S_TAU = 3  # rotated Kirchhoff stress τ = J σ (Pa), the variable of the return: S_TAU + 0..2
+S_EPS_P = 6  # ε̄p, equivalent plastic strain (—)
+S_PLASTIC_WORK = 7  # plastic work per unit reference area, cumulative (J/m²)
+S_THICK = 8  # λ3 = t / t0, thickness stretch (—)
+S_DAMAGE = 9  # D, Johnson–Cook damage (—), 0 … ≥ 1
+S_ALIVE = 10  # 1.0 until the point fails, then 0.0 for good (as fabric_layout.S_ALIVE)
+S_ENERGY = 11  # elastic stored energy per unit reference area (J/m²) (as fabric_layout.S_ENERGY)
+S_RATE = 12  # ε̇p, equivalent plastic strain rate of the last step (1/s)
+S_YIELD = 13  # σ_y, current flow stress (Pa), rate factor included
+S_FAIL_ENERGY = 14  # elastic energy per reference area released when the point failed (J/m²)
+S_ITER = 15  # iterations of the last return
+N_STATE = 16
+
+# --- status codes returned per point -----------------------------------------
+STATUS_OK = 0
+STATUS_NOT_CONVERGED = 1  # the plane-stress return left |f| > RETURN_TOL_FAIL σ_y
+STATUS_BAD_KINEMATICS = 2  # det F ≤ 0 or non-finite input
+
+STATUS_TEXT = {
+    STATUS_OK: "ok",
+    STATUS_NOT_CONVERGED: "plane-stress return did not converge",
+    STATUS_BAD_KINEMATICS: "inadmissible deformation (det F ≤ 0, or NaN)",
+}

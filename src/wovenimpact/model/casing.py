@@ -1,0 +1,194 @@
+"""Containment geometry (thesis ch. 8, MODEL.md §6): coaxial casing layers and a fan blade.
+
+``casing_mesh`` builds N coaxial cylindrical layers about the z axis (an inner metal
+shell and fabric plies, or metal layers), each on its own nodes; ``blade_mesh`` a flat
+tapered blade in the plane of the axis, split along a crack radius into a hub part and
+the released fragment joined by one row of "release" elements. Both return a
+:class:`~wovenimpact.model.mesh.Mesh`; ``join`` puts meshes side by side.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from wovenimpact.errors import InputError
+from wovenimpact.model.mesh import Mesh
+
+
+def _divisions(extent: float, size: float, label: str) -> int:
+    if not (math.isfinite(extent) and extent > 0.0):
+        raise InputError(f"{label} = {extent!r} m must be > 0")
+    if not (math.isfinite(size) and size > 0.0):
+        raise InputError(f"element_size = {size!r} m must be > 0")
+    n = int(math.ceil(extent / size - 1e-9))
+    if n > 20000:
+        raise InputError(f"{label} / element_size = {extent / size:.3g} elements along one "
+                         "edge; choose a larger element_size")
+    return max(n, 1)
+
+
+def casing_mesh(
+    radii,
+    length: float,
+    element_size: float,
+    sector: float = 360.0,
+    centre_angle: float = 0.0,
+) -> Mesh:
+    """Coaxial cylindrical layers about the z axis, z ∈ [−length/2, length/2].
+
+    Args:
+        radii: mid-surface radius of each layer (m), innermost first.
+        length: axial length (m).
+        element_size: target element edge (m), along the circumference of the
+            innermost layer and along z; every layer has the same divisions (its
+            elements are slightly longer circumferentially the further out it is).
+        sector: angular extent (degrees); 360 is the full ring (periodic, no seam).
+        centre_angle: angle of the sector's middle (degrees, from +x towards +y).
+
+    Elements are counter-clockwise about the outward normal (first edge along the
+    circumference, second along +z). Node sets: ``ends`` (z = ±length/2, every layer),
+    ``end_low``, ``end_high``, ``cut_edges`` (the two straight edges of a sector;
+    empty for a full ring), ``layer{k}``; element sets ``layer{k}``; ``ply`` = k.
+    """
+    radii = np.asarray(radii, dtype=float).ravel()
+    if radii.size == 0 or not np.all(np.isfinite(radii)) or np.any(radii <= 0.0):
+        raise InputError(f"casing layer radii {radii.tolist()} must be positive numbers")
+    if np.any(np.diff(radii) <= 0.0):
+        raise InputError(f"casing layer radii {radii.tolist()} must increase outwards")
+    if not (0.0 < sector <= 360.0):
+        raise InputError(f"casing sector = {sector!r}°; valid: 0 < sector ≤ 360")
+    full = sector >= 360.0
+    span = math.radians(sector)
+    n_t = _divisions(radii[0] * span, element_size, "casing circumference")
+    if full:
+        n_t = max(n_t, 8)
+    n_z = _divisions(length, element_size, "casing length")
+    t0 = math.radians(centre_angle) - 0.5 * span
+    n_tn = n_t if full else n_t + 1  # node columns around
+    theta = t0 + span * np.arange(n_tn) / n_t
+    z = np.linspace(-0.5 * length, 0.5 * length, n_z + 1)
+    per_layer = n_tn * (n_z + 1)
+    nodes, quads, ply = [], [], []
+    node_sets: dict[str, np.ndarray] = {}
+    elem_sets: dict[str, np.ndarray] = {}
+    jj, kk = np.meshgrid(np.arange(n_t), np.arange(n_z), indexing="ij")
+    jj, kk = jj.ravel(), kk.ravel()
+    for layer, r in enumerate(radii):
+        tt, zz = np.meshgrid(theta, z, indexing="ij")
+        nodes.append(np.stack([r * np.cos(tt).ravel(), r * np.sin(tt).ravel(), zz.ravel()],
+                              axis=1))
+        base = layer * per_layer
+
+        def nid(j, k):
+            return base + (j % n_tn) * (n_z + 1) + k
+
+        q = np.stack([nid(jj, kk), nid(jj + 1, kk), nid(jj + 1, kk + 1), nid(jj, kk + 1)],
+                     axis=1)
+        elem_sets[f"layer{layer}"] = np.arange(len(q)) + sum(len(a) for a in quads)
+        quads.append(q)
+        ply.append(np.full(len(q), layer))
+        node_sets[f"layer{layer}"] = base + np.arange(per_layer)
+    nodes = np.concatenate(nodes)
+    idx = np.arange(len(nodes))
+    col = (idx % per_layer) // (n_z + 1)
+    row = idx % (n_z + 1)
+    node_sets["end_low"] = idx[row == 0]
+    node_sets["end_high"] = idx[row == n_z]
+    node_sets["ends"] = idx[(row == 0) | (row == n_z)]
+    node_sets["cut_edges"] = idx[(col == 0) | (col == n_tn - 1)] if not full else idx[:0]
+    return Mesh(nodes=nodes, quads=np.concatenate(quads), ply=np.concatenate(ply),
+                node_sets=node_sets, elem_sets=elem_sets)
+
+
+def circumferential_directions(mesh: Mesh) -> np.ndarray:
+    """(n_elems, 3) unit e_θ at each element's centroid: the warp of a wrapped fabric."""
+    c = mesh.nodes[mesh.quads].mean(axis=1)
+    t = np.stack([-c[:, 1], c[:, 0], np.zeros(len(c))], axis=1)
+    return t / np.linalg.norm(t, axis=1, keepdims=True)
+
+
+def blade_mesh(
+    root_radius: float,
+    tip_radius: float,
+    crack_radius: float,
+    root_chord: float,
+    tip_chord: float,
+    element_size: float,
+    angle: float = 0.0,
+    stagger: float = 0.0,
+) -> Mesh:
+    """A flat tapered blade from ``root_radius`` to ``tip_radius`` along the radial
+    direction at ``angle`` (degrees from +x), its chord along z (linear taper from
+    ``root_chord`` to ``tip_chord``), turned by ``stagger`` (degrees) about its radial
+    axis; it spins about the z axis.
+
+    The radial divisions put a node row exactly at ``crack_radius``; the row of
+    elements just outboard of it is the element set ``release`` (eroded at release:
+    the fragment then flies free, the hub part keeps turning). Sets: nodes ``root``
+    (r = root_radius), ``hub``, ``fragment``; elements ``hub``, ``fragment``
+    (``release`` included in neither), ``blade``.
+    """
+    if not (0.0 < root_radius < crack_radius < tip_radius):
+        raise InputError(f"blade radii: need 0 < root_radius ({root_radius!r}) < crack_radius "
+                         f"({crack_radius!r}) < tip_radius ({tip_radius!r}) (m)")
+    for label, c in (("root_chord", root_chord), ("tip_chord", tip_chord)):
+        if not (math.isfinite(c) and c > 0.0):
+            raise InputError(f"blade {label} = {c!r} m must be > 0")
+    n_in = _divisions(crack_radius - root_radius, element_size, "blade hub length")
+    n_out = _divisions(tip_radius - crack_radius, element_size, "blade fragment length")
+    n_c = _divisions(max(root_chord, tip_chord), element_size, "blade chord")
+    r = np.concatenate([np.linspace(root_radius, crack_radius, n_in + 1),
+                        np.linspace(crack_radius, tip_radius, n_out + 1)[1:]])
+    u = np.linspace(-0.5, 0.5, n_c + 1)
+    rr, uu = np.meshgrid(r, u, indexing="ij")
+    chord = root_chord + (rr - root_radius) / (tip_radius - root_radius) * (tip_chord - root_chord)
+    a, s = math.radians(angle), math.radians(stagger)
+    e_r = np.array([math.cos(a), math.sin(a), 0.0])
+    e_t = np.array([-math.sin(a), math.cos(a), 0.0])
+    e_c = math.cos(s) * np.array([0.0, 0.0, 1.0]) + math.sin(s) * e_t  # chord direction
+    nodes = rr.ravel()[:, None] * e_r + (uu * chord).ravel()[:, None] * e_c
+    n_r = len(r) - 1
+    ii, jj = np.meshgrid(np.arange(n_r), np.arange(n_c), indexing="ij")
+    ii, jj = ii.ravel(), jj.ravel()
+
+    def nid(i, j):
+        return i * (n_c + 1) + j
+
+    quads = np.stack([nid(ii, jj), nid(ii + 1, jj), nid(ii + 1, jj + 1), nid(ii, jj + 1)], axis=1)
+    e = np.arange(len(quads))
+    release = e[ii == n_in]
+    hub = e[ii < n_in]
+    fragment = e[ii > n_in]
+    idx = np.arange(len(nodes))
+    ring = idx // (n_c + 1)
+    return Mesh(
+        nodes=nodes, quads=quads, ply=np.zeros(len(quads), dtype=np.int64),
+        node_sets={"root": idx[ring == 0], "hub": idx[ring <= n_in],
+                   "fragment": idx[ring >= n_in + 1]},
+        elem_sets={"hub": hub, "fragment": fragment, "release": release, "blade": e},
+    )
+
+
+def join(*meshes: Mesh, prefixes=None) -> Mesh:
+    """The meshes side by side (nodes renumbered, plies offset so that every mesh keeps
+    its own surfaces); sets are prefixed (``prefixes[i]``, default none)."""
+    prefixes = prefixes or [""] * len(meshes)
+    nodes, quads, ply = [], [], []
+    node_sets: dict[str, np.ndarray] = {}
+    elem_sets: dict[str, np.ndarray] = {}
+    n_off = e_off = p_off = 0
+    for m, pre in zip(meshes, prefixes):
+        nodes.append(m.nodes)
+        quads.append(m.quads + n_off)
+        ply.append(m.ply + p_off)
+        for k, v in m.node_sets.items():
+            node_sets[pre + k] = v + n_off
+        for k, v in m.elem_sets.items():
+            elem_sets[pre + k] = v + e_off
+        n_off += m.n_nodes
+        e_off += m.n_elems
+        p_off += int(m.ply.max()) + 1 if m.n_elems else 0
+    return Mesh(nodes=np.concatenate(nodes), quads=np.concatenate(quads),
+                ply=np.concatenate(ply), node_sets=node_sets, elem_sets=elem_sets)

@@ -1,0 +1,91 @@
+"""report.html: verdicts consistent with summary.json, every plot inlined and decodable,
+nothing fetched from elsewhere; the hook in a run, in a study and in the index."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import pytest  # noqa: E402
+
+import wovenimpact  # noqa: E402
+from tests.io.report_page import check_run_page, read_page  # noqa: E402
+from wovenimpact.errors import InputWarning  # noqa: E402
+from wovenimpact.io.report import write_index, write_run_report, write_study_report  # noqa: E402
+from wovenimpact.runs import run_case  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[2]
+TOUR = ROOT / "examples" / "cases" / "fabric_plate_impulse.toml"
+SMALL = ['run.end_time="1 us"', 'mesh.side="10 mm"', 'mesh.element_size="1.88 mm"']
+
+
+def fake_run(out: Path, **summary) -> Path:
+    """A run directory with a summary.json and two small plots."""
+    (out / "plots").mkdir(parents=True)
+    for name in ("energy.png", "impactor.png"):
+        fig, ax = plt.subplots(figsize=(2, 1.5))
+        ax.plot([0, 1], [1, 0])
+        fig.savefig(out / "plots" / name)
+        plt.close(fig)
+    (out / "summary.json").write_text(json.dumps({"case": "fake <case> & co", **summary}))
+    return out
+
+
+@pytest.mark.parametrize("summary", [
+    dict(outcome="stopped", residual_velocity_m_per_s=0.0, rebound_velocity_m_per_s=23.3,
+         energy_error_fraction=0.004, hourglass_fraction=0.05),
+    dict(outcome="perforated", residual_velocity_m_per_s=84.0, rebound_velocity_m_per_s=0.0,
+         energy_error_fraction=0.02, hourglass_fraction=0.25),
+    dict(outcome="undecided", residual_velocity_m_per_s=12.0, energy_error_fraction=0.01),
+    dict(energy_error_fraction=1e-5),  # no impactor, no hourglass key: n/a
+])
+def test_verdicts_follow_the_summary_and_its_thresholds(tmp_path, summary):
+    out = fake_run(tmp_path / "run", **summary)
+    write_run_report(out, case_text='[case]\nname = "a <b> & \'c\'"\n', case_path="x.toml",
+                     overrides=['run.end_time="5 us"'], model_digest="abc123")
+    page = check_run_page(out)
+    text = "".join(page.text)
+    assert 'name = "a <b> & \'c\'"' in text  # the case, escaped in HTML, read back intact
+    assert 'run.end_time="5 us"' in text and "abc123" in text
+    assert wovenimpact.__version__ in text and "fake <case> & co" in text
+
+
+def test_the_verdicts_come_first(tmp_path):
+    out = fake_run(tmp_path / "run", outcome="stopped", energy_error_fraction=0.0)
+    html = write_run_report(out).read_text()
+    assert html.index('class="verdict') < html.index('id="summary"') < html.index("<img")
+
+
+def test_a_run_writes_its_page_with_the_case_as_run(tmp_path):
+    out = tmp_path / "out"
+    with pytest.warns(InputWarning, match="clipped to the end time"):
+        run_case(TOUR, out, overrides=SMALL)
+    page = check_run_page(out)
+    text = "".join(page.text)
+    assert TOUR.read_text() in text  # the case file, verbatim
+    assert all(o in text for o in SMALL)
+    assert page.verdicts["energy_error_fraction"]["status"] == "pass"
+
+
+def test_study_page_links_each_run_page_and_inlines_the_plots(tmp_path):
+    out = tmp_path / "study"
+    rows = []
+    for vid, outcome in (("aaa", "stopped"), ("bbb", "perforated")):
+        fake_run(out / "runs" / vid, outcome=outcome, energy_error_fraction=0.001)
+        write_run_report(out / "runs" / vid)
+        rows.append({"id": vid, "impactor.velocity": "100 m/s", "status": "done",
+                     "error": "", "outcome": outcome})
+    rows.append({"id": "ccc", "impactor.velocity": "9", "status": "failed",
+                 "error": "no unit", "outcome": ""})
+    fake_run(out, case="study")  # its plots/ are the comparison plots
+    page = read_page(write_study_report(out, "velocity <study>", rows))
+    assert page.links == ["runs/aaa/report.html", "runs/bbb/report.html"]
+    assert all((out / link).exists() for link in page.links)
+    assert len(page.images) == 2 and not page.external
+    index = read_page(write_index(tmp_path, "all"))
+    assert "study/report.html" in index.links and "study/runs/aaa/report.html" in index.links
+    assert all((tmp_path / link).exists() for link in index.links)

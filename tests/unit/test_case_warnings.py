@@ -1,0 +1,86 @@
+"""A shortened run just runs (output intervals are clipped to the end time, with a
+warning naming each key), and a quarter plate without its symmetry constraints is
+warned of, naming the missing node sets."""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import pytest
+
+from wovenimpact.errors import InputWarning
+from wovenimpact.spec.case import load_case
+
+ROOT = Path(__file__).resolve().parents[2]
+# intervals: field 10 µs, history 0.5 µs, checkpoint 25 µs
+TOUR = ROOT / "examples" / "cases" / "fabric_plate_impulse.toml"
+
+
+def test_intervals_longer_than_a_shortened_end_time_are_clipped_with_a_warning():
+    with pytest.warns(InputWarning) as record:
+        spec, _ = load_case(TOUR, ['run.end_time="5 us"'])
+    messages = [str(w.message) for w in record]
+    assert spec.run.end_time == pytest.approx(5e-6)
+    assert spec.run.checkpoint_interval == spec.run.end_time
+    assert spec.run.field_interval == spec.run.end_time
+    assert spec.run.history_interval == pytest.approx(0.5e-6)  # shorter: kept
+    assert len(messages) == 2
+    assert any("run.checkpoint_interval = 25 us" in m and "clipped" in m for m in messages)
+    assert any("run.field_interval = 10 us" in m for m in messages)
+    assert all("run.end_time" in m and "5 us" in m for m in messages)
+
+
+def test_the_example_case_as_written_loads_without_warnings():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", InputWarning)
+        spec, _ = load_case(TOUR)
+    assert spec.run.checkpoint_interval == pytest.approx(25e-6)
+
+
+@pytest.mark.parametrize("dropped, missing", [
+    (("symmetry_x",), "symmetry_x"),
+    (("symmetry_y",), "symmetry_y"),
+    (("symmetry_x", "symmetry_y"), "symmetry_x and symmetry_y"),
+])
+def test_a_quarter_plate_without_symmetry_constraints_names_the_missing_sets(
+        tmp_path, dropped, missing):
+    text = TOUR.read_text()
+    for name in dropped:
+        block = f'[[boundary]]\nnodes = "{name}"\ntype = "{name}"\n'
+        assert block in text
+        text = text.replace(block, "")
+    text = text.replace('"../materials/', f'"{(ROOT / "examples" / "materials").as_posix()}/')
+    case = tmp_path / "quarter.toml"
+    case.write_text(text)
+    with pytest.warns(InputWarning, match=f"no boundary constrains {missing} ") as record:
+        load_case(case)
+    assert len(record) == 1
+    assert str(case) in str(record[0].message)
+
+
+def test_a_full_plate_needs_no_symmetry_sets():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", InputWarning)
+        load_case(TOUR, ["mesh.quarter=false", "boundary.1.nodes=edge_outer",
+                         "boundary.2.nodes=edge_outer"])
+
+
+def test_a_study_tells_each_input_warning_once_not_once_per_variant(tmp_path):
+    """Variants run in worker processes: their warnings come back with the result and the
+    study repeats each distinct one once, with the number of variants it concerns."""
+    from wovenimpact.spec.fields import apply_overrides, read_toml
+    from wovenimpact.studies.sweep import run_variant, warn_once
+
+    doc = apply_overrides(read_toml(TOUR, "case"), ['run.end_time="1 us"', 'mesh.side="10 mm"',
+                                                     'mesh.element_size="2.5 mm"'])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", InputWarning)  # nothing escapes the variant
+        result = run_variant(doc, str(TOUR.parent), str(tmp_path / "v1"), {"k": 1})
+    assert result["status"] == "done"
+    assert len(result["warnings"]) == 2
+    assert result["warnings"][0].startswith("run.field_interval = 10 us is longer")
+    with pytest.warns(InputWarning) as record:
+        warn_once({"a": result, "b": result, "c": {"status": "done"}}, 3)
+    assert sorted(str(w.message)[:31] for w in record) == [
+        "2 of 3 variants: run.checkpoint", "2 of 3 variants: run.field_inte"]

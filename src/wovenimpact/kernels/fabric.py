@@ -670,8 +670,7 @@ def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
 
     A thin wrapper of :func:`fabric_point` (which loop kernels call directly).
     """
-    p_table = np.empty((1, p.shape[0]))
-    p_table[0, :] = p
+    p_table = p.reshape((1, p.shape[0]))  # a view: the row may carry a 1.6 MB table
     row_in = np.empty((1, N_STATE))
     row_in[0, :] = s_in
     row_out = np.empty((1, N_STATE))
@@ -700,8 +699,7 @@ def fabric_update_for_points(p, f_old, f_new, state_in, state_out, n_out, stiff_
         stiff_out: (n,) tangent stiffness bounds (written).
         status_out: (n,) int32 status codes (written).
     """
-    p_table = np.empty((1, p.shape[0]))
-    p_table[0, :] = p
+    p_table = p.reshape((1, p.shape[0]))  # a view: the row may carry a 1.6 MB table
     for i in prange(f_new.shape[0]):
         status, stiff, n_xx, n_yy, n_xy = fabric_point(
             p_table, 0, f_old[i, 0, 0], f_old[i, 0, 1], f_old[i, 1, 0], f_old[i, 1, 1],

@@ -251,6 +251,7 @@ def update_points(
     res = np.empty((n, 3))
     stiff = np.empty(n)
     status = np.empty(n, dtype=np.int32)
+    p = np.ascontiguousarray(p, dtype=np.float64)
     fabric_update_for_points(p, f_old, f_new, state_in, state_out, res, stiff, status)
     bad = np.flatnonzero(status != L.STATUS_OK)
     if bad.size:

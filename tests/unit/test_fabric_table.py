@@ -214,3 +214,34 @@ def test_table_is_built_once_per_material():
     assert np.array_equal(a[L.N_PARAM:], b[L.N_PARAM:])
     c = table_row(dataclasses.replace(params, compaction_b=2 * params.compaction_b))
     assert not np.array_equal(a[L.N_PARAM:], c[L.N_PARAM:])
+
+
+def test_bucket_lookup_finds_the_same_interval_as_a_search():
+    """The O(1) knot lookup (bucket map + at most one step) against numpy's searchsorted,
+    on random points, the knots themselves and just beside them; outside → −1."""
+    import numba
+
+    from wovenimpact.kernels.fabric_table import knot_interval
+
+    row = table_row(reference_fabric())
+    kw, _ = FT.table_knots(row)
+    nw, nf, s = len(kw), int(row[L.P_TAB_NF]), int(row[L.P_TAB_START])
+    table = row.reshape(1, -1)
+
+    @numba.njit
+    def lookup(p, xs, out):
+        for q in range(xs.shape[0]):
+            out[q] = knot_interval(p, 0, s, nw, s + nw + nf, int(p[0, L.P_TAB_NBW]),
+                                   p[0, L.P_TAB_IBW], xs[q])
+
+    rng = np.random.default_rng(0)
+    xs = np.concatenate([rng.uniform(kw[0], kw[-1], 20_000), kw, np.nextafter(kw, 0.0),
+                         np.nextafter(kw, 2.0)])
+    xs = xs[(xs >= kw[0]) & (xs <= kw[-1])]
+    got = np.empty(xs.size, dtype=np.int64)
+    lookup(table, xs, got)
+    expect = np.clip(np.searchsorted(kw, xs, side="right") - 1, 0, nw - 2)
+    assert np.array_equal(got, expect)
+    out = np.empty(3, dtype=np.int64)
+    lookup(table, np.array([kw[0] - 1e-9, kw[-1] + 1e-9, np.nan]), out)
+    assert np.all(out == -1)

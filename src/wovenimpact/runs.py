@@ -43,6 +43,12 @@ from wovenimpact.quantities import (
     residual_velocity,
     symmetry_factor,
 )
+from wovenimpact.containment import (
+    CONTAINMENT_COLUMNS,
+    casing_summary,
+    fragment_row,
+    is_containment,
+)
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.spec.case import load_case
 from wovenimpact.state import KINETIC0, State
@@ -71,7 +77,8 @@ def history_columns(model) -> tuple[str, ...]:
     (solver.explicit.energy_balance). ``contact_energy_part_J`` is −(work of the contact
     forces): the penalty springs' energy plus ``contact_dissipated_part_J``, what contact
     dashpots and friction dissipated."""
-    return HISTORY_COLUMNS + (IMPACT_COLUMNS if model.body_params.shape[0] else ())
+    return (HISTORY_COLUMNS + (IMPACT_COLUMNS if model.body_params.shape[0] else ())
+            + (CONTAINMENT_COLUMNS if is_containment(model) else ()))
 
 
 def history_row(model, state: State) -> dict:
@@ -82,6 +89,8 @@ def history_row(model, state: State) -> dict:
     if model.body_params.shape[0]:
         impact = {**impactor_row(model, state), **intact_material_ahead(model, state),
                   "impactor_kinetic_energy_part_J": eb["impactor_kinetic_J"]}
+    if is_containment(model):
+        impact.update(fragment_row(model, state))
     return {
         **impact,
         "time_s": float(state.t), "step": int(state.step), "dt_s": float(state.dt),
@@ -259,6 +268,9 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, steps: in
     cycles = steps * model.n_elems
     factor = symmetry_factor(model)
     impact = {}
+    if is_containment(model):
+        impact = {**casing_summary(model, state, h),
+                  "absorbed_energy_per_layer_J": ply_energies(model, state)[:-1]}
     ke_body0 = 0.0
     if model.body_params.shape[0]:
         ke_body0 = factor * float(h["impactor_kinetic_energy_part_J"][0])

@@ -1,0 +1,133 @@
+"""Engineering quantities of a containment run (thesis ch. 8; docs/theory.md §7.3).
+
+A containment model (``[mesh] kind = "containment"``) has node sets ``blade.fragment``
+and ``casing.layer{k}``. Per history row: the fragment's centre-of-mass speed, radial
+velocity and radius, its outermost node's radius, and whether intact casing material
+lies outside it along its path. The outcome is decided from geometry, never from a
+speed test alone (:func:`containment_outcome`).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from wovenimpact.kernels import shell_layout as S
+
+FRAGMENT = "blade.fragment"
+WINDOW = 1.5  # half-width of the path window, in fragment half-extents
+
+
+def is_containment(model) -> bool:
+    return FRAGMENT in model.node_sets
+
+
+def layer_sets(model) -> list[str]:
+    """Names of the casing layers' node sets, innermost first."""
+    k = 0
+    out = []
+    while f"casing.layer{k}" in model.node_sets:
+        out.append(f"casing.layer{k}")
+        k += 1
+    return out
+
+
+def fragment_row(model, state) -> dict:
+    """The fragment's kinematics and the intact casing material outside it.
+
+    ``intact_casing_outside``: 1 if a casing node that still has a live element lies
+    within the fragment's path window (angular and axial extent of the fragment × 1.5
+    about its centre of mass, at least two casing elements either way) at a larger
+    radius than the fragment's outermost node.
+    """
+    nodes = model.node_sets[FRAGMENT]
+    m = model.node_mass[nodes]
+    mass = float(m.sum())
+    x = state.x[nodes]
+    cm = (m[:, None] * x).sum(axis=0) / mass
+    v_cm = (m[:, None] * state.v[nodes]).sum(axis=0) / mass
+    r_cm = math.hypot(cm[0], cm[1])
+    radial = (v_cm[0] * cm[0] + v_cm[1] * cm[1]) / r_cm if r_cm > 0 else 0.0
+    r_nodes = np.hypot(x[:, 0], x[:, 1])
+    phi = np.arctan2(x[:, 1], x[:, 0])
+    phi_cm = math.atan2(cm[1], cm[0])
+    casing = np.concatenate([model.node_sets[s] for s in layer_sets(model)])
+    # the window is at least two casing elements wide either way (a blade seen edge-on
+    # from the axis has no angular extent of its own)
+    size = 2.0 * math.sqrt(float(np.median(model.area0[np.isin(model.quads[:, 0], casing)])))
+    r_casing = float(np.min(np.hypot(*model.x0[casing, :2].T)))
+    half_angle = max(WINDOW * float(np.max(np.abs(np.angle(np.exp(1j * (phi - phi_cm)))))),
+                     size / r_casing)
+    half_z = max(WINDOW * float(np.max(np.abs(x[:, 2] - cm[2]))), size)
+    live = np.zeros(model.n_nodes, dtype=bool)
+    live[model.quads[state.elem[:, S.E_ALIVE] != 0.0].ravel()] = True
+    casing = casing[live[casing]]
+    xc = state.x[casing]
+    near = (np.abs(np.angle(np.exp(1j * (np.arctan2(xc[:, 1], xc[:, 0]) - phi_cm))))
+            <= half_angle) & (np.abs(xc[:, 2] - cm[2]) <= half_z)
+    outside = bool(np.any(np.hypot(xc[near, 0], xc[near, 1]) > float(r_nodes.max())))
+    return {
+        "fragment_speed_m_per_s": float(np.linalg.norm(v_cm)),
+        "fragment_radial_velocity_m_per_s": float(radial),
+        "fragment_cm_radius_m": float(r_cm),
+        "fragment_max_radius_m": float(r_nodes.max()),
+        "intact_casing_outside": int(outside),
+    }
+
+
+CONTAINMENT_COLUMNS = ("fragment_speed_m_per_s", "fragment_radial_velocity_m_per_s",
+                       "fragment_cm_radius_m", "fragment_max_radius_m", "intact_casing_outside")
+
+
+def containment_outcome(h: dict, inner_radius: float) -> dict:
+    """Outcome of a containment run from its history (geometry first):
+
+    - ``escaped``: no intact casing material outside the fragment along its path at the
+      end (it has passed the outermost intact layer) and it still moves outwards;
+    - ``contained``: it reached the casing (its outermost node came within 1 % of the
+      inner radius) and at the end moves inwards or along the casing (radial velocity
+      ≤ 1 % of its initial speed) with intact material outside it;
+    - ``undecided``: anything else (still pushing intact layers outwards, or never
+      arrived): run longer. A heavy fragment still pushing intact layers is never
+      ``escaped``.
+    Returns the outcome, ``contained`` (bool) and the exit speed (its speed at the end
+    if escaped, else 0)."""
+    speed = np.asarray(h["fragment_speed_m_per_s"], dtype=float)
+    radial = np.asarray(h["fragment_radial_velocity_m_per_s"], dtype=float)
+    reach = np.asarray(h["fragment_max_radius_m"], dtype=float)
+    outside = np.asarray(h["intact_casing_outside"], dtype=float)
+    arrived = bool(np.any(reach >= 0.99 * inner_radius))
+    v0 = float(speed[0]) if speed.size else 0.0
+    if not outside[-1] and radial[-1] > 0.0:
+        return {"outcome": "escaped", "contained": False,
+                "fragment_exit_speed_m_per_s": float(speed[-1])}
+    if arrived and outside[-1] and radial[-1] <= 0.01 * v0:
+        return {"outcome": "contained", "contained": True, "fragment_exit_speed_m_per_s": 0.0}
+    return {"outcome": "undecided", "contained": False,
+            "fragment_exit_speed_m_per_s": float(speed[-1])}
+
+
+def casing_summary(model, state, h: dict) -> dict:
+    """summary.json keys of a containment run (whole model; symmetry is not used)."""
+    nodes = model.node_sets[FRAGMENT]
+    layers = layer_sets(model)
+    inner = min(float(np.min(np.hypot(*model.x0[model.node_sets[s], :2].T))) for s in layers)
+    outcome = containment_outcome(h, inner)
+    casing_elems = np.flatnonzero(np.isin(model.quads, np.concatenate(
+        [model.node_sets[s] for s in layers])).all(axis=1))
+    mass = float(np.sum(model.sections[model.elem_section[casing_elems], S.C_AREAL_MASS]
+                        * model.area0[casing_elems]))
+    outer = layers[-1]
+    r0 = np.hypot(*model.x0[model.node_sets[outer], :2].T)
+    r1 = np.hypot(*state.x[model.node_sets[outer], :2].T)
+    area = float(model.area0[casing_elems].sum())
+    return {
+        **outcome,
+        "fragment_mass_kg": float(model.node_mass[nodes].sum()),
+        "fragment_initial_speed_m_per_s": float(h["fragment_speed_m_per_s"][0]),
+        "max_bulge_m": float(np.max(r1 - r0)),
+        "casing_mass_kg": mass,
+        "casing_mass_per_area_kg_per_m2": mass / area * len(layers) if area else None,
+        "casing_layers": len(layers),
+    }

@@ -1,4 +1,9 @@
-"""Unit tests of the crossover kernel (kernels/fabric.py): oracles, invariants, properties."""
+"""Unit tests of the crossover kernel (kernels/fabric.py): oracles, invariants, properties.
+
+The exact height solve is the subject here (crossover = "exact"; the tabulated option,
+the default, is tested against it in test_fabric_table.py); the invariants that hold for
+both run with both.
+"""
 
 from __future__ import annotations
 
@@ -23,6 +28,13 @@ from wovenimpact.kernels.fabric import (
 from wovenimpact.materials.fabric import initial_state, update_points
 
 RESIDUAL_TOL = 1e-9  # issue acceptance: equilibrium and compatibility residuals
+EXACT = {"crossover": "exact"}
+
+
+@pytest.fixture
+def kevlar():
+    """The reference fabric with the exact crossover solve (this module's subject)."""
+    return reference_fabric(**EXACT)
 
 
 def stretch_shear(lam_w: float, lam_f: float, gamma: float) -> np.ndarray:
@@ -115,7 +127,7 @@ def contact_force_oracle(params, lam_w, lam_f):
     "lam_w, lam_f", [(1.02, 1.0), (1.04, 1.01), (1.03, 1.03), (1.01, 1.035), (1.045, 0.99)]
 )
 def test_heights_match_an_independent_contact_force_solve(lam_w, lam_f):
-    params = reference_fabric()
+    params = reference_fabric(**EXACT)
     out = one_step(params, np.diag([lam_w, lam_f]))
     hw, hf = contact_force_oracle(params, lam_w, lam_f)
     assert out.state[0, L.S_H] == pytest.approx(hw, rel=1e-8)
@@ -126,7 +138,7 @@ def scaled_parameters(scale):
     """Reference parameters with each constant scaled by a factor in [1/√10, √10]."""
     import dataclasses
 
-    p = reference_fabric()
+    p = reference_fabric(**EXACT)
     yarn = dataclasses.replace(p.warp, modulus=p.warp.modulus * scale[0], area=p.warp.area * scale[1])
     fill = dataclasses.replace(p.fill, modulus=p.fill.modulus * scale[2], area=p.fill.area * scale[3])
     from wovenimpact.calibration.crimp import crimp_amplitude
@@ -233,9 +245,10 @@ def test_zz_report_solver_iterations():
 
 
 # --- invariants --------------------------------------------------------------------------
+@pytest.mark.parametrize("crossover", ["exact", "table"])
 @pytest.mark.parametrize("angle", [0.3, math.pi / 2, 2.5, -1.0])
-def test_superposed_rigid_rotation_changes_no_invariant(angle):
-    params = reference_fabric()
+def test_superposed_rigid_rotation_changes_no_invariant(angle, crossover):
+    params = reference_fabric(crossover=crossover)
     f = stretch_shear(1.03, 1.01, math.radians(20))
     rot = np.array([[math.cos(angle), -math.sin(angle)], [math.sin(angle), math.cos(angle)]])
     plain = one_step(params, f)
@@ -280,8 +293,8 @@ def test_virial_resultant_in_reference_state_small_strain(kevlar):
 
 def test_thesis_homogenisation_is_stiffer_by_the_section_ratio():
     """Eq. (6.38) vs virial: ratio t·2ℓ0/(2A)·/cosψ ≈ 1.57 for the reference fabric (§1.5)."""
-    virial = reference_fabric()
-    thesis = reference_fabric(homogenisation="thesis")
+    virial = reference_fabric(**EXACT)
+    thesis = reference_fabric(homogenisation="thesis", **EXACT)
     f = np.diag([1.045, 1.0])
     nv = one_step(virial, f)
     nt = one_step(thesis, f)
@@ -332,7 +345,7 @@ def test_both_yarns_broken_erodes_the_point(kevlar):
 
 def test_progressive_failure_follows_the_linear_softening_envelope():
     soft = 0.01
-    params = reference_fabric(failure="progressive", softening_strain=soft)
+    params = reference_fabric(failure="progressive", softening_strain=soft, **EXACT)
     w = params.warp
     ea = w.modulus * w.area
     eps_u = w.ultimate_tension / ea
@@ -367,10 +380,11 @@ def test_inadmissible_kinematics_raise_with_the_state(kevlar):
 
 # --- stiffness bound and many points ---------------------------------------------------------
 @settings(max_examples=200, deadline=None)
-@given(lam_w=st.floats(0.95, 1.04), lam_f=st.floats(0.95, 1.04), gamma=st.floats(-0.8, 0.8))
-def test_stiffness_bounds_the_membrane_tangent(lam_w, lam_f, gamma):
+@given(lam_w=st.floats(0.95, 1.04), lam_f=st.floats(0.95, 1.04), gamma=st.floats(-0.8, 0.8),
+       crossover=st.sampled_from(["exact", "table"]))
+def test_stiffness_bounds_the_membrane_tangent(lam_w, lam_f, gamma, crossover):
     """The time-step stiffness bounds the tangent dN_ii/dε along each yarn and in shear."""
-    params = reference_fabric()
+    params = reference_fabric(crossover=crossover)
     f = stretch_shear(lam_w, lam_f, gamma)
     base = one_step(params, f)
     if base.state[0, L.S_ALIVE] == 0.0 or np.any(base.state[0, L.S_DAMAGE : L.S_DAMAGE + 2] > 0):
@@ -389,13 +403,14 @@ def test_stiffness_bounds_the_membrane_tangent(lam_w, lam_f, gamma):
         assert tangent <= base.stiffness[0] * (1 + 1e-6)
 
 
-def test_many_points_equal_single_points_bitwise_and_any_thread_count():
+@pytest.mark.parametrize("crossover", ["exact", "table"])
+def test_many_points_equal_single_points_bitwise_and_any_thread_count(crossover):
     import numba
 
     from wovenimpact.jit import set_threads
     from wovenimpact.kernels.fabric import fabric_update_for_points
 
-    params = reference_fabric()
+    params = reference_fabric(crossover=crossover)
     p = params.to_array()
     rng = np.random.default_rng(7)
     n = 2000

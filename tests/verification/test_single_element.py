@@ -66,13 +66,15 @@ def warp_shear_cycle(params, n=1500):
     return np.array(legs)
 
 
-@pytest.mark.parametrize("shear", ["true", "thesis"])
-def test_elastic_cycle_external_work_equals_stored_energy(shear):
-    params = reference_fabric(shear=shear)
+@pytest.mark.parametrize("shear, crossover", [("true", "exact"), ("thesis", "exact"),
+                                               ("true", "table"), ("thesis", "table")])
+def test_elastic_cycle_external_work_equals_stored_energy(shear, crossover):
+    params = reference_fabric(shear=shear, crossover=crossover)
     res = drive_path(params, warp_shear_cycle(params))
     scale = np.max(res.work)
     err = np.max(np.abs(res.work - res.energy)) / scale
-    print(f"\nshear={shear}: max |W − U| / max W = {err:.2e}, closed-cycle W = {res.work[-1]:.2e} J/m²")
+    print(f"\nshear={shear}, crossover={crossover}: max |W − U| / max W = {err:.2e}, "
+          f"closed-cycle W = {res.work[-1]:.2e} J/m²")
     assert err < ENERGY_TOL
     assert abs(res.work[-1]) < ENERGY_TOL * scale
 
@@ -161,3 +163,36 @@ def test_superposed_rotation_along_a_whole_path_changes_no_invariant(frame):
     # trapezoidal work of a rotating path carries an O(Δθ²) quadrature error in the
     # spin part (measured 1.1e-6 of the peak with 400 steps), not an invariance error
     assert np.max(np.abs(turned.work - plain.work)) < 1e-5 * np.max(np.abs(plain.work))
+
+
+def biaxial_cycle(n=800):
+    """Closed path through the knee of the crimp interchange and the onset of contact:
+    warp to λ 1.045, fill to 1.03, warp back to 0.97, fill back to 1, warp back to 1
+    (with a 20° shear on the way out and back)."""
+    corners = [(1.0, 1.0, 0.0), (1.045, 1.0, 0.0), (1.045, 1.03, 20.0), (0.97, 1.03, 20.0),
+               (0.97, 1.0, 0.0), (1.0, 1.0, 0.0)]
+    s = np.linspace(0.0, 1.0, n)
+    path = []
+    for (a0, b0, g0), (a1, b1, g1) in zip(corners[:-1], corners[1:]):
+        for t in s[(1 if path else 0):]:
+            lw, lf, g = a0 + (a1 - a0) * t, b0 + (b1 - b0) * t, math.radians(g0 + (g1 - g0) * t)
+            path.append(np.array([[lw, lf * math.sin(g)], [0.0, lf * math.cos(g)]]))
+    return np.array(path)
+
+
+@pytest.mark.parametrize("crossover", ["exact", "table"])
+def test_biaxial_closed_cycle_through_the_knee_returns_no_work(crossover):
+    """Theory §1.9: the table's resultant is the exact derivative of its interpolant, so a
+    closed cycle returns no work beyond the trapezoid's O(Δs²) (halving the step divides
+    it by 4) — except where the path crosses between interpolated and exact cells, where
+    W may jump by the table's error (< 1e-4 W_u by construction)."""
+    params = reference_fabric(crossover=crossover)
+    out = []
+    for n in (400, 800):
+        res = drive_path(params, biaxial_cycle(n))
+        scale = np.max(res.work)
+        out.append((abs(res.work[-1]) / scale, np.max(np.abs(res.work - res.energy)) / scale))
+    print(f"\nbiaxial cycle, {crossover}: closed-cycle |W| / max W = {out[0][0]:.1e} (400 steps "
+          f"per leg), {out[1][0]:.1e} (800); max |W − U| / max W = {out[0][1]:.1e}, {out[1][1]:.1e}")
+    assert out[1][1] < 1e-5 and out[1][0] < 1e-6
+    assert out[1][1] < 0.5 * out[0][1]  # the quadrature error, not a constitutive one

@@ -8,7 +8,10 @@ current corotational frame), the kernel
 1. finds the stretches λ_i and yarn directions e_i (fibre frame, §1.7) or
    accumulates them incrementally (Green–Naghdi option, eq. 6.13–6.16);
 2. solves the crossover for the crimp heights H_w, H_f (eq. 6.19–6.25) with a
-   bracketed Newton iteration on one unknown (theory §1.3);
+   bracketed Newton iteration on one unknown (theory §1.3) — or, with the material's
+   crossover table (P_CROSSOVER, default), interpolates the stored energy W(λ_w, λ_f), its
+   gradient and the heights while both families are intact (theory §1.9,
+   ``kernels/fabric_table.py``);
 3. applies yarn failure (eq. 6.29, or progressive softening) and erosion;
 4. returns the membrane stress resultant N (force per unit current length,
    virial homogenisation §1.5 or the thesis's eq. 6.38), the trellis shear
@@ -28,7 +31,9 @@ import numpy as np
 from numba import prange
 
 from wovenimpact.jit import kernel, loop_kernel
+from wovenimpact.kernels.fabric_table import crossover_from_table
 from wovenimpact.kernels.fabric_layout import (
+    CROSSOVER_TABLE,
     FAILURE_PROGRESSIVE,
     FRAME_GREEN_NAGHDI,
     HOMOG_THESIS,
@@ -38,6 +43,7 @@ from wovenimpact.kernels.fabric_layout import (
     P_BETA2,
     P_COMP_A,
     P_COMP_B,
+    P_CROSSOVER,
     P_E,
     P_ELL0,
     P_ERODE_STRETCH,
@@ -453,7 +459,43 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
     l_w = 1.0
     l_f = 1.0
     iters = 0
+    w_cross = 0.0  # crossover energy per reference area from the table (use_table)
+    use_table = False
+    gw_cross = 0.0
+    gf_cross = 0.0
+    if p[m, P_CROSSOVER] == CROSSOVER_TABLE and d_w == 0.0 and d_f == 0.0:
+        # 2'. tabulated crossover (theory §1.9): W, its gradient and the heights from the
+        # C¹ interpolant; the tensions follow from ∂W/∂λ_i = 2 T_i cosψ_i ℓ_i0 / A0
+        inside, w_tab, gw_tab, gf_tab, hw_tab, hf_tab = crossover_from_table(p, m, lam_w, lam_f)
+        if inside:
+            area0 = 4.0 * ell0_w * ell0_f
+            h_w = max(hw_tab, 0.0)
+            h_f = max(hf_tab, 0.0)
+            l_w = math.sqrt(ell_w * ell_w + h_w * h_w)
+            l_f = math.sqrt(ell_f * ell_f + h_f * h_f)
+            t_w = max(gw_tab * area0 * l_w / (2.0 * ell0_w * ell_w), 0.0)
+            t_f = max(gf_tab * area0 * l_f / (2.0 * ell0_f * ell_f), 0.0)
+            d_w_new = d_w
+            d_f_new = d_f
+            if p[m, P_FAILURE] == FAILURE_PROGRESSIVE:
+                d_w_new = softening_damage(t_w / ea_w, d_w, ea_w, p[m, P_TU], p[m, P_SOFT])
+                d_f_new = softening_damage(t_f / ea_f, d_f, ea_f, p[m, P_TU + 1], p[m, P_SOFT])
+            else:
+                if t_w >= p[m, P_TU]:
+                    d_w_new = 1.0
+                if t_f >= p[m, P_TU + 1]:
+                    d_f_new = 1.0
+            if d_w_new == d_w and d_f_new == d_f:
+                use_table = True
+                w_cross = w_tab
+                gw_cross = gw_tab
+                gf_cross = gf_tab
+            else:  # a yarn failed: the exact solve takes over with the new damage
+                d_w = d_w_new
+                d_f = d_f_new
     for attempt in range(2):
+        if use_table:
+            break
         k_w = (1.0 - d_w) * ea_w / lt0_w
         k_f = (1.0 - d_f) * ea_f / lt0_f
         if d_w < 1.0 and d_f < 1.0:
@@ -554,6 +596,13 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
             ((1.0 - d_w) * ea_w * ell_w / lt0_w + t_w) / p[m, P_AREA],
             ((1.0 - d_f) * ea_f * ell_f / lt0_f + t_f) / p[m, P_AREA + 1],
         )
+    elif use_table:  # virial from the table: c_i = λ_i ∂W/∂λ_i / J, J = λ_w λ_f sinθ
+        c_w = gw_cross / (lam_f * sin_t)
+        c_f = gf_cross / (lam_w * sin_t)
+        stiff = max(
+            (ea_w * ell_w / lt0_w + t_w) / (2.0 * ell_f * sin_t),
+            (ea_f * ell_f / lt0_f + t_f) / (2.0 * ell_w * sin_t),
+        )
     else:  # virial: N = Σ 2 T_i ℓ_i cosψ_i e_i⊗e_i / A_cell
         a_cell = 4.0 * ell_w * ell_f * sin_t
         c_w = 2.0 * t_w * ell_w * (ell_w / l_w) / a_cell
@@ -593,11 +642,14 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
 
     # 5. stored energy per unit reference area: two half trusses per family,
     #    the compaction spring and the shear energy
-    k_w = (1.0 - d_w) * ea_w / lt0_w
-    k_f = (1.0 - d_f) * ea_f / lt0_f
-    u_yarn = k_w * max(ext_w, 0.0) ** 2 + k_f * max(ext_f, 0.0) ** 2
-    delta = s_total - h_w - h_f if f_c > 0.0 else 0.0
-    s_out[i, S_ENERGY] = (u_yarn + compaction_energy(delta, a, b)) / area0 + e_shear
+    if use_table:
+        s_out[i, S_ENERGY] = w_cross + e_shear
+    else:
+        k_w = (1.0 - d_w) * ea_w / lt0_w
+        k_f = (1.0 - d_f) * ea_f / lt0_f
+        u_yarn = k_w * max(ext_w, 0.0) ** 2 + k_f * max(ext_f, 0.0) ** 2
+        delta = s_total - h_w - h_f if f_c > 0.0 else 0.0
+        s_out[i, S_ENERGY] = (u_yarn + compaction_energy(delta, a, b)) / area0 + e_shear
     return STATUS_OK, stiff, n_xx, n_yy, n_xy
 
 
@@ -618,8 +670,7 @@ def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
 
     A thin wrapper of :func:`fabric_point` (which loop kernels call directly).
     """
-    p_table = np.empty((1, p.shape[0]))
-    p_table[0, :] = p
+    p_table = p.reshape((1, p.shape[0]))  # a view: the row may carry a 1.6 MB table
     row_in = np.empty((1, N_STATE))
     row_in[0, :] = s_in
     row_out = np.empty((1, N_STATE))
@@ -648,8 +699,7 @@ def fabric_update_for_points(p, f_old, f_new, state_in, state_out, n_out, stiff_
         stiff_out: (n,) tangent stiffness bounds (written).
         status_out: (n,) int32 status codes (written).
     """
-    p_table = np.empty((1, p.shape[0]))
-    p_table[0, :] = p
+    p_table = p.reshape((1, p.shape[0]))  # a view: the row may carry a 1.6 MB table
     for i in prange(f_new.shape[0]):
         status, stiff, n_xx, n_yy, n_xy = fabric_point(
             p_table, 0, f_old[i, 0, 0], f_old[i, 0, 1], f_old[i, 1, 0], f_old[i, 1, 1],

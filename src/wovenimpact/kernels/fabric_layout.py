@@ -4,8 +4,12 @@ Kept apart from the kernels so the Python side (materials/fabric.py, outputs,
 tests) can name entries without importing compiled code. Plain integer
 constants: Numba treats module-level ints as compile-time constants.
 
-Parameter vector ``p`` (float64, length ``N_PARAM``), SI units. Index 0/1 of a
-pair is warp/fill.
+Parameter vector ``p`` (float64, length ``N_PARAM``, followed by the crossover table
+when ``p[P_TAB_NW] > 0``: length ``N_PARAM + n_w + n_f + m_w + m_f + TAB_STRIDE n_w n_f``),
+SI units.
+Index 0/1 of a pair is warp/fill. The table rides in the same row of
+``Model.mat_params`` (rows are zero-padded to the longest), so it reaches every
+kernel without new arguments.
 """
 
 # --- parameters -------------------------------------------------------------
@@ -32,7 +36,38 @@ P_FRAME = 26  # frame option: FRAME_FIBRE or FRAME_GREEN_NAGHDI
 P_FAILURE = 27  # failure option: FAILURE_INSTANT or FAILURE_PROGRESSIVE
 P_AREAL_MASS = 28  # μ, areal mass (kg/m²) — derived or measured
 P_ERODE_STRETCH = 29  # erode once a broken family is stretched past this (—), 0: never
-N_PARAM = 30
+P_CROSSOVER = 30  # crossover evaluation: CROSSOVER_EXACT or CROSSOVER_TABLE (theory §1.9)
+P_TAB_NW = 31  # n_w, knots of the stored-energy table along λ_w (0: no table)
+P_TAB_NF = 32  # n_f, knots along λ_f
+P_TAB_START = 33  # s, index in the row where the table starts (= N_PARAM)
+P_TAB_NBW = 34  # m_w, buckets of the uniform knot-lookup map along λ_w
+P_TAB_NBF = 35  # m_f, along λ_f
+P_TAB_IBW = 36  # 1 / bucket width along λ_w
+P_TAB_IBF = 37  # 1 / bucket width along λ_f
+P_TAB_DATA = 38  # index in the row of the first knot's data (= s + n_w + n_f + m_w + m_f)
+N_PARAM = 39
+
+CROSSOVER_EXACT = 0
+CROSSOVER_TABLE = 1
+
+# --- tabulated crossover (theory §1.9), appended to the parameter row ----------------
+# From p[s] on (s = P_TAB_START; n_w, n_f, m_w, m_f as above):
+#   p[s : s + n_w]                    knots λ_w (increasing, non-uniform)
+#   p[s + n_w : s + n_w + n_f]        knots λ_f
+#   next m_w, then m_f entries        bucket maps: bucket b = ⌊(λ − λ_first)·(1/width)⌋
+#                                     holds the index of the knot interval containing its
+#                                     left edge (widths ≤ the smallest knot spacing / 2,
+#                                     so locating a point is O(1): no search)
+#   p[P_TAB_DATA + TAB_STRIDE (i n_f + j) + q]: knot (i, j), entry q:
+T_W = 0  # W, crossover stored energy per unit reference area (J/m²), shear excluded
+T_W_W = 1  # ∂W/∂λ_w
+T_W_F = 2  # ∂W/∂λ_f
+T_W_WF = 3  # ∂²W/∂λ_w∂λ_f
+T_HW = 4  # H_w (m), then ∂H_w/∂λ_w, ∂H_w/∂λ_f, ∂²H_w/∂λ_w∂λ_f at T_HW + 1..3
+T_HF = 8  # H_f (m), and its three derivatives at T_HF + 1..3
+T_EXACT = 12  # 1.0: the cell [λ_w,i, λ_w,i+1] × [λ_f,j, λ_f,j+1] is solved exactly (its
+#              interpolant missed the accuracy target at build time), 0.0: interpolated
+TAB_STRIDE = 13
 
 HOMOG_VIRIAL = 0
 HOMOG_THESIS = 1

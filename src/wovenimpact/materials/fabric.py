@@ -61,6 +61,10 @@ class FabricOptions:
     # a point whose broken family is stretched beyond this erodes (0: only when both
     # families are broken); nothing holds the element together across broken yarns
     erode_broken_stretch: float = 2.0
+    # crossover evaluation (theory §1.9): "table" interpolates the tabulated stored
+    # energy while both families are intact and inside the table (fibre frame only),
+    # "exact" always runs the height solve (the reference)
+    crossover: Literal["table", "exact"] = "table"
 
 
 @dataclass(frozen=True)
@@ -158,7 +162,9 @@ class FabricParameters:
         return out
 
     def to_array(self) -> np.ndarray:
-        """Pack into the flat parameter vector read by the kernels."""
+        """Pack into the flat parameter vector read by the kernels (with the crossover
+        table appended when ``options.crossover == "table"`` and the frame is the fibre
+        frame; the Green–Naghdi option keeps the exact solve)."""
         p = np.zeros(L.N_PARAM)
         for i, y in enumerate((self.warp, self.fill)):
             p[L.P_E + i] = y.modulus
@@ -185,6 +191,13 @@ class FabricParameters:
         ]
         p[L.P_AREAL_MASS] = self.areal_mass
         p[L.P_ERODE_STRETCH] = o.erode_broken_stretch
+        p[L.P_TAB_START] = L.N_PARAM
+        if o.crossover == "table" and o.frame == "fibre":
+            from wovenimpact.materials.fabric_table import with_table
+
+            p = with_table(self, p)
+        else:
+            p[L.P_CROSSOVER] = L.CROSSOVER_EXACT
         return p
 
 
@@ -238,6 +251,7 @@ def update_points(
     res = np.empty((n, 3))
     stiff = np.empty(n)
     status = np.empty(n, dtype=np.int32)
+    p = np.ascontiguousarray(p, dtype=np.float64)
     fabric_update_for_points(p, f_old, f_new, state_in, state_out, res, stiff, status)
     bad = np.flatnonzero(status != L.STATUS_OK)
     if bad.size:

@@ -1,0 +1,174 @@
+"""Tabulated crossover: the stored energy W(λ_w, λ_f) as a C¹ bicubic Hermite interpolant.
+
+docs/theory.md §1.9. Before any yarn is damaged, the crossover equilibrium depends on
+the two projected half-lengths ℓ_i = λ_i ℓ_i0 alone and is hyperelastic: the stored
+energy per unit reference area (two half trusses per family plus the compaction spring,
+eq. 6.20–6.25; shear is a separate law),
+
+    W(λ_w, λ_f) = min over the heights of [Σ_i k_i ⟨L_i − L_i0⟩² + ∫ F dδ] / (4 ℓ_w0 ℓ_f0),
+
+has the exact gradient ∂W/∂λ_i = 2 T_i cos ψ_i ℓ_i0 / (4 ℓ_w0 ℓ_f0) (envelope theorem:
+∂U/∂H_i = F_i − F_c = 0 at equilibrium). ``materials/fabric_table.py`` tabulates W, its
+gradient and ∂²W/∂λ_w∂λ_f, and the heights H_w, H_f with the same derivatives, on a
+non-uniform tensor grid; this module evaluates the interpolant. The membrane resultant
+is built from the interpolant's own gradient, so the tabulated material is exactly
+hyperelastic (closed cycles return no work beyond round-off and quadrature).
+
+Layout of the table in the parameter row: ``fabric_layout`` (P_TAB_*, T_*, TAB_STRIDE).
+"""
+
+from __future__ import annotations
+
+from wovenimpact.jit import inline_kernel, kernel
+from wovenimpact.kernels.fabric_layout import (
+    P_TAB_DATA,
+    P_TAB_IBF,
+    P_TAB_IBW,
+    P_TAB_NBF,
+    P_TAB_NBW,
+    P_TAB_NF,
+    P_TAB_NW,
+    P_TAB_START,
+    T_HF,
+    T_EXACT,
+    T_HW,
+    T_W,
+    TAB_STRIDE,
+)
+
+
+@inline_kernel
+def knot_interval(p, m, start, n, buckets, nb, inv_width, x):
+    """Index i (0 ≤ i ≤ n − 2) of the knot interval [k_i, k_i+1] of p[m, start : start + n]
+    holding x, or −1 if x lies outside the knots (or is NaN).
+
+    O(1): the bucket map p[m, buckets : buckets + nb] (uniform buckets of width
+    1/inv_width from k_0) gives the interval of the bucket's left edge; a bucket is
+    narrower than any knot interval, so at most one step forward remains. (A bisection
+    over 124 knots cost ~55 ns per axis here, its branches unpredictable.)
+    """
+    k0 = p[m, start]
+    if not (k0 <= x <= p[m, start + n - 1]):
+        return -1
+    b = min(int((x - k0) * inv_width), nb - 1)
+    i = int(p[m, buckets + b])
+    while i < n - 2 and x >= p[m, start + i + 1]:
+        i += 1
+    return i
+
+
+@inline_kernel
+def hermite_basis(t, h):
+    """Cubic Hermite basis on [0, 1] scaled to an interval of length h.
+
+    Returns (a0, a1, b0, b1, da0, da1, db0, db1): value weights a0 = (1 + 2t)(1 − t)²,
+    a1 = t²(3 − 2t), slope weights b0 = h t(1 − t)², b1 = h t²(t − 1), and their
+    derivatives with respect to x = x0 + t h.
+    """
+    t2 = t * t
+    u = 1.0 - t
+    a0 = (1.0 + 2.0 * t) * u * u
+    a1 = t2 * (3.0 - 2.0 * t)
+    b0 = h * t * u * u
+    b1 = h * t2 * (t - 1.0)
+    inv = 1.0 / h
+    da0 = 6.0 * (t2 - t) * inv
+    da1 = -da0
+    db0 = 3.0 * t2 - 4.0 * t + 1.0
+    db1 = 3.0 * t2 - 2.0 * t
+    return a0, a1, b0, b1, da0, da1, db0, db1
+
+
+@inline_kernel
+def hermite_corner(p, m, k, ax, bx, dax, dbx, ay, by, day, dby):
+    """One cell corner's terms of the bicubic Hermite interpolant (knot data at p[m, k:]).
+
+    With value weights a, slope weights b (including the interval length) and their
+    x-derivatives da, db in λ_w (x) and λ_f (y): W = Σ (f a_x + f_x b_x) a_y +
+    (f_y a_x + f_xy b_x) b_y over the corners, ∂W/∂λ_w the same with da_x, db_x, ∂W/∂λ_f
+    with da_y, db_y; H_w and H_f likewise (values only).
+
+    Returns the corner's (W, ∂W/∂λ_w, ∂W/∂λ_f, H_w, H_f) terms.
+    """
+    f = p[m, k + T_W]
+    fx = p[m, k + T_W + 1]
+    fy = p[m, k + T_W + 2]
+    fxy = p[m, k + T_W + 3]
+    u = f * ax + fx * bx
+    v = fy * ax + fxy * bx
+    w = u * ay + v * by
+    gw = (f * dax + fx * dbx) * ay + (fy * dax + fxy * dbx) * by
+    gf = u * day + v * dby
+    hw = (p[m, k + T_HW] * ax + p[m, k + T_HW + 1] * bx) * ay + (
+        p[m, k + T_HW + 2] * ax + p[m, k + T_HW + 3] * bx) * by
+    hf = (p[m, k + T_HF] * ax + p[m, k + T_HF + 1] * bx) * ay + (
+        p[m, k + T_HF + 2] * ax + p[m, k + T_HF + 3] * bx) * by
+    return w, gw, gf, hw, hf
+
+
+@kernel
+def crossover_from_table(p, m, lam_w, lam_f):
+    """Evaluate the tabulated crossover of material row m at (λ_w, λ_f) (theory §1.9).
+
+    Bicubic Hermite interpolation (C¹) of W, and of H_w, H_f, on the knot cell holding
+    the point; the gradient is the interpolant's exact derivative.
+
+    Returns:
+        (inside, W, ∂W/∂λ_w, ∂W/∂λ_f, H_w, H_f): inside is False (and the rest 0) when
+        the point lies outside the table or in a cell marked T_EXACT (then the caller
+        solves exactly).
+    """
+    nw = int(p[m, P_TAB_NW])
+    nf = int(p[m, P_TAB_NF])
+    start = int(p[m, P_TAB_START])
+    if nw < 2 or nf < 2:
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0
+    nbw = int(p[m, P_TAB_NBW])
+    i = knot_interval(p, m, start, nw, start + nw + nf, nbw, p[m, P_TAB_IBW], lam_w)
+    j = knot_interval(p, m, start + nw, nf, start + nw + nf + nbw, int(p[m, P_TAB_NBF]),
+                      p[m, P_TAB_IBF], lam_f)
+    if i < 0 or j < 0:
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0
+    base = int(p[m, P_TAB_DATA])
+    k00 = base + TAB_STRIDE * (i * nf + j)
+    if p[m, k00 + T_EXACT] != 0.0:
+        return False, 0.0, 0.0, 0.0, 0.0, 0.0
+    x0 = p[m, start + i]
+    hx = p[m, start + i + 1] - x0
+    y0 = p[m, start + nw + j]
+    hy = p[m, start + nw + j + 1] - y0
+    ax0, ax1, bx0, bx1, dax0, dax1, dbx0, dbx1 = hermite_basis((lam_w - x0) / hx, hx)
+    ay0, ay1, by0, by1, day0, day1, dby0, dby1 = hermite_basis((lam_f - y0) / hy, hy)
+    k10 = k00 + TAB_STRIDE * nf
+    w0, gw0, gf0, hw0, hf0 = hermite_corner(p, m, k00, ax0, bx0, dax0, dbx0, ay0, by0, day0, dby0)
+    w1, gw1, gf1, hw1, hf1 = hermite_corner(p, m, k00 + TAB_STRIDE, ax0, bx0, dax0, dbx0,
+                                            ay1, by1, day1, dby1)
+    w2, gw2, gf2, hw2, hf2 = hermite_corner(p, m, k10, ax1, bx1, dax1, dbx1, ay0, by0, day0, dby0)
+    w3, gw3, gf3, hw3, hf3 = hermite_corner(p, m, k10 + TAB_STRIDE, ax1, bx1, dax1, dbx1,
+                                            ay1, by1, day1, dby1)
+    w = (w0 + w1) + (w2 + w3)
+    gw = (gw0 + gw1) + (gw2 + gw3)
+    gf = (gf0 + gf1) + (gf2 + gf3)
+    hw = (hw0 + hw1) + (hw2 + hw3)
+    hf = (hf0 + hf1) + (hf2 + hf3)
+    return True, w, gw, gf, hw, hf
+
+
+@kernel
+def crossover_from_table_for_points(p, lam_w, lam_f, out):
+    """:func:`crossover_from_table` on many points (tests, measurements).
+
+    Args:
+        p: (length,) parameter row with its table.
+        lam_w, lam_f: (n,) stretches.
+        out: (n, 6) written: inside (1/0), W, ∂W/∂λ_w, ∂W/∂λ_f, H_w, H_f.
+    """
+    table = p.reshape((1, p.shape[0]))
+    for i in range(lam_w.shape[0]):
+        inside, w, gw, gf, hw, hf = crossover_from_table(table, 0, lam_w[i], lam_f[i])
+        out[i, 0] = 1.0 if inside else 0.0
+        out[i, 1] = w
+        out[i, 2] = gw
+        out[i, 3] = gf
+        out[i, 4] = hw
+        out[i, 5] = hf

@@ -260,7 +260,7 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, steps: in
       internal (energies of eroded elements at erosion) + dissipated, each joule once;
     - ``hourglass_fraction`` = (``hourglass_energy_J`` of live elements +
       ``eroded_hourglass_energy_J``, what eroded ones held at erosion) / internal work
-      (docs/theory.md §5);
+      (docs/theory.md §5), None while the internal work is not positive;
     - ``energy_error_fraction``: the largest of the history's.
     """
     model = compiled.model
@@ -311,7 +311,9 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, steps: in
         "eroded_internal_energy_J": factor * eb["eroded_internal_J"],
         "eroded_hourglass_energy_J": factor * eb["eroded_hourglass_J"],
         "eroded_kinetic_energy_J": factor * eb["eroded_kinetic_J"],
-        "hourglass_fraction": hg_all / w_int if w_int > 0.0 else 0.0,
+        # undefined (None, "n/a" on the page) while no positive internal work was done,
+        # e.g. a spun blade that has only given back part of its pre-stress energy
+        "hourglass_fraction": hg_all / w_int if w_int > 0.0 else None,
         "external_work_J": factor * eb["external_work_J"],
         "contact_energy_J": factor * eb["contact_energy_J"],
         "eroded_elements": int(np.sum(state.elem[:, S.E_ALIVE] == 0.0)),

@@ -1,7 +1,7 @@
 """Unit tests of the crossover kernel (kernels/fabric.py): oracles, invariants, properties.
 
-The exact height solve is the subject here (crossover = "exact"; the tabulated option,
-the default, is tested against it in test_fabric_table.py); the invariants that hold for
+The exact height solve is the subject here (crossover = "exact", the default; the
+tabulated option is tested against it in test_fabric_table.py); the invariants that hold for
 both run with both.
 """
 

@@ -64,7 +64,7 @@ class FabricOptions:
     # crossover evaluation (theory §1.9): "table" interpolates the tabulated stored
     # energy while both families are intact and inside the table (fibre frame only),
     # "exact" always runs the height solve (the reference)
-    crossover: Literal["table", "exact"] = "table"
+    crossover: Literal["table", "exact"] = "exact"
 
 
 @dataclass(frozen=True)

@@ -183,6 +183,12 @@ def strip_impact_figure(result: dict, path: Path, title: str = "") -> Path:
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
     a1.plot(t_us, h["contact_force_N"], lw=0.8, label="wovenimpact")
     a1.axhline(th["force_N"], color="k", ls="--", label="Smith et al. (1958)")
+    peak = float(np.max(h["contact_force_N"]))
+    if peak > 3.0 * th["force_N"]:  # the pick-up of the struck material, one step long
+        a1.set_ylim(-0.5 * th["force_N"], 3.0 * th["force_N"])
+        a1.text(0.98, 0.95, f"first contact: {peak / 1e3:.0f} kN (off scale), the\nstruck "
+                "material picked up", transform=a1.transAxes, ha="right", va="top",
+                fontsize=8)
     a1.set_xlabel("time (µs)")
     a1.set_ylabel("force on the face (N)")
     a1.legend()

@@ -115,6 +115,12 @@ def test_restart_ends_bitwise_identical_to_an_uninterrupted_run(tmp_path):
         (('material = "kevlar"', 'material = "aramid"'), "sections.fabric.material"),
         (('velocity = ["0 m/s", "0 m/s", "-60 m/s"]', 'velocity = ["0 m/s", "0 m/s"]'),
          "initial_velocity"),
+        # a NaN or zero direction is refused where it is written (it used to fail later as
+        # a "non-positive Jacobian" or run with a NaN impactor)
+        (('section = "fabric"', 'section = "fabric"\nwarp_direction = [nan, 1, 0]'),
+         "mesh.warp_direction"),
+        (('section = "fabric"', 'section = "fabric"\nwarp_direction = [0, 0, 0]'),
+         "mesh.warp_direction"),
     ],
 )
 def test_bad_case_files_give_errors_that_name_the_key(tmp_path, edit, message):
@@ -414,3 +420,14 @@ def test_a_node_eroded_in_the_step_takes_no_contact_force(tmp_path):
     assert orphan and np.all(cb.f_con[orphan] == 0.0)
     body_force = resultants[0][0]
     assert np.allclose(body_force, -cb.f_con.sum(axis=0) * np.array([0, 0, 1.0]), atol=1e-12)
+
+
+@pytest.mark.parametrize("direction", ["[nan, 0, -1]", "[0, 0, 0]", "[0, inf, -1]"])
+def test_a_bad_impactor_direction_is_an_error_naming_the_key(tmp_path, direction):
+    text = CASE + IMPACTOR.replace("{z}", "2 mm").replace("direction = [0, 0, -1]",
+                                                          f"direction = {direction}")
+    assert f"direction = {direction}" in text
+    result = CliRunner().invoke(app, ["run", str(write_case(tmp_path, text=text)),
+                                      "--out", str(tmp_path / "o")])
+    assert result.exit_code == 2
+    assert "impactor.direction" in result.output

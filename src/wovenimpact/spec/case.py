@@ -54,11 +54,12 @@ Schema (see README and examples/cases/)::
 from __future__ import annotations
 
 import dataclasses
+import math
 import warnings
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
-from pydantic import BaseModel, Field, ValidationError, model_validator
+from pydantic import AfterValidator, BaseModel, Field, ValidationError, model_validator
 
 from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.spec.fields import (
@@ -71,6 +72,16 @@ from wovenimpact.spec.fields import (
     read_toml,
 )
 
+def _unit_direction(v: tuple[float, float, float]) -> tuple[float, float, float]:
+    """A direction: three finite numbers, not all zero (it is normalised where used)."""
+    if not all(math.isfinite(c) for c in v):
+        raise ValueError(f"must be three finite numbers, got {list(v)}")
+    if not any(c != 0.0 for c in v):
+        raise ValueError("must be a non-zero vector")
+    return v
+
+
+Direction = Annotated[tuple[float, float, float], AfterValidator(_unit_direction)]
 Length = quantity("length", gt=0, example="0.94 mm")
 Time = quantity("time", gt=0, example="10 us")
 Velocity = quantity("velocity", example="-120 m/s")
@@ -118,7 +129,7 @@ class PlateMeshSpec(BaseModel):
     spacing: Length | None = None
     quarter: bool = False
     section: str = Field(min_length=1)
-    warp_direction: tuple[float, float, float] = (1.0, 0.0, 0.0)
+    warp_direction: Direction = (1.0, 0.0, 0.0)
 
 
 class AbaqusMeshSpec(BaseModel):
@@ -128,7 +139,7 @@ class AbaqusMeshSpec(BaseModel):
     kind: Literal["abaqus"]
     file: str = Field(min_length=1)
     sections: dict[str, str] = Field(min_length=1)  # element set → section name
-    warp_direction: tuple[float, float, float] = (1.0, 0.0, 0.0)
+    warp_direction: Direction = (1.0, 0.0, 0.0)
 
 
 Angle = quantity("angle", example="90 deg")
@@ -281,7 +292,7 @@ class ImpactorSpec(BaseModel):
     density: quantity("density", gt=0, example="7922 kg/m^3") = 7922.0
     mass: quantity("mass", gt=0, example="1.1 g") | None = None
     position: tuple[Coordinate, Coordinate, Coordinate]
-    direction: tuple[float, float, float] = (0.0, 0.0, -1.0)
+    direction: Direction = (0.0, 0.0, -1.0)
     velocity: quantity("velocity", gt=0, example="120 m/s")
     contact_stiffness: quantity("dimensionless", gt=0, le=0.5, example="0.1") = 0.1
     # dashpot of each node–body pair, a fraction of critical 2 √(k m): 1 makes a struck
@@ -293,8 +304,6 @@ class ImpactorSpec(BaseModel):
     def _cylinder_needs_length(self):
         if self.shape == "cylinder" and self.length is None:
             raise ValueError("a cylinder needs length (with unit)")
-        if sum(c * c for c in self.direction) == 0.0:
-            raise ValueError("direction must be a non-zero vector")
         return self
 
 
@@ -323,7 +332,7 @@ class InitialErosionSpec(BaseModel):
     centre: tuple[Coordinate, Coordinate, Coordinate] = (0.0, 0.0, 0.0)
     radius: Length
     plies: list[int] | None = None
-    cylinder_axis: tuple[float, float, float] | None = (0.0, 0.0, 1.0)
+    cylinder_axis: Direction | None = (0.0, 0.0, 1.0)
 
 
 class MaterialRef(BaseModel):

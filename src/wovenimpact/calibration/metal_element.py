@@ -19,7 +19,6 @@ work + energy released at failure.
 
 from __future__ import annotations
 
-import csv
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -27,6 +26,7 @@ from pathlib import Path
 import numpy as np
 from scipy.optimize import brentq
 
+from wovenimpact.calibration import single_element
 from wovenimpact.kernels import j2_layout as L
 from wovenimpact.materials.metal import (
     MetalParameters,
@@ -303,23 +303,7 @@ def run_metal_element_test(
 
 def write_history_csv(result: MetalElementTestResult, path: Path) -> Path:
     """Write the history as CSV (column names carry units); atomic replace."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    tmp = path.with_suffix(path.suffix + ".tmp")
-    names = list(COLUMNS)
-    with open(tmp, "w", newline="") as fh:
-        w = csv.writer(fh)
-        w.writerow(names)
-        for i in range(result.history[names[0]].size):
-            w.writerow([repr(float(result.history[n][i])) for n in names])
-    tmp.replace(path)
-    return path
+    return single_element.write_history_csv(result, path, COLUMNS)
 
 
-def read_history_csv(path: Path) -> dict[str, np.ndarray]:
-    """Read a history written by :func:`write_history_csv`."""
-    with open(path, newline="") as fh:
-        r = csv.reader(fh)
-        names = next(r)
-        data = np.array([[float(x) for x in row] for row in r])
-    return {n: data[:, j] for j, n in enumerate(names)}
+read_history_csv = single_element.read_history_csv

@@ -309,12 +309,13 @@ def run_element_test(
 
 
 # --- files -------------------------------------------------------------------------
-def write_history_csv(result: ElementTestResult, path: Path) -> Path:
-    """Write the history as CSV (column names carry units); atomic replace."""
+def write_history_csv(result: ElementTestResult, path: Path, columns=COLUMNS) -> Path:
+    """Write the history's ``columns`` as CSV (column names carry units); atomic replace.
+    The metal element test (calibration.metal_element) writes its own columns with it."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     tmp = path.with_suffix(path.suffix + ".tmp")
-    names = list(COLUMNS)
+    names = list(columns)
     with open(tmp, "w", newline="") as fh:
         w = csv.writer(fh)
         w.writerow(names)

@@ -22,14 +22,20 @@ from __future__ import annotations
 import json
 import math
 import time
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
-from wovenimpact.errors import InputError
+from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.io.atomic import atomic_write_text
-from wovenimpact.io.checkpoint import latest_checkpoint, load_checkpoint, save_checkpoint
+from wovenimpact.io.checkpoint import (
+    checkpoint_meta,
+    latest_checkpoint,
+    load_checkpoint,
+    save_checkpoint,
+)
 from wovenimpact.io.fields import FieldWriter
 from wovenimpact.io.history import History
 from wovenimpact.io.report import write_run_report
@@ -49,6 +55,7 @@ from wovenimpact.containment import (
     fragment_row,
     is_containment,
 )
+from wovenimpact.provenance import provenance, restart_digest
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.spec.case import load_case
 from wovenimpact.state import KINETIC0, State
@@ -57,13 +64,15 @@ HISTORY_COLUMNS = (
     "time_s", "step", "dt_s", "structure_kinetic_energy_part_J", "internal_work_part_J",
     "stored_energy_part_J", "hourglass_energy_part_J", "external_work_part_J",
     "eroded_kinetic_energy_part_J", "eroded_internal_energy_part_J", "contact_energy_part_J",
-    "contact_dissipated_part_J", "energy_error_fraction", "energy_normaliser_part_J",
+    "contact_dissipated_part_J", "body_force_work_part_J", "reaction_work_part_J",
+    "energy_drift_part_J", "energy_error_fraction", "energy_normaliser_part_J",
     "max_displacement_m", "eroded_elements",
 )
 IMPACT_COLUMNS = ("impactor_velocity_m_per_s", "impactor_displacement_m", "contact_force_full_N",
                   "impactor_nose_ahead_of_intact_m", "intact_material_ahead",
                   "impactor_kinetic_energy_part_J")
-SUMMARY_VERSION = 2  # 2: issue 9's outcome rule and energy keys; older summaries are re-run
+SUMMARY_VERSION = 3  # 2: issue 9's outcome rule and energy keys; 3: issue 12's energy
+#                     normalisation and provenance; older summaries are re-run
 DEFAULT_OUTPUTS = {"history": 1000, "field": 20, "checkpoint": 10}  # per run, if not given
 
 
@@ -73,17 +82,23 @@ def history_columns(model) -> tuple[str, ...]:
     Scope in the name: ``*_part_J`` is of the modelled part (a quarter of the problem
     in a quarter model; × ``symmetry_factor`` of summary.json gives the whole), ``*_full_*``
     of the whole problem; velocities, displacements, fractions and counts need neither.
-    ``energy_error_fraction`` = |drift| / ``energy_normaliser_part_J``
-    (solver.explicit.energy_balance). ``contact_energy_part_J`` is −(work of the contact
+    ``energy_drift_part_J`` is the balance's drift (solver.explicit.energy_balance),
+    ``energy_normaliser_part_J`` the largest energy in play so far (the running maximum of
+    its ``scale_J`` over the rows up to this one) and ``energy_error_fraction`` = |drift| /
+    normaliser; summary.json's figure is the largest |drift| over the last (largest)
+    normaliser. ``body_force_work_part_J`` and ``reaction_work_part_J`` (supports and
+    prescribed motions) are the parts of ``external_work_part_J`` besides loads. ``contact_energy_part_J`` is −(work of the contact
     forces): the penalty springs' energy plus ``contact_dissipated_part_J``, what contact
     dashpots and friction dissipated."""
     return (HISTORY_COLUMNS + (IMPACT_COLUMNS if model.body_params.shape[0] else ())
             + (CONTAINMENT_COLUMNS if is_containment(model) else ()))
 
 
-def history_row(model, state: State) -> dict:
-    """One history.csv row of ``state`` (columns :func:`history_columns`)."""
+def history_row(model, state: State, normaliser: float = 0.0) -> dict:
+    """One history.csv row of ``state`` (columns :func:`history_columns`); ``normaliser``
+    is the previous row's ``energy_normaliser_part_J`` (0 for the first row)."""
     eb = energy_balance(model, state)
+    scale = max(normaliser, eb["scale_J"])
     disp = np.sqrt(np.max(np.sum((state.x - model.x0) ** 2, axis=1)))
     impact = {}
     if model.body_params.shape[0]:
@@ -102,8 +117,10 @@ def history_row(model, state: State) -> dict:
         "eroded_internal_energy_part_J": eb["eroded_internal_J"],
         "contact_energy_part_J": eb["contact_energy_J"],
         "contact_dissipated_part_J": eb["contact_dissipated_J"],
-        "energy_error_fraction": eb["error_fraction"],
-        "energy_normaliser_part_J": eb["normaliser_J"], "max_displacement_m": float(disp),
+        "body_force_work_part_J": eb["body_force_work_J"],
+        "reaction_work_part_J": eb["reaction_work_J"], "energy_drift_part_J": eb["drift_J"],
+        "energy_error_fraction": abs(eb["drift_J"]) / scale,
+        "energy_normaliser_part_J": scale, "max_displacement_m": float(disp),
         "eroded_elements": int(np.sum(state.elem[:, S.E_ALIVE] == 0.0)),
     }
 
@@ -171,7 +188,15 @@ def run_spec(
 ) -> dict:
     """:func:`run_case` for a validated :class:`~wovenimpact.spec.case.CaseSpec` whose
     relative paths (materials, mesh) are relative to ``base``. ``source`` (case_text,
-    case_path, overrides) is what report.html shows as the case; without it, the spec."""
+    case_path, overrides) is what report.html shows as the case; without it, the spec.
+
+    A fresh run first removes the outputs an earlier run left in ``out_dir`` (checkpoints,
+    VTU frames, plots, history, summary, report; :func:`clear_outputs`, warning how many),
+    so no file of another case survives beside the new ones. A restart resumes only a
+    checkpoint written for this case, its files and this code (provenance.restart_digest)
+    whose history.csv and fields.pvd hold the rows and frames the checkpoint counted
+    (:func:`resume`); the frame and row numbering continue from the checkpoint's counts.
+    """
     compiled = compile_case(spec, Path(base))
     model = compiled.model
     out = Path(out_dir)
@@ -182,22 +207,19 @@ def run_spec(
 
         set_threads(capped_threads(n_threads, "--threads" if threads else "run.threads"))
     digest = model.digest()
+    prov = provenance(spec, base)
+    meta = {"restart_digest": restart_digest(spec, base), "wall_time_s": 0.0,
+            "restarted_from_step": None}
     run = spec.run
     ckpt_dir = out / "checkpoints"
-    history = History(history_columns(model))
     if restart:
-        last = latest_checkpoint(ckpt_dir)
-        if last is None:
-            raise InputError(f"--restart: no checkpoint in {ckpt_dir}; run without --restart")
-        state = load_checkpoint(last, digest)
-        if (out / "history.csv").exists():
-            history = History.from_csv(out / "history.csv")
-            history.truncate_after(state.t)
-        fields = FieldWriter.resume(out / "fields", model, state.t)
+        state, history, fields, wall_before = resume(out, model, digest, meta["restart_digest"],
+                                                     run.end_time)
+        meta["restarted_from_step"] = state.step
     else:
-        state = compiled.state
-        for old in ckpt_dir.glob("checkpoint_*.npz") if ckpt_dir.exists() else ():
-            old.unlink()
+        clear_outputs(out)
+        state, wall_before = compiled.state, 0.0
+        history = History(history_columns(model))
         fields = FieldWriter(out / "fields", model)
         history.append(history_row(model, state))
         fields.write(state)
@@ -206,9 +228,15 @@ def run_spec(
     c_sched = Schedule(_interval(run.checkpoint_interval, run.end_time, DEFAULT_OUTPUTS["checkpoint"]), state.t)
     ws = Workspace.for_model(model, state)
     wall0 = time.perf_counter()
-    steps0 = state.step
     last_report = wall0
-    max_error = max([0.0, *history.arrays()["energy_error_fraction"].tolist()])
+    normaliser = float(history.arrays()["energy_normaliser_part_J"][-1])
+
+    def checkpoint() -> None:
+        meta.update(history_rows=len(history), field_frames=len(fields.entries),
+                    wall_time_s=wall_before + time.perf_counter() - wall0)
+        history.write_csv(out / "history.csv")
+        save_checkpoint(ckpt_dir, state, digest, meta=meta)
+
     taken = 0
     while state.t < run.end_time:
         if max_steps is not None and taken >= max_steps:
@@ -216,24 +244,22 @@ def run_spec(
         step(model, state, ws)
         taken += 1
         if h_sched.due(state.t) or state.t >= run.end_time:
-            row = history_row(model, state)
-            max_error = max(max_error, row["energy_error_fraction"])
+            row = history_row(model, state, normaliser)
+            normaliser = row["energy_normaliser_part_J"]
             history.append(row)
         if f_sched.due(state.t) or state.t >= run.end_time:
             fields.write(state)
         if c_sched.due(state.t):
-            history.write_csv(out / "history.csv")
-            save_checkpoint(ckpt_dir, state, digest)
+            checkpoint()
         if progress is not None and time.perf_counter() - last_report > 0.2:
             last_report = time.perf_counter()
             progress(state, run.end_time)
-    wall = time.perf_counter() - wall0
     if progress is not None:
         progress(state, run.end_time)
-    history.write_csv(out / "history.csv")
-    save_checkpoint(ckpt_dir, state, digest)
-    summary = summarise(spec, compiled, state, wall, state.step - steps0, max_error,
-                        history.arrays())
+    checkpoint()
+    summary = summarise(spec, compiled, state, meta["wall_time_s"], history.arrays())
+    summary["restarted_from_step"] = meta["restarted_from_step"]
+    summary["provenance"] = prov
     from wovenimpact.io.plots import deflection_plot, energy_plot, impactor_plot
 
     h = history.arrays()
@@ -247,8 +273,62 @@ def run_spec(
     return summary
 
 
-def summarise(spec, compiled: CompiledCase, state: State, wall: float, steps: int,
-              max_error: float, h: dict) -> dict:
+OUTPUT_PATTERNS = ("checkpoints/checkpoint_*.npz", "fields/step_*.vtu", "fields/fields.pvd",
+                   "plots/*.png", "history.csv", "summary.json", "report.html")
+
+
+def clear_outputs(out: Path) -> None:
+    """Remove what an earlier run wrote into ``out`` (:data:`OUTPUT_PATTERNS`, nothing
+    else), warning how many files went: a new run's outputs never mix with another's."""
+    old = [p for pattern in OUTPUT_PATTERNS for p in out.glob(pattern) if p.is_file()]
+    for p in old:
+        p.unlink()
+    if old:
+        warnings.warn(f"{out}: removed {len(old)} output files of an earlier run "
+                      "(checkpoints, fields, plots, history, summary, report) before this one",
+                      InputWarning, stacklevel=3)
+
+
+def resume(out: Path, model, digest: str, resume_digest: str, end_time: float):
+    """State, History, FieldWriter and earlier wall time of a restart from the newest
+    checkpoint in ``out/checkpoints``, after checking that it belongs to this case and
+    code and that history.csv and fields.pvd hold what it counted; otherwise an
+    :class:`InputError` saying what is wrong (nothing is written before the checks)."""
+    last = latest_checkpoint(out / "checkpoints")
+    if last is None:
+        raise InputError(f"--restart: no checkpoint in {out / 'checkpoints'}; run without --restart")
+    meta = checkpoint_meta(last)
+    hint = "; run without --restart to start again"
+    if "history_rows" not in meta:
+        raise InputError(f"--restart: checkpoint {last} was written by an older wovenimpact "
+                         f"(no record of its history rows and field frames){hint}")
+    if meta.get("restart_digest") != resume_digest:
+        raise InputError(f"--restart: checkpoint {last} was written for another case, material "
+                         f"or mesh file, or code version (provenance digest differs){hint}")
+    state = load_checkpoint(last, digest)
+    if state.t > end_time:
+        raise InputError(f"--restart: checkpoint {last} is at t = {state.t!r} s, past "
+                         f"run.end_time = {end_time!r} s; give run.end_time ≥ {state.t!r} s"
+                         f"{hint}")
+    path = out / "history.csv"
+    if not path.exists():
+        raise InputError(f"--restart: {path} is missing (the checkpoint counts "
+                         f"{meta['history_rows']} rows before it){hint}")
+    history = History.from_csv(path)
+    n_rows = int(meta["history_rows"])
+    if history.columns != history_columns(model) or len(history) < n_rows:
+        raise InputError(f"--restart: {path} does not hold the {n_rows} rows of "
+                         f"{len(history_columns(model))} columns written before the checkpoint"
+                         f"{hint}")
+    history.keep_first(n_rows)
+    if not history.arrays()["time_s"][-1] <= state.t:
+        raise InputError(f"--restart: {path} has rows after the checkpoint's time among its "
+                         f"first {n_rows}; it belongs to another run{hint}")
+    fields = FieldWriter.resume(out / "fields", model, int(meta["field_frames"]))
+    return state, history, fields, float(meta["wall_time_s"])
+
+
+def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) -> dict:
     """The numbers a user wants from a finished run (summary.json). Energies here are
     of the whole problem (the modelled part's × ``symmetry_factor``):
 
@@ -261,11 +341,17 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, steps: in
     - ``hourglass_fraction`` = (``hourglass_energy_J`` of live elements +
       ``eroded_hourglass_energy_J``, what eroded ones held at erosion) / internal work
       (docs/theory.md §5), None while the internal work is not positive;
-    - ``energy_error_fraction``: the largest of the history's.
+    - ``energy_error_fraction``: the largest |drift| of the history over the largest
+      energy in play in it (its last ``energy_normaliser_part_J``), and ``energy_check``
+      "pass" if it is at most ``energy_tolerance`` (``run.energy_tolerance``), else "fail"
+      (the CLI then exits with code 4);
+    - ``element_cycles``, ``wall_time_s`` and ``ns_per_element_cycle`` of every
+      invocation that made this result (a restarted run's included).
     """
     model = compiled.model
     eb = energy_balance(model, state)
-    cycles = steps * model.n_elems
+    cycles = state.step * model.n_elems
+    error = float(np.max(np.abs(h["energy_drift_part_J"])) / h["energy_normaliser_part_J"][-1])
     factor = symmetry_factor(model)
     impact = {}
     if is_containment(model):
@@ -317,7 +403,9 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, steps: in
         "external_work_J": factor * eb["external_work_J"],
         "contact_energy_J": factor * eb["contact_energy_J"],
         "eroded_elements": int(np.sum(state.elem[:, S.E_ALIVE] == 0.0)),
-        "energy_error_fraction": float(max_error),
+        "energy_error_fraction": error,
+        "energy_tolerance": spec.run.energy_tolerance,
+        "energy_check": "pass" if error <= spec.run.energy_tolerance else "fail",
         "symmetry_factor": factor,
         "max_displacement_m": float(np.sqrt(np.max(np.sum((state.x - model.x0) ** 2, axis=1)))),
     }

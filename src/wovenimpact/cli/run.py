@@ -76,3 +76,14 @@ def run(
     emit(summary, as_json, f"{case.name}: summary (also in {out / 'summary.json'})")
     if not as_json:
         console.print(f"report: {out / 'report.html'}")
+    energy_verdict(summary)
+
+
+def energy_verdict(summary: dict) -> None:
+    """Exit with code 4, saying why, if the run's energy balance failed its tolerance
+    (``energy_check`` of the summary, which keeps the figure)."""
+    if summary.get("energy_check") == "fail":
+        fail(f"the energy balance failed: energy_error_fraction = "
+             f"{summary['energy_error_fraction']:.3g} exceeds run.energy_tolerance = "
+             f"{summary['energy_tolerance']:.3g}; the results are not trustworthy (a too "
+             "large time step or a diverging material?). The outputs are written.", code=4)

@@ -1,13 +1,16 @@
 """Checkpoints: a State and the digest of the Model it belongs to, in one ``.npz`` file.
 
 ``directory/checkpoint_{step:09d}.npz`` holds every array of ``State.arrays()``
-plus ``model_digest`` (a 0-d unicode array); nothing is pickled, and loading uses
-``allow_pickle=False``. Files are written atomically, so the newest checkpoint is
+plus ``model_digest`` (a 0-d unicode array) and ``run_meta``, a JSON text of what the
+run's side files held at that step (history rows, field frames, wall time; see
+runs.run_spec), by which a restart checks them and resumes their numbering; nothing is
+pickled, and loading uses ``allow_pickle=False``. Files are written atomically, so the newest checkpoint is
 always complete; older ones beyond ``keep`` are deleted.
 """
 
 from __future__ import annotations
 
+import json
 import re
 import zipfile
 from dataclasses import fields
@@ -20,6 +23,7 @@ from wovenimpact.io.atomic import atomic_path
 from wovenimpact.state import State
 
 DIGEST_KEY = "model_digest"
+META_KEY = "run_meta"
 _NAME = re.compile(r"checkpoint_(\d{9,})\.npz")
 
 
@@ -28,8 +32,10 @@ def checkpoint_name(step: int) -> str:
     return f"checkpoint_{step:09d}.npz"
 
 
-def save_checkpoint(directory: str | Path, state: State, model_digest: str, keep: int = 2) -> Path:
-    """Write ``state`` to ``directory/checkpoint_{step:09d}.npz`` atomically.
+def save_checkpoint(directory: str | Path, state: State, model_digest: str, keep: int = 2,
+                    meta: dict | None = None) -> Path:
+    """Write ``state`` to ``directory/checkpoint_{step:09d}.npz`` atomically, with
+    ``meta`` (JSON-able; :func:`checkpoint_meta` reads it back).
 
     The directory is created if needed. Afterwards only the ``keep`` newest
     checkpoints up to this one remain (this one included); checkpoints with a
@@ -41,6 +47,7 @@ def save_checkpoint(directory: str | Path, state: State, model_digest: str, keep
     directory.mkdir(parents=True, exist_ok=True)
     arrays = state.arrays()
     arrays[DIGEST_KEY] = np.array(str(model_digest))
+    arrays[META_KEY] = np.array(json.dumps(meta or {}, sort_keys=True))
     path = directory / checkpoint_name(state.step)
     with atomic_path(path) as tmp, open(tmp, "wb") as f:
         np.savez(f, **arrays)
@@ -89,6 +96,22 @@ def load_checkpoint(path: str | Path, model_digest: str) -> State:
         raise InputError(f"checkpoint {path} is incomplete (no {', '.join(missing)}); "
                          "delete it or run without --restart")
     return State.from_arrays(data)
+
+
+def checkpoint_meta(path: str | Path) -> dict:
+    """The ``meta`` saved with a checkpoint ({} for one written without)."""
+    path = Path(path)
+    data = _read_arrays(path)
+    if META_KEY not in data:
+        return {}
+    try:
+        meta = json.loads(str(data[META_KEY][()]))
+    except ValueError:
+        meta = None
+    if not isinstance(meta, dict):
+        raise InputError(f"checkpoint {path}: its run_meta is not a JSON object; delete it "
+                         "or run without --restart")
+    return meta
 
 
 def _read_arrays(path: Path) -> dict[str, np.ndarray]:

@@ -119,16 +119,30 @@ class FieldWriter:
         return path
 
     @classmethod
-    def resume(cls, directory: str | Path, model, t: float) -> FieldWriter:
-        """Continue the series in ``directory`` after a restart from time ``t``.
-
-        Entries with time > t are dropped from ``fields.pvd`` and their files deleted
-        (the restarted run writes them again).
+    def resume(cls, directory: str | Path, model, frames: int) -> FieldWriter:
+        """Continue the series in ``directory`` after a restart whose checkpoint counted
+        ``frames`` frames: the series goes on at frame ``frames``. Frames after those
+        are dropped from ``fields.pvd`` and their files deleted (the restarted run writes
+        them again); a collection listing fewer frames, or naming a missing file, is an
+        :class:`InputError` (resuming would overwrite or lose frames).
         """
-        entries = read_pvd(Path(directory) / PVD_NAME)
-        kept = [(time, name) for time, name in entries if not time > t]
-        for _, name in entries[len(kept):]:
-            (Path(directory) / name).unlink(missing_ok=True)
+        directory = Path(directory)
+        entries = read_pvd(directory / PVD_NAME)
+        kept = entries[:frames]
+        expected = [frame_name(k) for k in range(frames)]
+        if [name for _, name in kept] != expected:
+            raise InputError(
+                f"--restart: {directory / PVD_NAME} lists {len(entries)} frames, the checkpoint "
+                f"counts {frames} ({expected[0] if expected else ''}…); resuming would overwrite "
+                "or lose frames: run without --restart to start again")
+        missing = [name for _, name in kept if not (directory / name).exists()]
+        if missing:
+            raise InputError(f"--restart: {directory / missing[0]} (frame of the checkpoint's "
+                             "series) is missing; run without --restart to start again")
+        for old in directory.glob("step_*.vtu"):
+            k = _frame_index(old.name)
+            if k is not None and k >= frames:
+                old.unlink()
         writer = cls(directory, model, kept)
         writer._write_pvd()
         return writer

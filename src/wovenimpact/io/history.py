@@ -73,6 +73,10 @@ class History:
         i = self.columns.index(TIME)
         self._rows = [r for r in self._rows if not r[i] > t]
 
+    def keep_first(self, n: int) -> None:
+        """Keep the first ``n`` rows (a restart keeps those its checkpoint counted)."""
+        self._rows = self._rows[:n]
+
     def to_csv_text(self) -> str:
         buf = io.StringIO()
         buf.write(",".join(self.columns) + "\n")

@@ -24,9 +24,9 @@ def energy_curves(h: dict, symmetry_factor: float = 1.0) -> dict[str, np.ndarray
     energy`` and its part ``contact dissipated`` (dashpots and friction, when the
     history has it), ``internal work`` with its parts ``stored (live elements)``,
     ``hourglass (live elements)`` and ``eroded internal (at erosion)``, ``eroded
-    kinetic``, ``external work``, and ``balance error`` = energy_error_fraction ×
-    energy_normaliser: exactly the quantity whose largest value summary.json reports as
-    ``energy_error_fraction``, drawn in J. The balance is structure kinetic + impactor
+    kinetic``, ``external work``, and ``balance error`` = |energy_drift|: its largest
+    value over the last ``energy_normaliser`` (× the same factor) is exactly summary.json's
+    ``energy_error_fraction``. The balance is structure kinetic + impactor
     kinetic + internal work + eroded kinetic − external work + contact energy − initial
     kinetic energy; parts are not added again.
     """
@@ -44,7 +44,7 @@ def energy_curves(h: dict, symmetry_factor: float = 1.0) -> dict[str, np.ndarray
     out["eroded internal (at erosion)"] = f * h["eroded_internal_energy_part_J"]
     out["eroded kinetic"] = f * h["eroded_kinetic_energy_part_J"]
     out["external work"] = f * h["external_work_part_J"]
-    out["balance error"] = f * h["energy_error_fraction"] * h["energy_normaliser_part_J"]
+    out["balance error"] = f * np.abs(h["energy_drift_part_J"])
     return out
 
 
@@ -63,7 +63,7 @@ def energy_plot(h: dict, path: str | Path, title: str = "", symmetry_factor: flo
     fig, ax = plt.subplots(figsize=(7.5, 4.6))
     for label, y in curves.items():
         if label == "balance error":
-            ax.plot(t, y, "k:", lw=1.6, label="balance error (energy_error_fraction × normaliser)")
+            ax.plot(t, y, "k:", lw=1.6, label="balance error |drift| (energy_error_fraction × largest energy)")
         else:
             ax.plot(t, y, "--" if label in dashed else "-", label=label)
     e0 = symmetry_factor * (h["structure_kinetic_energy_part_J"][0]

@@ -78,6 +78,7 @@ def verdicts(summary: dict) -> list[Verdict]:
                            summary.get("fragment_exit_speed_m_per_s"))
     rebound = summary.get("rebound_velocity_m_per_s")
     error = summary.get("energy_error_fraction")
+    limit = summary.get("energy_tolerance", ENERGY_ERROR_LIMIT)  # the run's own, if given
     hourglass = summary.get("hourglass_fraction")
     residual_text = "n/a" if residual is None else f"{residual:.2f} m/s"
     if rebound is not None:
@@ -88,8 +89,8 @@ def verdicts(summary: dict) -> list[Verdict]:
         Verdict("residual_velocity_m_per_s", "residual velocity", residual_text, "0 m/s",
                 _status(None if residual is None else residual == 0.0)),
         Verdict("energy_error_fraction", "energy error",
-                "n/a" if error is None else f"{error * 100:.2g} %", f"≤ {ENERGY_ERROR_LIMIT:.0%}",
-                _status(None if error is None else error <= ENERGY_ERROR_LIMIT)),
+                "n/a" if error is None else f"{error * 100:.2g} %", f"≤ {limit:.2g}",
+                _status(None if error is None else error <= limit)),
         Verdict("hourglass_fraction", "hourglass share of internal work",
                 "n/a" if hourglass is None else f"{hourglass:.1%}", f"≤ {HOURGLASS_LIMIT:.0%}",
                 _status(None if hourglass is None else hourglass <= HOURGLASS_LIMIT)),

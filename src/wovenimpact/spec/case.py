@@ -272,6 +272,9 @@ class RunSpec(BaseModel):
     # an element crushed through itself is eroded (true) or stops the run (false)
     erode_inverted: bool = False
     threads: int | None = Field(default=None, ge=1)
+    # largest energy-balance error fraction of a run that ends with exit 0 (runs.summarise;
+    # docs/theory.md §3): 1 %, the report's verdict line; the examples stay below 1e-3
+    energy_tolerance: quantity("dimensionless", gt=0, le=1, example="0.01") = 0.01
 
 
 class ImpactorSpec(BaseModel):

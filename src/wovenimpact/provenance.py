@@ -1,0 +1,113 @@
+"""Provenance of a result: digests of what made it, so that nothing stale is reused.
+
+Every summary.json carries ``provenance`` (:func:`provenance`):
+
+- ``case_digest``: SHA-256 of the case as resolved (the validated spec, every quantity
+  in SI, as JSON) — a unit spelt differently is the same case, a changed value is not;
+- ``files``: SHA-256 of each file the case reads (material files, an Abaqus mesh), by
+  the path the case gives;
+- ``code_version``: the package version, and ``source_digest``, a SHA-256 of every
+  ``.py`` file of the installed package (an edit to any module is a new code version);
+- ``digest``: one SHA-256 of all of the above. A sweep, ``validate`` and a ``design``
+  search reuse a finished run only when its ``digest`` equals the one the case would
+  have now; anything else runs again, and the reason is said.
+
+``restart_digest`` is the same with ``run.end_time`` and ``run.threads`` left out (a
+restart may run a case further, on other threads: neither changes the steps it
+replays); a checkpoint stores it and ``--restart`` refuses a checkpoint written for
+another case, material, mesh or code.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+from pathlib import Path
+
+from wovenimpact.errors import InputError
+
+PACKAGE = Path(__file__).resolve().parent
+
+
+@functools.lru_cache(maxsize=1)
+def source_digest() -> str:
+    """SHA-256 (16 hex digits) of every ``.py`` file of the package, by relative path."""
+    h = hashlib.sha256()
+    for f in sorted(PACKAGE.rglob("*.py")):
+        h.update(f.relative_to(PACKAGE).as_posix().encode() + b"\0" + f.read_bytes())
+    return h.hexdigest()[:16]
+
+
+def code_version() -> dict[str, str]:
+    """The package version and :func:`source_digest`."""
+    from wovenimpact import __version__
+
+    return {"code_version": __version__, "source_digest": source_digest()}
+
+
+def input_files(spec) -> list[str]:
+    """The paths (as the case writes them) of the files a case reads: material files
+    and an Abaqus mesh."""
+    files = [ref if isinstance(ref, str) else ref.file for ref in spec.materials.values()]
+    mesh_file = getattr(spec.mesh, "file", None)
+    if mesh_file:
+        files.append(mesh_file)
+    return sorted(set(files))
+
+
+def file_digest(path: Path) -> str:
+    """SHA-256 (16 hex digits) of a file's bytes."""
+    try:
+        return hashlib.sha256(path.read_bytes()).hexdigest()[:16]
+    except OSError as exc:
+        raise InputError(f"{path}: cannot be read ({exc.strerror})") from None
+
+
+def _spec_json(spec, drop_run=()) -> str:
+    doc = spec.model_dump(mode="json")
+    for key in drop_run:
+        doc["run"].pop(key, None)
+    return json.dumps(doc, sort_keys=True)
+
+
+def _combine(parts: dict) -> str:
+    return hashlib.sha256(json.dumps(parts, sort_keys=True).encode()).hexdigest()[:16]
+
+
+def provenance(spec, base: str | Path) -> dict:
+    """Digests of a case (``spec``, its relative paths relative to ``base``), the files
+    it reads and the code (module docstring); ``digest`` combines them all."""
+    base = Path(base)
+    parts = {
+        "case_digest": hashlib.sha256(_spec_json(spec).encode()).hexdigest()[:16],
+        "files": {name: file_digest(base / name) for name in input_files(spec)},
+        **code_version(),
+    }
+    return {**parts, "digest": _combine(parts)}
+
+
+def restart_digest(spec, base: str | Path) -> str:
+    """:func:`provenance`'s digest without ``run.end_time`` and ``run.threads``: what a
+    checkpoint must have been written for to be resumed."""
+    base = Path(base)
+    return _combine({
+        "case": _spec_json(spec, drop_run=("end_time", "threads")),
+        "files": {name: file_digest(base / name) for name in input_files(spec)},
+        **code_version(),
+    })
+
+
+def stale_reason(summary: dict, expected: dict) -> str | None:
+    """Why a finished run's ``summary`` cannot stand for the case of ``expected``
+    (:func:`provenance`), or None if its digest matches."""
+    old = summary.get("provenance")
+    if not isinstance(old, dict) or "digest" not in old:
+        return "its summary has no provenance digest (written by an older wovenimpact)"
+    if old["digest"] == expected["digest"]:
+        return None
+    changed = [k for k in ("case_digest", "files", "code_version", "source_digest")
+               if old.get(k) != expected.get(k)]
+    names = {"case_digest": "the case", "files": "a material or mesh file",
+             "code_version": "the code version", "source_digest": "the code"}
+    return "changed since it ran: " + ", ".join(names[k] for k in changed or ["case_digest"])

@@ -42,11 +42,14 @@ sources>`` (``NUMBA_CACHE_DIR`` overrides), so editing any kernel invalidates th
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import hashlib
 import multiprocessing
 import os
 import sys
+import threading
+import time
 from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
@@ -133,12 +136,28 @@ def capped_threads(n: int, source: str = "threads") -> int:
 
 
 def _limit_threads(n: int) -> None:
-    """Process-pool initializer: only ``n`` Numba threads exist in this worker."""
+    """Process-pool initializer: only ``n`` Numba threads exist in this worker, and the
+    worker ends itself when its parent is gone (:func:`_watch_parent`)."""
     os.environ["NUMBA_NUM_THREADS"] = str(n)
     numba.config.reload_config()
+    threading.Thread(target=_watch_parent, args=(os.getppid(),), daemon=True,
+                     name="wovenimpact-parent-watchdog").start()
 
 
-def process_pool(workers: int, threads: int = 1) -> ProcessPoolExecutor:
+PARENT_POLL_S = 0.5  # how often a pool worker checks that its parent is alive
+
+
+def _watch_parent(parent: int) -> None:
+    """Exit this worker process at once when ``parent`` has died (a killed sweep or
+    design search): its parent id changes when it is orphaned. Without it a worker of
+    a killed study went on computing its queued variants."""
+    while os.getppid() == parent:
+        time.sleep(PARENT_POLL_S)
+    os._exit(1)
+
+
+@contextlib.contextmanager
+def process_pool(workers: int, threads: int = 1):
     """A pool of ``workers`` fresh processes whose kernels run on ``threads`` threads each.
 
     The workers are spawned, not forked: forking a process whose threading layer has
@@ -146,10 +165,23 @@ def process_pool(workers: int, threads: int = 1) -> ProcessPoolExecutor:
     exactly ``threads`` threads instead of carrying idle ones. (Two 1-thread runs side
     by side on 2 cores, 4 plies at 120 m/s: 1459 ns per element-cycle each; 5980 before
     the per-step ``np.vdot`` was replaced — its OpenBLAS threads spun, not Numba's.)
+
+    No worker outlives the study: leaving the ``with`` block by an exception (Ctrl-C
+    included) cancels the queued tasks and terminates the workers, and a worker whose
+    parent is killed outright ends itself within :data:`PARENT_POLL_S`.
     """
-    return ProcessPoolExecutor(max_workers=max(1, workers),
+    pool = ProcessPoolExecutor(max_workers=max(1, workers),
                                mp_context=multiprocessing.get_context("spawn"),
                                initializer=_limit_threads, initargs=(threads,))
+    try:
+        yield pool
+    except BaseException:
+        workers_now = list((pool._processes or {}).values())  # no public way to list them
+        pool.shutdown(wait=False, cancel_futures=True)
+        for proc in workers_now:
+            proc.terminate()
+        raise
+    pool.shutdown(wait=True)
 
 
 def inline_kernel(fn):

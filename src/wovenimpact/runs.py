@@ -401,6 +401,8 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
         # e.g. a spun blade that has only given back part of its pre-stress energy
         "hourglass_fraction": hg_all / w_int if w_int > 0.0 else None,
         "external_work_J": factor * eb["external_work_J"],
+        "body_force_work_J": factor * eb["body_force_work_J"],
+        "reaction_work_J": factor * eb["reaction_work_J"],
         "contact_energy_J": factor * eb["contact_energy_J"],
         "eroded_elements": int(np.sum(state.elem[:, S.E_ALIVE] == 0.0)),
         "energy_error_fraction": error,
@@ -409,3 +411,50 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
         "symmetry_factor": factor,
         "max_displacement_m": float(np.sqrt(np.max(np.sum((state.x - model.x0) ** 2, axis=1)))),
     }
+
+
+IMPACT_SUMMARY_KEYS = ("outcome", "perforated", "residual_velocity_m_per_s",
+                       "rebound_velocity_m_per_s", "initial_velocity_m_per_s",
+                       "absorbed_energy_J", "absorbed_energy_per_ply_J", "max_deflection_m",
+                       "max_deflection_per_ply_m", "peak_contact_force_N")
+CONTAINMENT_SUMMARY_KEYS = ("outcome", "contained", "fragment_exit_speed_m_per_s",
+                            "fragment_mass_kg", "fragment_initial_speed_m_per_s", "max_bulge_m",
+                            "casing_mass_kg", "casing_mass_per_area_kg_per_m2", "casing_layers",
+                            "absorbed_energy_per_layer_J")
+COMMON_SUMMARY_KEYS = (
+    "summary_version", "case", "end_time_s", "steps", "elements", "nodes", "first_time_step_s",
+    "last_time_step_s", "wall_time_s", "element_cycles", "ns_per_element_cycle",
+    "structure_kinetic_energy_J", "impactor_kinetic_energy_J", "total_kinetic_energy_J",
+    "initial_total_kinetic_energy_J", "initial_structure_kinetic_energy_J",
+    "initial_impactor_kinetic_energy_J", "internal_work_J", "stored_energy_J",
+    "hourglass_energy_J", "eroded_internal_energy_J", "eroded_hourglass_energy_J",
+    "eroded_kinetic_energy_J", "hourglass_fraction", "external_work_J", "body_force_work_J",
+    "reaction_work_J", "contact_energy_J", "eroded_elements", "energy_error_fraction",
+    "energy_tolerance", "energy_check", "symmetry_factor", "max_displacement_m",
+    "restarted_from_step", "provenance",
+)
+
+
+def summary_keys(spec) -> tuple[str, ...]:
+    """The keys summary.json will have for a case (the metrics a study may ask for)."""
+    from wovenimpact.spec.case import ContainmentMeshSpec
+
+    extra = (CONTAINMENT_SUMMARY_KEYS if isinstance(spec.mesh, ContainmentMeshSpec)
+             else IMPACT_SUMMARY_KEYS if spec.impactor is not None else ())
+    return tuple(dict.fromkeys(COMMON_SUMMARY_KEYS + extra))
+
+
+def reusable_summary(out: str | Path, spec, base: str | Path) -> tuple[dict | None, str]:
+    """The summary.json in ``out`` if it is a finished run of exactly this case, its
+    files and this code (provenance digest, current ``summary_version``), else None with
+    the reason ("" when there is no summary at all)."""
+    from wovenimpact.provenance import stale_reason
+
+    try:
+        summary = json.loads((Path(out) / "summary.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return None, ""
+    if not isinstance(summary, dict) or summary.get("summary_version", 1) < SUMMARY_VERSION:
+        return None, "its summary was written by an older wovenimpact (summary_version)"
+    reason = stale_reason(summary, provenance(spec, base))
+    return (None, reason) if reason else (summary, "")

@@ -13,7 +13,7 @@ from wovenimpact.kernels import shell_layout as S
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.solver.explicit import element_forces
-from wovenimpact.state import initial_state
+from wovenimpact.state import KINETIC0, initial_state
 
 
 def distorted_square(n=4, amplitude=0.25, seed=3):
@@ -143,7 +143,7 @@ def measured_frequency(model, nodes, length, t_end):
 
 def test_cantilever_first_bending_frequency_matches_beam_theory():
     """f1 = (1.875²/2π) √(E I/(ρ A L⁴)) for a clamped–free strip, ν = 0 (within 3 %);
-    total energy is also conserved over the run."""
+    the energy balance of the run holds to round-off at its end (2.6 periods)."""
     length, t = 0.1, 5e-3
     nodes, model, mat = cantilever(10, t, length)
     f_beam = beam_frequency(mat, t, length)
@@ -152,6 +152,9 @@ def test_cantilever_first_bending_frequency_matches_beam_theory():
     print(f"\ncantilever (10 × 2 elements, L/t = 20): f1 = {f_fe:.2f} Hz vs beam theory "
           f"{f_beam:.2f} Hz ({f_fe / f_beam - 1:+.2%}); energy error {eb['error_fraction']:.1e}")
     assert f_fe == pytest.approx(f_beam, rel=0.03)
+    # leapfrog kinetic energy with trapezoidal work balances a linear system at constant
+    # Δt exactly: what is left is round-off (measured 1.2e-15)
+    assert st.energy[KINETIC0] > 0.0 and eb["error_fraction"] < 1e-9
 
 
 def test_longitudinal_wave_travels_at_the_plate_speed():
@@ -302,11 +305,15 @@ def test_steps_are_bitwise_identical_with_one_or_two_threads():
     model = build_model(mesh.nodes, mesh.quads, {"f": sec}, np.zeros(mesh.n_elems, int), bcs=bc)
     v0 = np.zeros((mesh.n_nodes, 3))
     v0[np.linalg.norm(mesh.nodes[:, :2], axis=1) < 2e-3, 2] = -100.0
+    if numba.config.NUMBA_NUM_THREADS < 2:
+        pytest.skip("NUMBA_NUM_THREADS < 2 here: a second thread count to compare with does "
+                    "not exist (run with NUMBA_NUM_THREADS=2 to check determinism)")
     results = []
     before = numba.get_num_threads()
     try:
-        for threads in sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)}):
+        for threads in (1, 2):
             set_threads(threads)
+            assert numba.get_num_threads() == threads
             st = initial_state(model, velocity=v0)
             ws = Workspace.for_model(model, st)
             for _ in range(30):
@@ -314,7 +321,7 @@ def test_steps_are_bitwise_identical_with_one_or_two_threads():
             results.append(st)
     finally:
         set_threads(before)
-    assert all(r.equals(results[0]) for r in results[1:])
+    assert len(results) == 2 and results[1].equals(results[0])
     assert results[0].mat[:, FL.S_TENSION].max() > 0.0  # yarn tensions were exercised
 
 

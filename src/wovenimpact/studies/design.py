@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import copy
 import json
+import traceback
 from collections.abc import Callable
 from pathlib import Path
 
@@ -83,28 +84,51 @@ def _case_with_plies(doc: dict, n: int) -> dict:
 
 
 def _run_one(doc: dict, base: str, out: str) -> str:
-    """Outcome of one pack, resuming: a finished run of the same case document is read
-    back, an interrupted one restarts from its last checkpoint (a search survives a
-    crash), anything else runs from the start."""
+    """Outcome of one pack, resuming: a finished run of the same case document, files
+    and code (provenance digest) is read back, an interrupted one restarts from its last
+    checkpoint if that was written for the same (a search survives a crash), anything
+    else runs from the start. Never raises: a pack whose run fails returns
+    ``"failed: <reason>"`` (written to its ``error.txt``), so the other packs of the
+    batch finish and stay reusable."""
     from wovenimpact.io.atomic import atomic_write_text
     from wovenimpact.io.checkpoint import latest_checkpoint
     from wovenimpact.runs import run_spec
     from wovenimpact.spec.case import case_from_dict
-    from wovenimpact.studies.sweep import finished
+    from wovenimpact.studies.sweep import finished, outcome_of
 
     out_dir = Path(out)
-    done = finished(out_dir, doc)  # the sweep's test: same parameters.json, a summary
+    done, _ = finished(out_dir, doc, doc, base)  # the sweep's test: parameters and digest
     if done is not None:
-        return done["outcome"]
+        return _pack_outcome(done)
     params = out_dir / "parameters.json"
     text = json.dumps(doc, indent=2, default=str) + "\n"
     restart = (params.exists() and json.loads(params.read_text()) == json.loads(text)
                and latest_checkpoint(out_dir / "checkpoints") is not None)
     out_dir.mkdir(parents=True, exist_ok=True)
     (out_dir / "summary.json").unlink(missing_ok=True)
+    (out_dir / "error.txt").unlink(missing_ok=True)
     atomic_write_text(params, text)
-    summary = run_spec(case_from_dict(doc, source=out), base, out, threads=1, restart=restart)
-    return summary["outcome"]
+    spec = None
+    try:
+        spec = case_from_dict(doc, source=out)
+        try:
+            summary = run_spec(spec, base, out, threads=1, restart=restart)
+        except InputError as err:
+            if not (restart and str(err).startswith("--restart")):
+                raise
+            summary = run_spec(spec, base, out, threads=1)  # a stale checkpoint: start again
+        return _pack_outcome(outcome_of(summary))
+    except Exception as err:  # one failing pack is reported, the others finish
+        message = f"{type(err).__name__}: {err}"
+        atomic_write_text(out_dir / "error.txt", message + "\n\n" + traceback.format_exc())
+        return f"failed: {message}"
+
+
+def _pack_outcome(result: dict) -> str:
+    """The outcome of a pack's result, or ``"failed: <reason>"`` (an energy check)."""
+    if result["status"] != "done":
+        return f"failed: {result['error']}"
+    return result["outcome"]
 
 
 def _run_batch(docs: list[dict], base: str, dirs: list[str], workers: int) -> list[str]:
@@ -152,6 +176,7 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
     def stops(batch: list[int]) -> dict[int, bool]:
         docs = [_case_with_plies(doc, n) for n in batch]
         results = dict(zip(batch, run_batch(docs, [str(out / f"plies_{n}") for n in batch])))
+        refuse_failed(results, out)
         again = [n for n in batch if results[n] not in DECIDED]
         if again:
             longer = [_longer(d) for n, d in zip(batch, docs) if n in again]
@@ -162,6 +187,7 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
                                                       for n in again])):
                 reruns[str(n)] = f"{results[n]} → {r} with twice the end time"
                 results[n] = r
+            refuse_failed({n: results[n] for n in again}, out, "_end2x")
         for n in batch:
             outcomes[n] = results[n]
             if results[n] not in DECIDED:
@@ -191,6 +217,17 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
         "reruns": reruns,
         "warning": monotonic_warning(plies, seen),
     }
+
+
+def refuse_failed(results: dict[int, str], out: Path, suffix: str = "") -> None:
+    """An :class:`InputError` naming every pack whose run failed (``"failed: …"``) and
+    where its error.txt is; the packs that ran are kept in ``out`` for the next search."""
+    failed = [n for n, r in results.items() if r.startswith("failed")]
+    if failed:
+        raise InputError(
+            "; ".join(f"{n} plies: the run {results[n]} (see "
+                      f"{out / f'plies_{n}{suffix}' / 'error.txt'})" for n in failed)
+            + ". The packs that ran are kept: fix the case and search again to reuse them")
 
 
 def monotonic_warning(plies: int, seen: dict[int, bool]) -> str:

@@ -17,8 +17,12 @@ addressed by its dotted path in the case document::
 Every variant is validated like a case file (a bad value fails that variant, with the
 key named, and the others still run), run in ``OUT/runs/<id>/`` and summarised in
 ``OUT/results.csv`` (and ``OUT/report.html``, linking each run's page). A variant
-whose ``summary.json`` exists with the same parameters is not run again (the study
-resumes). For impact runs results.csv always records the ``outcome`` (perforated,
+whose ``summary.json`` exists with the same parameters and the provenance digest its
+case would have now (case, material and mesh files, code: wovenimpact.provenance) is
+not run again (the study resumes); one whose digest differs runs again, with a warning
+saying what changed. Variants with the same values are run once (a warning says so);
+``metrics`` that no summary has are an error before anything runs. A variant whose
+energy balance fails ``run.energy_tolerance`` is reported as failed (with its figures). For impact runs results.csv always records the ``outcome`` (perforated,
 stopped, undecided, no contact), which the ballistic fits require to be decided. Runs
 go to a local process pool by default, or
 to a Dask cluster when a scheduler address is given.
@@ -113,14 +117,45 @@ def load_study(path: str | Path, overrides=()) -> tuple[StudyInfo, list[Variant]
         rows = list(zip(*columns))
     else:
         rows = list(itertools.product(*columns))
-    variants = []
+    variants: dict[str, Variant] = {}
     for row in rows:
         values = dict(zip(keys, row))
         document = copy.deepcopy(base_doc)
         for k, v in values.items():
             set_dotted(document, k, v)
-        variants.append(Variant(variant_id(values), values, document))
-    return spec.study, variants, case_path.parent
+        variants.setdefault(variant_id(values), Variant(variant_id(values), values, document))
+    if len(variants) < len(rows):
+        warnings.warn(f"{path}: {len(rows) - len(variants)} of the {len(rows)} variants repeat "
+                      "the values of another; each distinct variant runs once",
+                      InputWarning, stacklevel=2)
+    check_metrics(path, spec.study.metrics, list(variants.values()))
+    return spec.study, list(variants.values()), case_path.parent
+
+
+def check_metrics(path: Path, metrics: list[str], variants: list[Variant]) -> None:
+    """An :class:`InputError` naming every metric that no variant's summary will have
+    (runs.summary_keys of the variants that validate; all kinds of case if none does)."""
+    from wovenimpact.runs import (
+        COMMON_SUMMARY_KEYS,
+        CONTAINMENT_SUMMARY_KEYS,
+        IMPACT_SUMMARY_KEYS,
+        summary_keys,
+    )
+    from wovenimpact.spec.case import case_from_dict
+
+    valid: dict[str, None] = {}
+    for v in variants:
+        try:
+            valid.update(dict.fromkeys(summary_keys(case_from_dict(v.document, source=v.id))))
+        except InputError:
+            continue  # that variant fails when it runs, with its own message
+    if not valid:
+        valid = dict.fromkeys(COMMON_SUMMARY_KEYS + IMPACT_SUMMARY_KEYS
+                              + CONTAINMENT_SUMMARY_KEYS)
+    bad = [m for m in metrics if m not in valid]
+    if bad:
+        raise InputError(f"{path}: study.metrics {bad}: no summary of this study has "
+                         f"{'it' if len(bad) == 1 else 'them'}; valid: {sorted(valid)}")
 
 
 def run_variant(document: dict, base: str, out_dir: str, values: dict, threads: int = 1) -> dict:
@@ -135,8 +170,7 @@ def run_variant(document: dict, base: str, out_dir: str, values: dict, threads: 
         warnings.simplefilter("always", InputWarning)
         try:
             spec = case_from_dict(document, source=f"variant {out.name}")
-            summary = run_spec(spec, base, out, threads=threads)
-            result = {"status": "done", **summary}
+            result = outcome_of(run_spec(spec, base, out, threads=threads))
         except Exception as err:  # one failing case is reported, the others finish
             message = f"{type(err).__name__}: {err}"
             atomic_write_text(out / "error.txt", message + "\n\n" + traceback.format_exc())
@@ -162,21 +196,38 @@ def warn_once(results: dict[str, dict], total: int) -> None:
         warnings.warn(f"{count} of {total} variants: {note}", InputWarning, stacklevel=3)
 
 
-def finished(out: Path, values: dict) -> dict | None:
-    """The summary of a variant already run with these values, else None (also when the
-    summary was written by an older wovenimpact whose outcome rule or energy keys differ:
-    ``summary_version`` below ``runs.SUMMARY_VERSION``)."""
-    from wovenimpact.runs import SUMMARY_VERSION
+def outcome_of(summary: dict) -> dict:
+    """A finished run's result: ``status`` "done", or "failed" with the reason when its
+    energy balance failed ``run.energy_tolerance`` (the figures are kept)."""
+    if summary.get("energy_check") == "fail":
+        return {**summary, "status": "failed",
+                "error": f"energy balance failed: energy_error_fraction "
+                         f"{summary['energy_error_fraction']:.3g} > run.energy_tolerance "
+                         f"{summary['energy_tolerance']:.3g}"}
+    return {"status": "done", **summary}
+
+
+def finished(out: Path, values: dict, document: dict, base: str | Path) -> tuple[dict | None, str]:
+    """The result of a variant already run in ``out`` with these ``values`` whose summary's
+    provenance digest is the one ``document`` (its paths relative to ``base``) would have
+    now (runs.reusable_summary), else None and why it cannot be reused ("" if it never
+    finished)."""
+    from wovenimpact.runs import reusable_summary
+    from wovenimpact.spec.case import case_from_dict
 
     try:
-        same = json.loads((out / "parameters.json").read_text()) == json.loads(
+        same = json.loads((out / "parameters.json").read_text(encoding="utf-8")) == json.loads(
             json.dumps(values, default=str))
-        summary = json.loads((out / "summary.json").read_text())
     except (OSError, ValueError):
-        return None
-    if summary.get("summary_version", 1) < SUMMARY_VERSION:
-        return None
-    return {"status": "done", **summary} if same else None
+        return None, ""
+    if not same or not (out / "summary.json").exists():
+        return None, ""
+    try:
+        spec = case_from_dict(document, source=str(out))
+    except InputError:
+        return None, ""
+    summary, why = reusable_summary(out, spec, base)
+    return (outcome_of(summary), "") if summary is not None else (None, why)
 
 
 def run_study(
@@ -202,12 +253,18 @@ def run_study(
     (out / "runs").mkdir(parents=True, exist_ok=True)
     results: dict[str, dict] = {}
     todo = []
+    stale: dict[str, int] = {}
     for v in variants:
-        done = finished(out / "runs" / v.id, {**v.values, **extra})
+        done, why = finished(out / "runs" / v.id, {**v.values, **extra}, v.document, base)
         if done is not None:
             results[v.id] = {**done, "resumed": True}
         else:
             todo.append(v)
+            if why:
+                stale[why] = stale.get(why, 0) + 1
+    for why, count in stale.items():
+        warnings.warn(f"{count} of {len(variants)} variants run again: {why}", InputWarning,
+                      stacklevel=2)
     if results:
         progress(len(results), len(variants), "", {"status": "finished earlier"})
     args = [(v.document, str(base), str(out / "runs" / v.id), {**v.values, **extra},

@@ -11,7 +11,6 @@ or a convergence verdict; the others are named as not decided.
 from __future__ import annotations
 
 import copy
-import json
 import shutil
 from datetime import date
 from pathlib import Path
@@ -85,7 +84,7 @@ def convergence_runs(work: Path, threads: int, log=_quiet) -> list[dict]:
                 doc = full_plate(doc)
             values = {"case": name, **changes, "mesh.element_size": size, "quarter": quarter}
             out = work / "convergence" / variant_id(values)
-            done = finished(out, values)
+            done, _ = finished(out, values, doc, path.parent)  # same values and digest
             if done is None:
                 log(f"convergence: {name}{''.join(', ' + v for v in changes.values())}, "
                     f"{label} → {out}")
@@ -239,7 +238,8 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
     """Run (or resume) everything and write the report; returns its path. ``log(message)``
     hears of each case, convergence run and study as it starts (the whole takes about
     half an hour on 2 cores)."""
-    from wovenimpact.runs import SUMMARY_VERSION, run_case
+    from wovenimpact.runs import reusable_summary, run_case
+    from wovenimpact.spec.case import load_case
     from wovenimpact.studies.ballistics import lambert_jonas_fit, require_decided
     from wovenimpact.studies.sweep import run_study
     from wovenimpact.units import to_si
@@ -262,11 +262,11 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
     cases = {}
     for name in CASES:
         out = work / "cases" / name
-        summary_path = out / "summary.json"
-        s = json.loads(summary_path.read_text()) if summary_path.exists() else {}
-        if s.get("summary_version", 1) < SUMMARY_VERSION:  # none, or an older rule's
-            log(f"case {name} → {out}")
-            s = run_case(ROOT / "examples" / "plate_impact" / f"{name}.toml", out)
+        case_path = ROOT / "examples" / "plate_impact" / f"{name}.toml"
+        s, why = reusable_summary(out, *load_case(case_path))  # same digest, else run again
+        if s is None:
+            log(f"case {name} → {out}" + (f" (run again: {why})" if why else ""))
+            s = run_case(case_path, out)
         cases[name] = s
         hg = s["hourglass_fraction"]
         lines.append(

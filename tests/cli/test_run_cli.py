@@ -11,6 +11,7 @@ from typer.testing import CliRunner
 
 from wovenimpact.cli.app import app
 from wovenimpact.io.checkpoint import latest_checkpoint, load_checkpoint
+from wovenimpact.io.history import read_csv
 from wovenimpact.model.compile import compile_case
 from wovenimpact.runs import run_case
 from wovenimpact.spec.case import load_case
@@ -237,7 +238,9 @@ def test_impactor_overlapping_the_plies_is_an_error(tmp_path):
 
 def test_impact_run_reports_outcome_velocity_and_energies(tmp_path):
     """A small plate struck by the FSP at 120 m/s for 15 µs: the history carries the
-    impactor columns, the summary the outcome fields, and the energy balance holds."""
+    impactor columns, the summary the outcome fields; 15 µs is too short to decide (the
+    impactor is still pushing the ply: undecided, slowed but not stopped), and the
+    energy balance holds to 1e-3 (measured 9.9e-5)."""
     text = CASE.replace('[[initial_velocity]]\nvelocity = ["0 m/s", "0 m/s", "-60 m/s"]\n'
                         'radius = "1.5 mm"\n', "") + IMPACTOR.replace("{z}", "0.4 mm")
     case = write_case(tmp_path, text=text, end="15 us")
@@ -252,7 +255,12 @@ def test_impact_run_reports_outcome_velocity_and_energies(tmp_path):
     assert "intact_material_ahead" in header and "impactor_nose_ahead_of_intact_m" in header
     assert summary["peak_contact_force_N"] > 0.0
     assert 0.0 < summary["absorbed_energy_J"] < 0.5 * 1.1e-3 * 120.0**2
-    assert summary["energy_error_fraction"] < 0.02
+    assert summary["outcome"] == "undecided" and not summary["perforated"]
+    h = read_csv(out / "history.csv")
+    v = h["impactor_velocity_m_per_s"]
+    assert v[0] == pytest.approx(120.0) and 0.0 < v[-1] < 120.0  # slowed, still coming
+    assert h["intact_material_ahead"][-1] == 1 and h["contact_force_full_N"][-1] > 0.0
+    assert summary["energy_error_fraction"] < 1e-3 and summary["energy_check"] == "pass"
     assert (out / "plots" / "impactor.png").exists() and (out / "plots" / "ply_deflection.png").exists()
 
 
@@ -362,7 +370,8 @@ def test_design_run_interrupted_by_a_crash_resumes_from_its_checkpoint(tmp_path)
     assert _run_one(doc, str(tmp_path), str(cut)) == "undecided"
     resumed = json.loads((cut / "summary.json").read_text())
     assert resumed["steps"] == full_steps  # same end, restart bitwise (tested above)
-    assert 0 < resumed["element_cycles"] < 0.5 * a["element_cycles"]  # only the rest ran
+    assert resumed["restarted_from_step"] > 0.5 * full_steps  # only the rest ran
+    assert resumed["element_cycles"] == a["element_cycles"]  # every invocation counted
     assert resumed["residual_velocity_m_per_s"] == a["residual_velocity_m_per_s"]
 
 

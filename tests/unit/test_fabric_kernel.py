@@ -401,6 +401,11 @@ def test_stiffness_bounds_the_membrane_tangent(lam_w, lam_f, gamma, crossover):
         n1 = np.array([[pert.resultant[0, 0], pert.resultant[0, 2]], [pert.resultant[0, 2], pert.resultant[0, 1]]])
         tangent = (e @ n1 @ e - e @ n0 @ e) / h
         assert tangent <= base.stiffness[0] * (1 + 1e-6)
+    # in shear: the fill turned by h more towards the warp (engineering shear strain h)
+    sheared = one_step(params, stretch_shear(lam_w, lam_f, gamma + h))
+    if np.all(sheared.state[0, L.S_DAMAGE : L.S_DAMAGE + 2] == 0):
+        tangent = abs(sheared.resultant[0, 2] - base.resultant[0, 2]) / h
+        assert tangent <= base.stiffness[0] * (1 + 1e-6)
 
 
 @pytest.mark.parametrize("crossover", ["exact", "table"])

@@ -12,9 +12,10 @@ Every summary.json carries ``provenance`` (:func:`provenance`):
   search reuse a finished run only when its ``digest`` equals the one the case would
   have now; anything else runs again, and the reason is said.
 
-``restart_digest`` is the same with ``run.end_time`` and ``run.threads`` left out (a
-restart may run a case further, on other threads: neither changes the steps it
-replays); a checkpoint stores it and ``--restart`` refuses a checkpoint written for
+``restart_digest`` is the same with ``run.end_time``, ``run.threads`` and the output
+intervals left out (a restart may run a case further or shorter, on other threads, with
+other output intervals: none changes the steps it replays, and the checkpoint counts the
+rows and frames already written); a checkpoint stores it and ``--restart`` refuses a checkpoint written for
 another case, material, mesh or code.
 """
 
@@ -28,6 +29,8 @@ from pathlib import Path
 from wovenimpact.errors import InputError
 
 PACKAGE = Path(__file__).resolve().parent
+RESTART_FREE = ("end_time", "threads", "field_interval", "history_interval",
+                "checkpoint_interval")  # [run] keys a restart may change
 
 
 @functools.lru_cache(maxsize=1)
@@ -88,11 +91,11 @@ def provenance(spec, base: str | Path) -> dict:
 
 
 def restart_digest(spec, base: str | Path) -> str:
-    """:func:`provenance`'s digest without ``run.end_time`` and ``run.threads``: what a
-    checkpoint must have been written for to be resumed."""
+    """:func:`provenance`'s digest without ``run.end_time``, ``run.threads`` and the output
+    intervals: what a checkpoint must have been written for to be resumed."""
     base = Path(base)
     return _combine({
-        "case": _spec_json(spec, drop_run=("end_time", "threads")),
+        "case": _spec_json(spec, drop_run=RESTART_FREE),
         "files": {name: file_digest(base / name) for name in input_files(spec)},
         **code_version(),
     })

@@ -88,11 +88,28 @@ def test_run_writes_every_output_and_a_json_summary(tmp_path):
     assert latest_checkpoint(out / "checkpoints") is not None
 
 
-def test_restart_ends_bitwise_identical_to_an_uninterrupted_run(tmp_path):
-    case = write_case(tmp_path, end="12 us")
+def two_plies_struck() -> str:
+    """CASE as two plies one shell thickness apart, struck by the FSP at 120 m/s."""
+    return (CASE.replace('[[initial_velocity]]\nvelocity = ["0 m/s", "0 m/s", "-60 m/s"]\n'
+                         'radius = "1.5 mm"\n', "")
+            .replace('section = "fabric"', 'section = "fabric"\nplies = 2\nspacing = "0.4992 mm"')
+            + IMPACTOR.replace("{z}", "0.8992 mm"))
+
+
+@pytest.mark.parametrize("kind", ["kicked ply", "two plies struck"])
+def test_restart_ends_bitwise_identical_to_an_uninterrupted_run(tmp_path, kind):
+    """Killed after a checkpoint and restarted, a run ends bitwise as an uninterrupted
+    one: a kicked ply, and two plies struck by the impactor, whose shell–shell contact
+    (rebuilt on restart, candidates searched afresh) pushes the lower ply."""
+    text = CASE if kind == "kicked ply" else two_plies_struck()
+    end = "12 us" if kind == "kicked ply" else "15 us"
+    case = write_case(tmp_path, end=end, text=text)
     whole, broken = tmp_path / "whole", tmp_path / "broken"
-    run_case(case, whole)
-    partial = run_case(case, broken, max_steps=60)  # "killed" after the 4 µs checkpoint
+    full = run_case(case, whole)
+    if kind == "two plies struck":
+        assert min(full["max_deflection_per_ply_m"]) > 0.0  # the lower ply was struck too
+    partial = run_case(case, broken, max_steps=int(0.8 * full["steps"]))  # "killed" after
+    # the 8 µs checkpoint (one every 4 µs)
     assert "interrupted_at_step" in partial
     run_case(case, broken, restart=True)
     assert (whole / "history.csv").read_text() == (broken / "history.csv").read_text()
@@ -104,6 +121,51 @@ def test_restart_ends_bitwise_identical_to_an_uninterrupted_run(tmp_path):
     fa = sorted(p.name for p in (whole / "fields").glob("*.vtu"))
     fb = sorted(p.name for p in (broken / "fields").glob("*.vtu"))
     assert fa == fb
+    sa, sb = (json.loads((d / "summary.json").read_text()) for d in (whole, broken))
+    assert sb["restarted_from_step"] > 0 and sa["restarted_from_step"] is None
+    assert sb["element_cycles"] == sa["element_cycles"]  # both invocations counted
+    assert sb["provenance"] == sa["provenance"]
+
+
+def test_restart_refuses_side_files_that_do_not_match_its_checkpoint(tmp_path):
+    """A restart trusts nothing beside its checkpoint: a deleted history.csv, a history
+    cut short, a deleted fields.pvd (resuming would overwrite the frames), an end time
+    before the checkpoint's, or a material file changed since are each refused with a
+    message, and nothing in the directory is touched."""
+    import shutil
+
+    from wovenimpact.errors import InputError
+
+    kevlar = tmp_path / "kevlar.toml"
+    shutil.copy(KEVLAR, kevlar)
+    case = tmp_path / "case.toml"
+    case.write_text(CASE.format(kevlar=kevlar.as_posix(), end="12 us"), encoding="utf-8")
+    cut = tmp_path / "cut"
+    assert "interrupted_at_step" in run_case(case, cut, max_steps=60)  # after the 8 µs one
+
+    def history_cut(d):
+        lines = (d / "history.csv").read_text().splitlines(keepends=True)
+        (d / "history.csv").write_text("".join(lines[:3]))
+
+    sabotage = {
+        "history.csv is missing": lambda d: (d / "history.csv").unlink(),
+        "does not hold the": history_cut,
+        "overwrite or lose frames": lambda d: (d / "fields" / "fields.pvd").unlink(),
+    }
+    for i, (message, spoil) in enumerate(sabotage.items()):
+        d = shutil.copytree(cut, tmp_path / f"spoilt{i}")
+        spoil(d)
+        before = {p: p.read_bytes() for p in d.rglob("*") if p.is_file()}
+        with pytest.raises(InputError, match=message):
+            run_case(case, d, restart=True)
+        assert {p: p.read_bytes() for p in d.rglob("*") if p.is_file()} == before
+    short = tmp_path / "short.toml"
+    short.write_text(CASE.format(kevlar=kevlar.as_posix(), end="6 us"), encoding="utf-8")
+    with pytest.raises(InputError, match="past run.end_time"):  # the checkpoint is at 8 µs
+        run_case(short, cut, restart=True)
+    kevlar.write_text(kevlar.read_text() + "\n# edited\n")
+    with pytest.raises(InputError, match="provenance digest differs"):
+        run_case(case, cut, restart=True)
 
 
 @pytest.mark.parametrize(

@@ -267,13 +267,16 @@ def advance(model, state: State, ws: Workspace, t_stop: float, max_steps: int | 
 
 
 def body_force_work(model, state: State) -> float:
-    """Work of the body forces (gravity): Σ_a m_a g_a · (x_a − X_a), exact for the
-    constant loads m_a g_a that the trapezoid rule integrates (a node stops moving, and
-    its body force working, when it erodes)."""
+    """Work of the body forces (gravity) up to the last whole step t^n, like every work of
+    :func:`energy_balance`: Σ_a m_a g_a · (x_a^n − X_a), exact for the constant loads
+    m_a g_a that the trapezoid rule integrates; x^n = x^{n+1} − Δt^{n+1/2} v^{n+1/2}
+    (the State already holds x^{n+1}). A node stops moving, and its body force working,
+    when it erodes (its velocity is then zero)."""
     g = model.body_accel[:, :3]
     if not np.any(g):
         return 0.0
-    return float(np.sum(model.node_mass[:, None] * g * (state.x - model.x0)))
+    x_n = state.x - state.dt * state.v
+    return float(np.sum(model.node_mass[:, None] * g * (x_n - model.x0)))
 
 
 def energy_balance(model, state: State) -> dict[str, float]:

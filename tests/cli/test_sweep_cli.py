@@ -7,7 +7,7 @@ from pathlib import Path
 
 from typer.testing import CliRunner
 
-from tests.cli.test_run_cli import write_case
+from tests.cli.test_run_cli import CASE, KEVLAR, write_case
 from wovenimpact.cli.app import app
 
 STUDY = """
@@ -106,22 +106,150 @@ def test_results_of_impact_runs_record_the_outcome(tmp_path: Path):
     the variants were finished earlier, so the study only reads their summaries back)."""
     import csv
 
-    from wovenimpact.runs import SUMMARY_VERSION
-    from wovenimpact.studies.sweep import load_study, run_study
+    from wovenimpact.studies.sweep import run_study
 
     write_case(tmp_path, end="8 us")
     study = tmp_path / "study.toml"
     study.write_text(STUDY.replace(', ["0 m/s", "0 m/s", "-60"]', ""))
-    _, variants, _ = load_study(study)
     out = tmp_path / "out"
-    for v, outcome in zip(variants, ("stopped", "undecided")):
+    fake_finished_runs(study, out, ("stopped", "undecided"))
+    run_study(study, out)
+    with (out / "results.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert [r["outcome"] for r in rows] == ["stopped", "undecided"]
+
+
+def fake_finished_runs(study: Path, out: Path, outcomes) -> list:
+    """Write parameters.json and a summary.json (current version and provenance digest)
+    for the variants of ``study`` as if they had run; returns the variants."""
+    from wovenimpact.provenance import provenance
+    from wovenimpact.runs import SUMMARY_VERSION
+    from wovenimpact.spec.case import case_from_dict
+    from wovenimpact.studies.sweep import load_study
+
+    _, variants, base = load_study(study)
+    for v, outcome in zip(variants, outcomes):
         run = out / "runs" / v.id
         run.mkdir(parents=True)
         (run / "parameters.json").write_text(json.dumps(v.values, default=str))
         (run / "summary.json").write_text(json.dumps({
             "summary_version": SUMMARY_VERSION, "outcome": outcome,
-            "max_displacement_m": 1e-3, "energy_error_fraction": 1e-4}))
-    run_study(study, out)
-    with (out / "results.csv").open() as fh:
-        rows = list(csv.DictReader(fh))
-    assert [r["outcome"] for r in rows] == ["stopped", "undecided"]
+            "max_displacement_m": 1e-3, "energy_error_fraction": 1e-4,
+            "provenance": provenance(case_from_dict(v.document), base)}))
+    return variants
+
+
+def test_a_finished_variant_is_reused_only_while_its_digest_matches(tmp_path: Path):
+    """A variant's summary stands only for the case, material file and code it was run
+    with: after the material file changes it is not reused, and the reason is said."""
+    import shutil
+
+    from wovenimpact.studies.sweep import finished
+
+    kevlar = tmp_path / "kevlar.toml"
+    shutil.copy(KEVLAR, kevlar)
+    (tmp_path / "case.toml").write_text(CASE.format(kevlar=kevlar.as_posix(), end="8 us"))
+    study = tmp_path / "study.toml"
+    study.write_text(STUDY.replace(', ["0 m/s", "0 m/s", "-60"]', ""))
+    out = tmp_path / "out"
+    variants = fake_finished_runs(study, out, ("stopped", "undecided"))
+    v = variants[0]
+    done, why = finished(out / "runs" / v.id, v.values, v.document, tmp_path)
+    assert done["status"] == "done" and done["outcome"] == "stopped" and why == ""
+    other = json.loads(json.dumps(v.document))
+    other["sections"]["fabric"]["bending_modulus"] = "2 GPa"  # same values, another case
+    done, why = finished(out / "runs" / v.id, v.values, other, tmp_path)
+    assert done is None and why == "changed since it ran: the case"
+    kevlar.write_text(kevlar.read_text() + "\n# edited\n")
+    done, why = finished(out / "runs" / v.id, v.values, v.document, tmp_path)
+    assert done is None and why == "changed since it ran: a material or mesh file"
+
+
+def test_duplicate_variants_run_once_and_unknown_metrics_are_refused_before_any_run(
+        tmp_path: Path):
+    import warnings
+
+    from wovenimpact.errors import InputWarning
+    from wovenimpact.studies.sweep import load_study
+
+    write_case(tmp_path, end="8 us")
+    study = tmp_path / "study.toml"
+    kick = '["0 m/s", "0 m/s", "-30 m/s"]'
+    study.write_text(STUDY.replace('["0 m/s", "0 m/s", "-60 m/s"], ["0 m/s", "0 m/s", "-60"]',
+                                   f"{kick}, {kick}"))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        _, variants, _ = load_study(study)
+    assert len(variants) == 1  # three times the same kick
+    assert any(issubclass(w.category, InputWarning) and "2 of the 3 variants repeat" in
+               str(w.message) for w in caught)
+    study.write_text(STUDY.replace('"energy_error_fraction"]', '"max_displacment_m"]'))
+    out = tmp_path / "o"
+    result = CliRunner().invoke(app, ["sweep", str(study), "--out", str(out)])
+    assert result.exit_code == 2
+    assert "study.metrics ['max_displacment_m']" in result.output
+    assert "max_displacement_m" in result.output  # the valid names are listed
+    assert not out.exists()  # nothing ran
+
+
+def _children(pid: int) -> list[int]:
+    """Process ids whose parent is ``pid`` (from /proc)."""
+    found = []
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            found.append(int(stat.parent.name))
+    return found
+
+
+def _alive(pid: int) -> bool:
+    """The process exists and is not a zombie."""
+    try:
+        return Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0] != "Z"
+    except OSError:
+        return False
+
+
+def test_a_killed_sweep_leaves_no_worker_behind(tmp_path: Path):
+    """``wovenimpact sweep`` killed outright (SIGKILL, no chance to clean up) while its two
+    pool workers run variants that would take minutes: every worker ends by itself
+    within seconds (each watches its parent), none goes on computing."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+
+    if not Path("/proc/self/stat").exists():
+        import pytest
+
+        pytest.skip("needs /proc to find the worker processes")
+    write_case(tmp_path, end="50 ms")  # ~3e5 steps a variant: minutes, were they left
+    study = tmp_path / "study.toml"
+    study.write_text(STUDY.replace(', ["0 m/s", "0 m/s", "-60"]', ""))
+    out = tmp_path / "out"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", "from wovenimpact.cli import main; main()", "sweep", str(study),
+         "--out", str(out), "--workers", "2", "--json"],
+        stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    try:
+        deadline = time.monotonic() + 180.0
+        while len(list(out.glob("runs/*/parameters.json"))) < 2:  # both variants started
+            assert proc.poll() is None and time.monotonic() < deadline
+            time.sleep(0.2)
+        workers = _children(proc.pid)
+        assert len(workers) >= 2
+    finally:
+        os.kill(proc.pid, signal.SIGKILL)
+        proc.wait()
+    deadline = time.monotonic() + 20.0
+    while any(_alive(w) for w in workers) and time.monotonic() < deadline:
+        time.sleep(0.2)
+    left = [w for w in workers if _alive(w)]
+    for w in left:  # do not leave them to the rest of the suite
+        os.kill(w, signal.SIGKILL)
+    assert not left, f"workers {left} outlived the killed sweep"
+    assert not any(out.glob("runs/*/summary.json"))  # they were cut short, as they should

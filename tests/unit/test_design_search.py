@@ -91,3 +91,38 @@ def test_design_stops_when_a_pack_is_undecided_even_twice_as_long(tmp_path, monk
     monkeypatch.setattr(design, "_run_batch", run_batch)
     with pytest.raises(InputError, match=r"2 plies: undecided even with twice run.end_time"):
         design.design_plies(ROOT / "examples" / "plate_impact" / "plies1_100.toml", tmp_path)
+
+
+def test_a_failed_pack_stops_the_search_with_its_error_and_keeps_the_others(tmp_path,
+                                                                             monkeypatch):
+    """A pack whose run fails (here: 2 plies) does not crash the search with a traceback:
+    the batch finishes, the error names the pack and its error.txt, and the packs that
+    ran stay for the next search to reuse."""
+    from wovenimpact.studies import design
+
+    run_batch, calls = _fake_runs(threshold=3, slow={})
+
+    def failing(docs, base, dirs, workers):
+        out = run_batch(docs, base, dirs, workers)
+        return ["failed: SimulationError: element 7 inverted" if d.endswith("plies_2") else o
+                for d, o in zip(dirs, out)]
+
+    monkeypatch.setattr(design, "_run_batch", failing)
+    with pytest.raises(InputError, match=r"2 plies: the run failed: SimulationError: element 7 "
+                       r"inverted \(see .*plies_2/error.txt\)\. The packs that ran are kept"):
+        design.design_plies(ROOT / "examples" / "plate_impact" / "plies1_100.toml", tmp_path)
+    assert [c[0] for c in calls] == [1, 2]  # both packs of the first batch ran
+
+
+def test_run_one_reports_a_failing_pack_instead_of_raising(tmp_path):
+    """The worker function itself never raises: a pack that cannot run returns
+    "failed: …" and leaves its error.txt."""
+    from wovenimpact.spec.fields import read_toml
+    from wovenimpact.studies.design import _case_with_plies, _run_one
+
+    case = ROOT / "examples" / "plate_impact" / "plies1_100.toml"
+    doc = _case_with_plies(read_toml(case, "case file"), 1)
+    doc["mesh"]["element_size"] = "-1 mm"
+    result = _run_one(doc, str(case.parent), str(tmp_path / "p"))
+    assert result.startswith("failed: InputError") and "mesh.element_size" in result
+    assert "mesh.element_size" in (tmp_path / "p" / "error.txt").read_text()

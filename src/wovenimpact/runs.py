@@ -15,6 +15,12 @@
   the State alone);
 - ``OUT/plots/energy.png``, ``OUT/summary.json`` and ``OUT/report.html`` (one page:
   verdicts, summary, plots, case, provenance; :mod:`wovenimpact.io.report`) at the end.
+
+summary.json carries the ``provenance`` digests (:mod:`wovenimpact.provenance`) by which
+studies reuse a finished run, and ``energy_check``: a run whose energy balance fails
+``run.energy_tolerance`` still writes every output; the CLI then exits with code 4.
+A checkpoint also records the history rows and field frames written so far, which a
+restart checks against history.csv and fields.pvd (:func:`resume`).
 """
 
 from __future__ import annotations

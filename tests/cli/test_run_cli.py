@@ -502,3 +502,24 @@ def test_a_bad_impactor_direction_is_an_error_naming_the_key(tmp_path, direction
                                       "--out", str(tmp_path / "o")])
     assert result.exit_code == 2
     assert "impactor.direction" in result.output
+
+
+def test_a_reused_output_directory_is_cleared_of_an_earlier_runs_outputs(tmp_path):
+    """Frames, plots and checkpoints another case left in OUT are removed (with a warning
+    saying so) before a fresh run writes its own; files the run never writes stay."""
+    from wovenimpact.errors import InputWarning
+
+    out = tmp_path / "out"
+    stale = [out / "fields" / "step_000099.vtu", out / "plots" / "impactor.png",
+             out / "checkpoints" / "checkpoint_000999999.npz", out / "summary.json"]
+    for p in stale:
+        p.parent.mkdir(parents=True, exist_ok=True)
+        p.write_text("another case's output")
+    (out / "notes.txt").write_text("mine")
+    with pytest.warns(InputWarning, match="removed 4 output files of an earlier run"):
+        summary = run_case(write_case(tmp_path, end="8 us"), out)
+    assert not any(p.exists() and p.read_text() == "another case's output" for p in stale)
+    assert (out / "notes.txt").read_text() == "mine"
+    frames = sorted(p.name for p in (out / "fields").glob("*.vtu"))
+    assert frames == [f"step_{k:06d}.vtu" for k in range(len(frames))]
+    assert summary["steps"] > 0 and not (out / "plots" / "impactor.png").exists()

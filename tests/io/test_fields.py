@@ -77,10 +77,12 @@ def test_explicit_time_and_no_going_back(tmp_path, model):
 
 
 def test_resume_drops_later_frames(tmp_path, model):
+    """A restart whose checkpoint counted 2 frames keeps those, deletes the later ones and
+    numbers the next frame 2."""
     w = FieldWriter(tmp_path, model)
     for k in range(4):
         w.write(moved(model, k))
-    r = FieldWriter.resume(tmp_path, model, t=1.5e-6)
+    r = FieldWriter.resume(tmp_path, model, frames=2)
     assert [f for _, f in r.entries] == ["step_000000.vtu", "step_000001.vtu"]
     assert not (tmp_path / "step_000002.vtu").exists()
     assert pvd_entries(tmp_path / PVD_NAME) == list(r.entries)
@@ -89,16 +91,28 @@ def test_resume_drops_later_frames(tmp_path, model):
         "step_000000.vtu", "step_000001.vtu", "step_000002.vtu"]
 
 
-def test_resume_without_a_series_starts_one(tmp_path, model):
-    r = FieldWriter.resume(tmp_path / "new", model, t=0.0)
-    assert r.entries == ()
-    assert pvd_entries(tmp_path / "new" / PVD_NAME) == []
+def test_resume_refuses_a_series_shorter_than_the_checkpoints(tmp_path, model):
+    """fields.pvd gone, or listing fewer frames than the checkpoint counted, or a counted
+    frame file gone: resuming would overwrite or lose frames, so it is refused and the
+    frames on disk are left alone."""
+    w = FieldWriter(tmp_path, model)
+    for k in range(3):
+        w.write(moved(model, k))
+    with pytest.raises(InputError, match="lists 3 frames, the checkpoint counts 4"):
+        FieldWriter.resume(tmp_path, model, frames=4)
+    (tmp_path / "step_000001.vtu").unlink()
+    with pytest.raises(InputError, match="step_000001.vtu .* is missing"):
+        FieldWriter.resume(tmp_path, model, frames=3)
+    (tmp_path / PVD_NAME).unlink()
+    with pytest.raises(InputError, match="lists 0 frames"):
+        FieldWriter.resume(tmp_path, model, frames=2)
+    assert (tmp_path / "step_000002.vtu").exists()
 
 
 def test_corrupt_collection_is_named(tmp_path, model):
     (tmp_path / PVD_NAME).write_text("<VTKFile><Collection>")
     with pytest.raises(InputError, match="fields.pvd"):
-        FieldWriter.resume(tmp_path, model, t=0.0)
+        FieldWriter.resume(tmp_path, model, frames=0)
 
 
 def test_fabric_columns_come_from_the_material_state(tmp_path, model, kevlar):

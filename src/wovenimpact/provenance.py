@@ -12,11 +12,12 @@ Every summary.json carries ``provenance`` (:func:`provenance`):
   search reuse a finished run only when its ``digest`` equals the one the case would
   have now; anything else runs again, and the reason is said.
 
-``restart_digest`` is the same with ``run.end_time``, ``run.threads`` and the output
+:func:`restart_parts` are the same with ``run.end_time``, ``run.threads`` and the output
 intervals left out (a restart may run a case further or shorter, on other threads, with
 other output intervals: none changes the steps it replays, and the checkpoint counts the
-rows and frames already written); a checkpoint stores it and ``--restart`` refuses a checkpoint written for
-another case, material, mesh or code.
+rows and frames already written); a checkpoint stores them and their digest, and
+``--restart`` refuses a checkpoint written for another case, material, mesh or code,
+naming which.
 """
 
 from __future__ import annotations
@@ -74,7 +75,8 @@ def _spec_json(spec, drop_run=()) -> str:
     return json.dumps(doc, sort_keys=True)
 
 
-def _combine(parts: dict) -> str:
+def digest_of(parts: dict) -> str:
+    """SHA-256 (16 hex digits) of a dict of digests (JSON, keys sorted)."""
     return hashlib.sha256(json.dumps(parts, sort_keys=True).encode()).hexdigest()[:16]
 
 
@@ -87,18 +89,20 @@ def provenance(spec, base: str | Path) -> dict:
         "files": {name: file_digest(base / name) for name in input_files(spec)},
         **code_version(),
     }
-    return {**parts, "digest": _combine(parts)}
+    return {**parts, "digest": digest_of(parts)}
 
 
-def restart_digest(spec, base: str | Path) -> str:
-    """:func:`provenance`'s digest without ``run.end_time``, ``run.threads`` and the output
-    intervals: what a checkpoint must have been written for to be resumed."""
+def restart_parts(spec, base: str | Path) -> dict:
+    """What a checkpoint must have been written for to be resumed: :func:`provenance`'s
+    parts without ``run.end_time``, ``run.threads`` and the output intervals (``case``,
+    ``files``, ``code_version``, ``source_digest``; a refused restart says which one
+    changed)."""
     base = Path(base)
-    return _combine({
-        "case": _spec_json(spec, drop_run=RESTART_FREE),
+    return {
+        "case": hashlib.sha256(_spec_json(spec, drop_run=RESTART_FREE).encode()).hexdigest()[:16],
         "files": {name: file_digest(base / name) for name in input_files(spec)},
         **code_version(),
-    })
+    }
 
 
 def stale_reason(summary: dict, expected: dict) -> str | None:
@@ -109,8 +113,14 @@ def stale_reason(summary: dict, expected: dict) -> str | None:
         return "its summary has no provenance digest (written by an older wovenimpact)"
     if old["digest"] == expected["digest"]:
         return None
-    changed = [k for k in ("case_digest", "files", "code_version", "source_digest")
-               if old.get(k) != expected.get(k)]
-    names = {"case_digest": "the case", "files": "a material or mesh file",
-             "code_version": "the code version", "source_digest": "the code"}
-    return "changed since it ran: " + ", ".join(names[k] for k in changed or ["case_digest"])
+    return "changed since it ran: " + changed_parts(old, expected)
+
+
+NAMES = {"case_digest": "the case", "case": "the case", "files": "a material or mesh file",
+         "code_version": "the code version", "source_digest": "the code"}
+
+
+def changed_parts(old: dict, new: dict) -> str:
+    """What differs between two sets of digest parts, in words ("the case, the code")."""
+    changed = [NAMES[k] for k in NAMES if k in new and old.get(k) != new.get(k)]
+    return ", ".join(dict.fromkeys(changed)) or "the case"

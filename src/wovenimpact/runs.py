@@ -61,7 +61,7 @@ from wovenimpact.containment import (
     fragment_row,
     is_containment,
 )
-from wovenimpact.provenance import provenance, restart_digest
+from wovenimpact.provenance import changed_parts, digest_of, provenance, restart_parts
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.spec.case import load_case
 from wovenimpact.state import KINETIC0, State
@@ -199,7 +199,7 @@ def run_spec(
     A fresh run first removes the outputs an earlier run left in ``out_dir`` (checkpoints,
     VTU frames, plots, history, summary, report; :func:`clear_outputs`, warning how many),
     so no file of another case survives beside the new ones. A restart resumes only a
-    checkpoint written for this case, its files and this code (provenance.restart_digest)
+    checkpoint written for this case, its files and this code (provenance.restart_parts)
     whose history.csv and fields.pvd hold the rows and frames the checkpoint counted
     (:func:`resume`); the frame and row numbering continue from the checkpoint's counts.
     """
@@ -214,13 +214,13 @@ def run_spec(
         set_threads(capped_threads(n_threads, "--threads" if threads else "run.threads"))
     digest = model.digest()
     prov = provenance(spec, base)
-    meta = {"restart_digest": restart_digest(spec, base), "wall_time_s": 0.0,
-            "restarted_from_step": None}
+    parts = restart_parts(spec, base)
+    meta = {"restart_digest": digest_of(parts), "restart_parts": parts,
+            "wall_time_s": 0.0, "restarted_from_step": None}
     run = spec.run
     ckpt_dir = out / "checkpoints"
     if restart:
-        state, history, fields, wall_before = resume(out, model, digest, meta["restart_digest"],
-                                                     run.end_time)
+        state, history, fields, wall_before = resume(out, model, digest, parts, run.end_time)
         meta["restarted_from_step"] = state.step
     else:
         clear_outputs(out)
@@ -295,7 +295,7 @@ def clear_outputs(out: Path) -> None:
                       InputWarning, stacklevel=3)
 
 
-def resume(out: Path, model, digest: str, resume_digest: str, end_time: float):
+def resume(out: Path, model, digest: str, parts: dict, end_time: float):
     """State, History, FieldWriter and earlier wall time of a restart from the newest
     checkpoint in ``out/checkpoints``, after checking that it belongs to this case and
     code and that history.csv and fields.pvd hold what it counted; otherwise an
@@ -308,9 +308,10 @@ def resume(out: Path, model, digest: str, resume_digest: str, end_time: float):
     if "history_rows" not in meta:
         raise InputError(f"--restart: checkpoint {last} was written by an older wovenimpact "
                          f"(no record of its history rows and field frames){hint}")
-    if meta.get("restart_digest") != resume_digest:
-        raise InputError(f"--restart: checkpoint {last} was written for another case, material "
-                         f"or mesh file, or code version (provenance digest differs){hint}")
+    if meta.get("restart_digest") != digest_of(parts):
+        what = changed_parts(meta.get("restart_parts") or {}, parts)
+        raise InputError(f"--restart: checkpoint {last} was written before a change of {what} "
+                         f"(provenance digest differs){hint}")
     state = load_checkpoint(last, digest)
     if state.t > end_time:
         raise InputError(f"--restart: checkpoint {last} is at t = {state.t!r} s, past "

@@ -70,16 +70,27 @@ def test_undecided_runs_get_no_verdict_and_are_named():
 
 
 def test_a_summary_of_an_older_rule_is_not_taken_as_finished(tmp_path):
-    """A variant's summary written before issue 9's outcome rule (no summary_version) is
-    run again; one of the current version is kept."""
+    """A variant's summary written before issue 9's outcome rule (no summary_version), or
+    of the current version without the provenance digest of issue 12, is run again; one
+    of the current version with the case's digest is kept."""
     import json
 
+    from wovenimpact.provenance import provenance
     from wovenimpact.runs import SUMMARY_VERSION
+    from wovenimpact.spec.case import case_from_dict
+    from wovenimpact.spec.fields import read_toml
     from wovenimpact.studies.sweep import finished
 
+    case = ROOT / "examples" / "plate_impact" / "plies1_100.toml"
+    doc = read_toml(case, "case file")
     (tmp_path / "parameters.json").write_text(json.dumps({"a": 1}))
     (tmp_path / "summary.json").write_text(json.dumps({"outcome": "perforated"}))
-    assert finished(tmp_path, {"a": 1}) is None
-    (tmp_path / "summary.json").write_text(json.dumps({"outcome": "perforated",
-                                                       "summary_version": SUMMARY_VERSION}))
-    assert finished(tmp_path, {"a": 1})["outcome"] == "perforated"
+    assert finished(tmp_path, {"a": 1}, doc, case.parent) == (
+        None, "its summary was written by an older wovenimpact (summary_version)")
+    current = {"outcome": "perforated", "summary_version": SUMMARY_VERSION}
+    (tmp_path / "summary.json").write_text(json.dumps(current))
+    done, why = finished(tmp_path, {"a": 1}, doc, case.parent)
+    assert done is None and "no provenance digest" in why
+    current["provenance"] = provenance(case_from_dict(doc), case.parent)
+    (tmp_path / "summary.json").write_text(json.dumps(current))
+    assert finished(tmp_path, {"a": 1}, doc, case.parent)[0]["outcome"] == "perforated"

@@ -89,13 +89,13 @@ def history_columns(model) -> tuple[str, ...]:
     in a quarter model; × ``symmetry_factor`` of summary.json gives the whole), ``*_full_*``
     of the whole problem; velocities, displacements, fractions and counts need neither.
     ``energy_drift_part_J`` is the balance's drift (solver.explicit.energy_balance),
-    ``energy_normaliser_part_J`` the largest energy in play so far (the running maximum of
-    its ``scale_J`` over the rows up to this one) and ``energy_error_fraction`` = |drift| /
-    normaliser; summary.json's figure is the largest |drift| over the last (largest)
-    normaliser. ``body_force_work_part_J`` and ``reaction_work_part_J`` (supports and
-    prescribed motions) are the parts of ``external_work_part_J`` besides loads. ``contact_energy_part_J`` is −(work of the contact
-    forces): the penalty springs' energy plus ``contact_dissipated_part_J``, what contact
-    dashpots and friction dissipated."""
+    ``energy_normaliser_part_J`` the largest energy put into the model so far (the running
+    maximum of its ``scale_J`` over the rows up to this one) and ``energy_error_fraction``
+    = |drift| / normaliser; summary.json's figure is the largest |drift| over the last
+    (largest) normaliser. ``body_force_work_part_J`` and ``reaction_work_part_J`` (supports
+    and prescribed motions) are the two parts of ``external_work_part_J``.
+    ``contact_energy_part_J`` is −(work of the contact forces): the penalty springs' energy
+    plus ``contact_dissipated_part_J``, what contact dashpots and friction dissipated."""
     return (HISTORY_COLUMNS + (IMPACT_COLUMNS if model.body_params.shape[0] else ())
             + (CONTAINMENT_COLUMNS if is_containment(model) else ()))
 
@@ -280,7 +280,8 @@ def run_spec(
 
 
 OUTPUT_PATTERNS = ("checkpoints/checkpoint_*.npz", "fields/step_*.vtu", "fields/fields.pvd",
-                   "plots/*.png", "history.csv", "summary.json", "report.html")
+                   "plots/*.png", "history.csv", "summary.json", "report.html",
+                   "error.txt")  # error.txt: a failed run of a sweep or design search
 
 
 def clear_outputs(out: Path) -> None:
@@ -291,7 +292,8 @@ def clear_outputs(out: Path) -> None:
         p.unlink()
     if old:
         warnings.warn(f"{out}: removed {len(old)} output files of an earlier run "
-                      "(checkpoints, fields, plots, history, summary, report) before this one",
+                      "(checkpoints, fields, plots, history, summary, report, error) before "
+                      "this one",
                       InputWarning, stacklevel=3)
 
 
@@ -349,7 +351,7 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
       ``eroded_hourglass_energy_J``, what eroded ones held at erosion) / internal work
       (docs/theory.md §5), None while the internal work is not positive;
     - ``energy_error_fraction``: the largest |drift| of the history over the largest
-      energy in play in it (its last ``energy_normaliser_part_J``), and ``energy_check``
+      energy put into the model (its last ``energy_normaliser_part_J``), and ``energy_check``
       "pass" if it is at most ``energy_tolerance`` (``run.energy_tolerance``), else "fail"
       (the CLI then exits with code 4);
     - ``element_cycles``, ``wall_time_s`` and ``ns_per_element_cycle`` of every

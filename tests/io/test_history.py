@@ -41,12 +41,11 @@ def test_from_csv_continues_the_history(tmp_path):
     assert h.arrays()["step"].tolist() == [0, 10, 20, 30]
 
 
-def test_truncate_after_drops_later_rows(tmp_path):
+def test_keep_first_keeps_the_rows_a_checkpoint_counted(tmp_path):
     h = filled(5)
-    t = h.arrays()["time_s"][2]
-    h.truncate_after(t)
+    h.keep_first(3)
     assert h.arrays()["step"].tolist() == [0, 10, 20]
-    h.truncate_after(-1.0)
+    h.keep_first(0)
     assert len(h) == 0
     h.write_csv(tmp_path / "empty.csv")
     back = read_csv(tmp_path / "empty.csv")

@@ -2,7 +2,7 @@
 
 Column names carry their unit (``time_s``, ``kinetic_energy_J``, ``reaction_z_N``);
 a name without a unit is a count (``step``). Every History has a ``time_s``
-column, by which rows are truncated on a restart. Floats are written with
+column. Floats are written with
 ``repr`` (shortest exact form) and integers as integers, so a CSV round trip is
 exact and keeps each column's type.
 """
@@ -67,11 +67,6 @@ class History:
     def arrays(self) -> dict[str, np.ndarray]:
         """Each column as an array (int64 if all its values are integers, else float64)."""
         return {c: _column_array([r[i] for r in self._rows]) for i, c in enumerate(self.columns)}
-
-    def truncate_after(self, t: float) -> None:
-        """Drop the rows with time_s > t (a restart from time t replays them)."""
-        i = self.columns.index(TIME)
-        self._rows = [r for r in self._rows if not r[i] > t]
 
     def keep_first(self, n: int) -> None:
         """Keep the first ``n`` rows (a restart keeps those its checkpoint counted)."""

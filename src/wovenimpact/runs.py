@@ -304,7 +304,8 @@ def resume(out: Path, model, digest: str, parts: dict, end_time: float):
     :class:`InputError` saying what is wrong (nothing is written before the checks)."""
     last = latest_checkpoint(out / "checkpoints")
     if last is None:
-        raise InputError(f"--restart: no checkpoint in {out / 'checkpoints'}; run without --restart")
+        raise InputError(f"--restart: no checkpoint in {out / 'checkpoints'}; run without "
+                         "--restart")
     meta = checkpoint_meta(last)
     hint = "; run without --restart to start again"
     if "history_rows" not in meta:

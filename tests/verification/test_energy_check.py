@@ -72,7 +72,8 @@ def test_a_plate_at_rest_under_gravity_balances_to_round_off(tmp_path):
     the first step's forces with the weight the half-step start gave them: the balance
     holds to round-off (was 0.25, an O(Δt²) first-step term over energies of the same
     size)."""
-    text = PLATE + CLAMPED + '\n[body_force]\nacceleration = ["0 m/s^2", "0 m/s^2", "-9.81 m/s^2"]\n'
+    text = (PLATE + CLAMPED
+            + '\n[body_force]\nacceleration = ["0 m/s^2", "0 m/s^2", "-9.81 m/s^2"]\n')
     s, h = run(tmp_path, text, "gravity")
     assert s["initial_total_kinetic_energy_J"] == 0.0 and s["body_force_work_J"] > 0.0
     # the clamps do no work; what the external work holds besides gravity's Σ m g·Δx is

@@ -4,8 +4,8 @@
 plus ``model_digest`` (a 0-d unicode array) and ``run_meta``, a JSON text of what the
 run's side files held at that step (history rows, field frames, wall time; see
 runs.run_spec), by which a restart checks them and resumes their numbering; nothing is
-pickled, and loading uses ``allow_pickle=False``. Files are written atomically, so the newest checkpoint is
-always complete; older ones beyond ``keep`` are deleted.
+pickled, and loading uses ``allow_pickle=False``. Files are written atomically, so the
+newest checkpoint is always complete; older ones beyond ``keep`` are deleted.
 """
 
 from __future__ import annotations

@@ -63,7 +63,8 @@ def energy_plot(h: dict, path: str | Path, title: str = "", symmetry_factor: flo
     fig, ax = plt.subplots(figsize=(7.5, 4.6))
     for label, y in curves.items():
         if label == "balance error":
-            ax.plot(t, y, "k:", lw=1.6, label="balance error |drift| (energy_error_fraction × largest energy)")
+            ax.plot(t, y, "k:", lw=1.6,
+                    label="balance error |drift| (energy_error_fraction × energy put in)")
         else:
             ax.plot(t, y, "--" if label in dashed else "-", label=label)
     e0 = symmetry_factor * (h["structure_kinetic_energy_part_J"][0]

@@ -22,7 +22,8 @@ case would have now (case, material and mesh files, code: wovenimpact.provenance
 not run again (the study resumes); one whose digest differs runs again, with a warning
 saying what changed. Variants with the same values are run once (a warning says so);
 ``metrics`` that no summary has are an error before anything runs. A variant whose
-energy balance fails ``run.energy_tolerance`` is reported as failed (with its figures). For impact runs results.csv always records the ``outcome`` (perforated,
+energy balance fails ``run.energy_tolerance`` is reported as failed (with its figures).
+For impact runs results.csv always records the ``outcome`` (perforated,
 stopped, undecided, no contact), which the ballistic fits require to be decided. Runs
 go to a local process pool by default, or
 to a Dask cluster when a scheduler address is given.
@@ -141,14 +142,12 @@ def check_metrics(path: Path, metrics: list[str], variants: list[Variant]) -> No
         IMPACT_SUMMARY_KEYS,
         summary_keys,
     )
-    from wovenimpact.spec.case import case_from_dict
 
     valid: dict[str, None] = {}
     for v in variants:
-        try:
-            valid.update(dict.fromkeys(summary_keys(case_from_dict(v.document, source=v.id))))
-        except InputError:
-            continue  # that variant fails when it runs, with its own message
+        spec = quiet_spec(v.document, v.id)
+        if spec is not None:  # else that variant fails when it runs, with its own message
+            valid.update(dict.fromkeys(summary_keys(spec)))
     if not valid:
         valid = dict.fromkeys(COMMON_SUMMARY_KEYS + IMPACT_SUMMARY_KEYS
                               + CONTAINMENT_SUMMARY_KEYS)
@@ -156,6 +155,19 @@ def check_metrics(path: Path, metrics: list[str], variants: list[Variant]) -> No
     if bad:
         raise InputError(f"{path}: study.metrics {bad}: no summary of this study has "
                          f"{'it' if len(bad) == 1 else 'them'}; valid: {sorted(valid)}")
+
+
+def quiet_spec(document: dict, source: str):
+    """The validated case of a variant, or None if it is invalid, without its input
+    warnings: the run itself tells them (once per study, :func:`warn_once`)."""
+    from wovenimpact.spec.case import case_from_dict
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", InputWarning)
+        try:
+            return case_from_dict(document, source=source)
+        except InputError:
+            return None
 
 
 def run_variant(document: dict, base: str, out_dir: str, values: dict, threads: int = 1) -> dict:
@@ -213,7 +225,6 @@ def finished(out: Path, values: dict, document: dict, base: str | Path) -> tuple
     now (runs.reusable_summary), else None and why it cannot be reused ("" if it never
     finished)."""
     from wovenimpact.runs import reusable_summary
-    from wovenimpact.spec.case import case_from_dict
 
     try:
         same = json.loads((out / "parameters.json").read_text(encoding="utf-8")) == json.loads(
@@ -222,9 +233,8 @@ def finished(out: Path, values: dict, document: dict, base: str | Path) -> tuple
         return None, ""
     if not same or not (out / "summary.json").exists():
         return None, ""
-    try:
-        spec = case_from_dict(document, source=str(out))
-    except InputError:
+    spec = quiet_spec(document, str(out))
+    if spec is None:
         return None, ""
     summary, why = reusable_summary(out, spec, base)
     return (outcome_of(summary), "") if summary is not None else (None, why)

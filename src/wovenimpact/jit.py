@@ -135,11 +135,23 @@ def capped_threads(n: int, source: str = "threads") -> int:
     return n
 
 
+KEPT_CONFIG = ("CACHE_DIR", "THREADING_LAYER_PRIORITY", "THREADING_LAYER")
+
+
 def _limit_threads(n: int) -> None:
     """Process-pool initializer: only ``n`` Numba threads exist in this worker, and the
-    worker ends itself when its parent is gone (:func:`_watch_parent`)."""
+    worker ends itself when its parent is gone (:func:`_watch_parent`).
+
+    ``reload_config`` rereads every setting from the environment: without restoring them,
+    a worker lost the cache directory keyed on the kernel sources (set at import, above)
+    and loaded Numba's per-file ``__pycache__`` entries, which can hold a kernel compiled
+    against an older inlined callee — pool workers could compute with other code than
+    the parent (a likely cause of the 5e-9 pool/Dask difference of issue 13's test)."""
+    kept = {key: getattr(numba.config, key) for key in KEPT_CONFIG}
     os.environ["NUMBA_NUM_THREADS"] = str(n)
     numba.config.reload_config()
+    for key, value in kept.items():
+        setattr(numba.config, key, value)
     threading.Thread(target=_watch_parent, args=(os.getppid(),), daemon=True,
                      name="wovenimpact-parent-watchdog").start()
 

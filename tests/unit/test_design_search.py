@@ -126,3 +126,33 @@ def test_run_one_reports_a_failing_pack_instead_of_raising(tmp_path):
     result = _run_one(doc, str(case.parent), str(tmp_path / "p"))
     assert result.startswith("failed: InputError") and "mesh.element_size" in result
     assert "mesh.element_size" in (tmp_path / "p" / "error.txt").read_text()
+
+
+def test_design_on_a_containment_case_searches_the_casing_layers(tmp_path, monkeypatch):
+    """On a containment case N is mesh.casing.layers, ``contained`` counts as held and
+    ``escaped`` as through; the answer carries the casing mass of the answer's run
+    (inner shell counted, as its summary reports it)."""
+    import json
+
+    from wovenimpact.studies import design
+
+    def run_batch(docs, base, dirs, workers):
+        out = []
+        for d, where in zip(docs, dirs):
+            n = d["mesh"]["casing"]["layers"]
+            assert "plies" not in d["mesh"]
+            Path(where).mkdir(parents=True, exist_ok=True)
+            (Path(where) / "summary.json").write_text(json.dumps(
+                {"casing_mass_kg": 1.0 + 0.1 * n, "casing_mass_per_area_kg_per_m2": 2.0 * n}))
+            out.append("contained" if n >= 7 else "escaped")
+        return out
+
+    monkeypatch.setattr(design, "_run_batch", run_batch)
+    case = ROOT / "examples" / "containment" / "hybrid_4.toml"
+    result = design.design_plies(case, tmp_path)
+    assert result["layers_to_contain"] == 7
+    assert result["casing_mass_kg"] == pytest.approx(1.7)
+    assert result["runs"]["6"] == "escaped" and result["runs"]["7"] == "contained"
+    assert result["warning"] == ""
+    text = design.monotonic_warning(7, {7: True, 9: False}, "layers", "contain the fragment")
+    assert text.startswith("9 layers did not contain the fragment although 7 did")

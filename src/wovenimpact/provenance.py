@@ -12,10 +12,11 @@ Every summary.json carries ``provenance`` (:func:`provenance`):
   search reuse a finished run only when its ``digest`` equals the one the case would
   have now; anything else runs again, and the reason is said.
 
-:func:`restart_parts` are the same with ``run.end_time``, ``run.threads`` and the output
-intervals left out (a restart may run a case further or shorter, on other threads, with
-other output intervals: none changes the steps it replays, and the checkpoint counts the
-rows and frames already written); a checkpoint stores them and their digest, and
+:func:`restart_parts` are the same with ``run.end_time``, ``run.threads``, the output
+intervals and ``run.energy_tolerance`` left out (a restart may run a case further or
+shorter, on other threads, with other output intervals or verdict: none changes the
+steps it replays, and the checkpoint counts the rows and frames already written); a
+checkpoint stores them and their digest, and
 ``--restart`` refuses a checkpoint written for another case, material, mesh or code,
 naming which.
 """
@@ -31,7 +32,7 @@ from wovenimpact.errors import InputError
 
 PACKAGE = Path(__file__).resolve().parent
 RESTART_FREE = ("end_time", "threads", "field_interval", "history_interval",
-                "checkpoint_interval")  # [run] keys a restart may change
+                "checkpoint_interval", "energy_tolerance")  # [run] keys a restart may change
 
 
 @functools.lru_cache(maxsize=1)
@@ -94,7 +95,7 @@ def provenance(spec, base: str | Path) -> dict:
 
 def restart_parts(spec, base: str | Path) -> dict:
     """What a checkpoint must have been written for to be resumed: :func:`provenance`'s
-    parts without ``run.end_time``, ``run.threads`` and the output intervals (``case``,
+    parts without the ``[run]`` keys of :data:`RESTART_FREE` (``case``,
     ``files``, ``code_version``, ``source_digest``; a refused restart says which one
     changed)."""
     base = Path(base)

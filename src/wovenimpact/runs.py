@@ -316,7 +316,7 @@ def resume(out: Path, model, digest: str, parts: dict, end_time: float):
         raise InputError(f"--restart: checkpoint {last} was written before a change of {what} "
                          f"(provenance digest differs){hint}")
     state = load_checkpoint(last, digest)
-    if state.t > end_time:
+    if state.t - state.dt >= end_time:  # this run would have ended steps before it
         raise InputError(f"--restart: checkpoint {last} is at t = {state.t!r} s, past "
                          f"run.end_time = {end_time!r} s; give run.end_time ≥ {state.t!r} s"
                          f"{hint}")

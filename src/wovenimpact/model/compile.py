@@ -17,6 +17,7 @@ import numpy as np
 
 from wovenimpact.errors import InputError
 from wovenimpact.model.abaqus import read_inp
+from wovenimpact.model.gmsh import read_msh
 from wovenimpact.model.mesh import Mesh, plate_mesh
 from wovenimpact.impactor import Impactor
 from wovenimpact.kernels import rigid_body as RB
@@ -31,7 +32,7 @@ from wovenimpact.model.model import (
 )
 from wovenimpact.spec.case import (
     DOFS,
-    AbaqusMeshSpec,
+    ImportedMeshSpec,
     CaseSpec,
     ContainmentMeshSpec,
     PlateMeshSpec,
@@ -100,11 +101,12 @@ def make_mesh(spec: CaseSpec, base: Path) -> tuple[Mesh, list[str]]:
         mesh = plate_mesh(m.side, m.element_size, plies=m.plies, spacing=m.spacing or 0.0,
                           quarter=m.quarter)
         return mesh, [m.section] * mesh.n_elems
-    assert isinstance(m, AbaqusMeshSpec)
+    assert isinstance(m, ImportedMeshSpec)
     path = (base / m.file).resolve()
     if not path.is_file():
         raise InputError(f"mesh.file: {m.file!r} not found (looked for {path})")
-    mesh = read_inp(path)
+    mesh = read_inp(path) if m.kind == "abaqus" else read_msh(path)
+    mesh.nodes *= m.length_unit
     names: list[str | None] = [None] * mesh.n_elems
     for elset, section in m.sections.items():
         if elset not in mesh.elem_sets:
@@ -310,6 +312,8 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         mesh, elem_sections, warp = containment_mesh(spec.mesh, sections)
     else:
         mesh, elem_sections = make_mesh(spec, base)
+        if isinstance(warp, str):  # "circumferential" (an imported casing)
+            warp = circumferential_directions(mesh, spec.mesh.axis)
     bcs = BoundaryConditions(mesh.n_nodes, ramp_time=spec.amplitude.ramp_time)
     for i, b in enumerate(spec.boundary):
         nodes = node_set(mesh, b.nodes, f"boundary[{i}].nodes")

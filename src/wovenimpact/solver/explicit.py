@@ -238,7 +238,7 @@ def first_step_work_correction(model, state: State) -> None:
     difference, ¼ Δt^{1/2} f⁰ · (v^{1/2} − v⁰) = ⅛ (Δt^{1/2})² f⁰ · M⁻¹ f⁰_net for each
     force (internal, external, contact on the nodes), is taken off the work here, once,
     in the step from x¹ to x², while ``state.f_int``/``f_ext``/``f_contact`` still hold
-    the forces at x⁰ (docs/theory.md §3, "first step"). Without it a plate starting at
+    the forces at x⁰ (docs/theory.md §5, "First step"). Without it a plate starting at
     rest under gravity reports a balance error of 25 % of the (tiny) energies of its
     first steps, and a prescribed velocity switched on at t = 0 books twice the kinetic
     energy it gives its nodes (m v² for ½ m v²)."""
@@ -296,7 +296,7 @@ def energy_balance(model, state: State) -> dict[str, float]:
     energy are left out on purpose: in a run that keeps its balance each is at most the
     energy put in (W_int, contact energy ≥ 0), and in one that does not they are what
     blows up — normalising by them let a section 1 m thick whose internal work went to
-    −9e10 J from 5 mJ report 0.12 instead of 2e12 (docs/theory.md §3).
+    −9e10 J from 5 mJ report 0.12 instead of 2e12 (docs/theory.md §5).
     ``error_fraction`` here is |drift| / ``scale_J`` of this state alone.
 
     The internal work is split, each joule once: ``stored_J`` and ``hourglass_J`` are

@@ -25,6 +25,11 @@ from wovenimpact.kernels import j2_layout as J
 from wovenimpact.kernels import shell_layout as S
 
 
+def has_metal(model) -> bool:
+    """The model has a J2 (plastic metal) material."""
+    return bool(np.any(model.mat_kind == S.MAT_J2))
+
+
 def simpson_weights(n_pts: int) -> np.ndarray:
     """w_k of the n-point (odd) Simpson rule on [−t/2, t/2] normalised to Σ w_k = 1;
     [1.0] for a resultant section (n = 1), as ``section_response`` weights its points."""

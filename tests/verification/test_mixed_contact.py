@@ -59,7 +59,7 @@ def momentum_z(model, st) -> float:
 def test_projectile_perforates_metal_then_meets_fabric_momentum_and_energy_booked():
     """The FSP at 600 m/s erodes a ring of aluminium elements and carries on with the
     plug into the plies: momentum along z is conserved to 1e-6 of the projectile's;
-    the energy balance holds to 1 %; the fabric is pushed by the shell–shell contact
+    the energy balance holds to 1e-3; the fabric is pushed by the shell–shell contact
     (metal on fabric) and then by the projectile itself, the metal by the projectile,
     all three forces nonzero; the metal's
     plastic work is a part of the internal work. A node that loses its last element
@@ -97,6 +97,6 @@ def test_projectile_perforates_metal_then_meets_fabric_momentum_and_energy_booke
     assert eroded_metal > 0
     assert shell_on_fabric > 0.0 and body_on_metal > 0.0 and body_on_fabric > 0.0
     assert momentum_z(model, st) + eroded_p == pytest.approx(p0, abs=1e-6 * abs(p0))
-    assert worst < 0.01
+    assert worst < 1e-3
     assert 0.0 < w_p < eb["internal_work_J"]
     assert v_body < 600.0

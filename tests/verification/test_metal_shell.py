@@ -9,7 +9,7 @@ import pytest
 
 from wovenimpact.kernels import j2_layout as J
 from wovenimpact.kernels import shell_layout as S
-from wovenimpact.metal_state import thickness_ratio
+from wovenimpact.metal_state import plastic_work, thickness_ratio
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.spec import load_material
@@ -47,7 +47,8 @@ def test_aluminium_strip_pulled_follows_the_hardening_table_and_books_its_plasti
     every element's membrane stress σ = N/t is the hardening table's at its plastic
     strain (1 %: the table is of the Kirchhoff stress), the points through the
     thickness yield alike (no bending), and the internal work is the elastic stored
-    energy plus the plastic work of the points (1 %), the energy balance holding."""
+    energy plus the plastic work of the points (1 %; metal_state.plastic_work sums the
+    same to 1e-12), the energy balance holding."""
     al, t, n, model, st = pulled_strip(membrane)
     assert model.sections[0, S.C_POINTS] == 5
     width = model.point_width
@@ -66,6 +67,7 @@ def test_aluminium_strip_pulled_follows_the_hardening_table_and_books_its_plasti
     gw = (model.gauss_weight / model.area0[:, None]) if membrane == "full" else np.ones((n, 1))
     plastic = float(np.sum(a0 * gw * np.einsum("egk,k->eg", per_elem[..., J.S_PLASTIC_WORK],
                                                 weights)))
+    assert plastic_work(model, st) == pytest.approx(plastic, rel=1e-12)  # metal_state's sum
     eb = energy_balance(model, st)
     assert eb["stored_J"] + plastic == pytest.approx(eb["internal_work_J"], rel=0.01)
     assert eb["error_fraction"] < 1e-3

@@ -99,17 +99,22 @@ def case_lines(work: Path, figures: Path, log=_quiet) -> list[str]:
                     "(![hybrid coupon](validation/metal_hybrid_coupon_energy.png)).", ""]
 
 
-def ladder_lines(work: Path, workers: int = 1, log=_quiet) -> list[str]:
-    """The perforation ladder and its Lambert–Jonas V50 (runs kept in ``work/studies``)."""
+def ladder_lines(work: Path, workers: int = 1, log=_quiet, element_size: str = "1 mm"
+                 ) -> list[str]:
+    """The perforation ladder with ``element_size`` elements and its Lambert–Jonas V50
+    (runs kept in ``work/studies``; the case's own mesh is 1 mm)."""
     from wovenimpact.studies.ballistics import lambert_jonas_fit, require_decided
     from wovenimpact.studies.sweep import run_study
     from wovenimpact.units import to_si
 
-    log(f"study {LADDER} → {work / 'studies' / LADDER}")
+    name = LADDER if element_size == "1 mm" else f"{LADDER}_{element_size.replace(' ', '')}"
+    log(f"study {name} → {work / 'studies' / name}")
     rows = run_study(ROOT / "examples" / "studies" / f"{LADDER}.toml",
-                     work / "studies" / LADDER, workers=workers)
-    lines = ["### Perforation ladder (examples/studies/metal_perforation_v50.toml)", "",
-             "1 mm Al 2024-T3 (Johnson–Cook, Lesuer 2000), 60 mm square clamped, 1 mm "
+                     work / "studies" / name, workers=workers,
+                     overrides=() if name == LADDER else (f"mesh.element_size={element_size}",))
+    lines = [f"### Perforation ladder, {element_size} elements "
+             "(examples/studies/metal_perforation_v50.toml)", "",
+             f"1 mm Al 2024-T3 (Johnson–Cook, Lesuer 2000), 60 mm square clamped, {element_size} "
              "elements (quarter model), 5 points; rigid blunt steel cylinder 10 mm × 20 mm "
              "(12.3 g).", "", "| velocity | outcome | residual (m/s) | plastic work (J) | "
              "energy error |", "|---|---|---|---|---|"]
@@ -144,7 +149,8 @@ def metal_section(work: str | Path, figures: str | Path, log=_quiet, workers: in
     figures = Path(figures)
     figures.mkdir(parents=True, exist_ok=True)
     return ["## Metal shells (issue 10)", "", *jones_lines(work, figures, log),
-            *case_lines(work, figures, log), *ladder_lines(work, workers, log)]
+            *case_lines(work, figures, log), *ladder_lines(work, workers, log),
+            *ladder_lines(work, workers, log, element_size="0.5 mm")]
 
 
 def main(argv: list[str]) -> None:

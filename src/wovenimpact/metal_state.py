@@ -12,6 +12,8 @@ value — the same quadrature the shell uses for its forces (docs/theory.md §7.
   area) × weights, live and eroded elements alike (an eroded element's points keep
   their state): the energy the metal dissipated plastically, a part of the internal
   work W_int that the balance's ``stored`` does not hold.
+- :func:`max_plastic_strain` (—): the largest equivalent plastic strain ε̄p of an
+  element's points (0 for elements whose material is not J2).
 - :func:`thickness_ratio` (—): t / t0 = Σ_k w_k λ3,k averaged over the in-plane points
   (λ3 = S_THICK, the thickness stretch from plastic incompressibility and the elastic
   plane-stress ε33, eq. J10); 1 for elements whose material is not J2.
@@ -73,4 +75,12 @@ def thickness_ratio(model, state) -> np.ndarray:
     for elems, w_in, w_k, values in _j2_point_values(model, state, J.S_THICK):
         per_point = np.einsum("egk,k->eg", values, w_k)
         out[elems] = np.sum(per_point * w_in, axis=1) / np.sum(w_in, axis=1)
+    return out
+
+
+def max_plastic_strain(model, state) -> np.ndarray:
+    """(n_elems,) the largest ε̄p over each element's points (module docstring)."""
+    out = np.zeros(model.n_elems)
+    for elems, _, _, values in _j2_point_values(model, state, J.S_EPS_P):
+        out[elems] = values.reshape(len(elems), -1).max(axis=1)
     return out

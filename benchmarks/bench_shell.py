@@ -1,7 +1,7 @@
 """``make bench``: the explicit step's cost (see :mod:`wovenimpact.benchmark`).
 
-Options: ``--sizes=10000,100000``, ``--kinds=metal,fabric,fabric_reduced``, ``--threads=1,2``, ``--steps=N``,
-``--json`` (prints {"cases": [{"name", "elements", "threads", "ns_per_element_cycle",
+Options: ``--sizes=10000,100000``, ``--kinds=metal,fabric,fabric_reduced``,
+``--threads=1,2``, ``--steps=N``, ``--json`` (prints {"cases": [{"name", "elements", "threads", "ns_per_element_cycle",
 "shares"}], "machine", "threading_layer"}), ``--no-machine-line`` (``make bench`` prints
 it first). Same as ``wovenimpact bench``.
 """

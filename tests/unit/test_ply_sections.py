@@ -45,7 +45,8 @@ def test_touching_plies_are_stacked_by_their_own_thicknesses():
     ("value", "expect"),
     [
         (["fabric", "plate"], "mesh.ply_sections: has 2 entries"),
-        (["fabric", "fabric", "fabric", "fabric", "steel"], "mesh.ply_sections[4]: names no section"),
+        (["fabric", "fabric", "fabric", "fabric", "steel"],
+         "mesh.ply_sections[4]: names no section"),
     ],
 )
 def test_bad_ply_sections_name_the_key(value, expect):

@@ -1,4 +1,5 @@
-"""``wovenimpact bench``: ns per element-cycle of the explicit step (elastic, metal and fabric plates).
+"""``wovenimpact bench``: ns per element-cycle of the explicit step (elastic, metal and
+fabric plates).
 
 The second of ``make bench``'s three benchmarks (the first is the fabric kernel alone,
 benchmarks/bench_fabric_kernel.py; the third the ply-on-ply contact,

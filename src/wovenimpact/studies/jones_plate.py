@@ -9,10 +9,11 @@ along the edges and the diagonals) and a square yield curve in the (N, M) plane 
 membrane force N0 = σ0 H and the moment M0 = σ0 H²/4 act together on a hinge line,
 D = Σ∫(M0 + N0 w) θ̇ dl): edges 4 × 2L × M0 × Ẇ/L, diagonals 4 × √2 L × (M0 + N0 w̄)
 × √2 Ẇ/L with the mean w̄ = W/2 along them, so the work to reach W is 16 M0 W + 2 N0 W².
-(For the 2L × 2B plate the same steps give the form of Jones's result, W_f/H = (3 − ξ0)(√(1 + Γ) − 1) /
-(2[1 + (ξ0 − 1)(ξ0 − 2)]) with his ξ0 = β(√(3 + β²) − β); for the simply supported
-square, no edge hinges, ½(√(1 + 2λ/3) − 1).) What a single mode cannot say is how much
-of the impulse's kinetic energy 2 μ V0² L² (μ = ρH) it carries; the two limits are
+(For the 2L × 2B plate the same steps give the form of Jones's result,
+W_f/H = (3 − ξ0)(√(1 + Γ) − 1) / (2[1 + (ξ0 − 1)(ξ0 − 2)]) with his ξ0 = β(√(3 + β²) − β);
+for the simply supported square, no edge hinges, ½(√(1 + 2λ/3) − 1).) What a single
+mode cannot say is how much of the impulse's kinetic energy 2 μ V0² L² (μ = ρH) it
+carries; the two limits are
 
     mid-point velocity V0 (Jones's approximate method): E = μ (2L²/3) V0²/2, the
         pyramid's kinetic energy, 1/6 of the impulse's → W_f/H = √(1 + λ/6) − 1;

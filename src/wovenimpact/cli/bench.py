@@ -24,6 +24,9 @@ def bench(
     threads: str = typer.Option(None, help="Thread counts, comma-separated (default: 1 and 2)."),
     steps: int = typer.Option(20, min=1, help="Timed steps per case."),
     as_json: bool = typer.Option(False, "--json", help='Print {"cases": [...]} as one JSON object.'),
+    save_release: bool = typer.Option(False, "--save-release", help="Store this run's figures "
+                                      "in benchmarks/release_figures.json (at a release, on "
+                                      "an idle machine): the next runs print their ratio to it."),
 ) -> None:
     """Time the explicit step on square plates (the machine first); prints ns per
     element-cycle and stage shares. ``make bench`` also times the fabric kernel alone and
@@ -47,3 +50,10 @@ def bench(
                                "threading_layer": numba.threading_layer()}))
     else:
         console.print(f"threading layer: {numba.threading_layer()}", highlight=False)
+    if save_release:
+        from wovenimpact.benchmark import RELEASE_FIGURES, release_figures
+        from wovenimpact.io.atomic import atomic_write_text
+
+        atomic_write_text(RELEASE_FIGURES, json.dumps(release_figures(cases), indent=2) + "\n")
+        if not as_json:
+            console.print(f"release figures written to {RELEASE_FIGURES}", highlight=False)

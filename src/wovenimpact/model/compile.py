@@ -17,6 +17,7 @@ import numpy as np
 
 from wovenimpact.errors import InputError
 from wovenimpact.model.abaqus import read_inp
+from wovenimpact.model.gmsh import read_msh
 from wovenimpact.model.mesh import Mesh, plate_mesh
 from wovenimpact.impactor import Impactor
 from wovenimpact.kernels import rigid_body as RB
@@ -31,7 +32,7 @@ from wovenimpact.model.model import (
 )
 from wovenimpact.spec.case import (
     DOFS,
-    AbaqusMeshSpec,
+    ImportedMeshSpec,
     CaseSpec,
     ContainmentMeshSpec,
     PlateMeshSpec,
@@ -112,11 +113,12 @@ def make_mesh(spec: CaseSpec, base: Path, sections: dict | None = None
         if thick is not None:
             stack_plies(mesh, thick)
         return mesh, [m.ply_sections[k] for k in mesh.ply]
-    assert isinstance(m, AbaqusMeshSpec)
+    assert isinstance(m, ImportedMeshSpec)
     path = (base / m.file).resolve()
     if not path.is_file():
         raise InputError(f"mesh.file: {m.file!r} not found (looked for {path})")
-    mesh = read_inp(path)
+    mesh = read_inp(path) if m.kind == "abaqus" else read_msh(path)
+    mesh.nodes *= m.length_unit
     names: list[str | None] = [None] * mesh.n_elems
     for elset, section in m.sections.items():
         if elset not in mesh.elem_sets:
@@ -211,7 +213,7 @@ def check_impactor_clearance(model: Model) -> None:
         prof = model.body_profiles[b, : int(p[RB.BP_NPTS])]
         # k = 1 N/m per node: energy ½ g², no dashpot
         rigid_contact_forces(model.x0, np.zeros((n, 3)), np.ones(n, np.int8), np.ones(n),
-                             model.node_offset, 1.0, 0.0, 0.0, 1.0, tip, axis, zero, zero, zero,
+                             model.node_offset, 1.0, 0.0, 0.0, 1.0, 1.0, tip, axis, zero, zero, zero,
                              np.ascontiguousarray(prof[:, 0]), np.ascontiguousarray(prof[:, 1]),
                              p[RB.BP_REACH] + float(model.node_offset.max()), force, energy)
         bad = np.flatnonzero(energy > 0.0)
@@ -331,6 +333,8 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         mesh, elem_sections, warp = containment_mesh(spec.mesh, sections)
     else:
         mesh, elem_sections = make_mesh(spec, base, sections)
+        if isinstance(warp, str):  # "circumferential" (an imported casing)
+            warp = circumferential_directions(mesh, spec.mesh.axis)
     bcs = BoundaryConditions(mesh.n_nodes, ramp_time=spec.amplitude.ramp_time)
     for i, b in enumerate(spec.boundary):
         nodes = node_set(mesh, b.nodes, f"boundary[{i}].nodes")

@@ -24,8 +24,9 @@ Schema (see README and examples/cases/)::
                       membrane? ("full": 2×2 in-plane points, fabric default;
                       "reduced": one point + hourglass springs, metal default)
     [mesh]            kind = "plate": side, element_size, plies, spacing, quarter,
-                      section, warp_direction   | kind = "abaqus": file, sections
-                      = {ELSET = SECTION}, warp_direction
+                      section, warp_direction   | kind = "abaqus" | "gmsh": file,
+                      sections = {ELSET = SECTION}, length_unit?, warp_direction?
+                      (vector | "circumferential"), axis?
     [[boundary]]      nodes = SET, type = clamped | pinned | symmetry_x | symmetry_y |
                       symmetry_z | velocity (with dof and velocity)
                       | kind = "containment": element_size, [mesh.casing] (inner_radius,
@@ -40,7 +41,7 @@ Schema (see README and examples/cases/)::
     [body_force]      acceleration = [ax, ay, az]
     [impactor]        shape = sphere | cylinder, radius, length, nose, nose_length, fillet,
                       density | mass, position (nose tip), direction, velocity,
-                      contact_stiffness (penalty factor β of k = β m / Δt²),
+                      contact_stiffness (penalty factor β of k = β m / Δt²; 0.3),
                       contact_damping (ζ, fraction of critical; 1), friction (μ; 0)
     [contact]         shell–shell contact: surfaces = plies | parts | element_sets |
                       none, self_contact, penalty_scale (β; 0.1), damping (ζ; 0.3),
@@ -62,6 +63,7 @@ from typing import Annotated, Any, Literal
 from pydantic import AfterValidator, BaseModel, Field, ValidationError, model_validator
 
 from wovenimpact.errors import InputError, InputWarning
+from wovenimpact.impactor import BODY_PENALTY_SCALE
 from wovenimpact.spec.fields import (
     STRICT,
     Problem,
@@ -135,14 +137,24 @@ class PlateMeshSpec(BaseModel):
     warp_direction: Direction = (1.0, 0.0, 0.0)
 
 
-class AbaqusMeshSpec(BaseModel):
-    """``[mesh] kind = "abaqus"``: nodes, shell elements and sets from an ``.inp`` file."""
+class ImportedMeshSpec(BaseModel):
+    """``[mesh] kind = "abaqus"`` (an ``.inp`` file) or ``"gmsh"`` (a ``.msh`` file):
+    nodes, shell elements and sets read through meshio. ``length_unit`` is the length
+    of one coordinate unit of the file ("1 mm" for a mesh drawn in millimetres; default
+    1 m). ``warp_direction`` is a vector projected on each element, or
+    ``"circumferential"``: the hoop direction about ``axis`` (through the origin), the
+    warp of a fabric wrapped on a cylinder (a casing)."""
 
     model_config = STRICT
-    kind: Literal["abaqus"]
+    kind: Literal["abaqus", "gmsh"]
     file: str = Field(min_length=1)
     sections: dict[str, str] = Field(min_length=1)  # element set → section name
-    warp_direction: Direction = (1.0, 0.0, 0.0)
+    length_unit: quantity("length", gt=0, example="1 mm") = 1.0
+    warp_direction: Direction | Literal["circumferential"] = (1.0, 0.0, 0.0)
+    axis: Direction = (0.0, 0.0, 1.0)
+
+
+AbaqusMeshSpec = ImportedMeshSpec  # the name of the table before gmsh files were read
 
 
 Angle = quantity("angle", example="90 deg")
@@ -297,7 +309,8 @@ class ImpactorSpec(BaseModel):
     position: tuple[Coordinate, Coordinate, Coordinate]
     direction: Direction = (0.0, 0.0, -1.0)
     velocity: quantity("velocity", gt=0, example="120 m/s")
-    contact_stiffness: quantity("dimensionless", gt=0, le=0.5, example="0.1") = 0.1
+    contact_stiffness: quantity("dimensionless", gt=0, le=0.5,
+                                 example="0.3") = BODY_PENALTY_SCALE
     # dashpot of each node–body pair, a fraction of critical 2 √(k m): 1 makes a struck
     # node come to rest on the face (plastic impact) instead of leaving at twice its speed
     contact_damping: quantity("dimensionless", ge=0, le=2, example="1") = 1.0
@@ -355,7 +368,7 @@ class CaseSpec(BaseModel):
     case: CaseInfo
     materials: dict[str, str | MaterialRef] = Field(min_length=1)
     sections: dict[str, SectionSpec] = Field(min_length=1)
-    mesh: PlateMeshSpec | AbaqusMeshSpec | ContainmentMeshSpec = Field(discriminator="kind")
+    mesh: PlateMeshSpec | ImportedMeshSpec | ContainmentMeshSpec = Field(discriminator="kind")
     boundary: list[BoundarySpec] = []
     amplitude: AmplitudeSpec = AmplitudeSpec()
     initial_velocity: list[InitialVelocitySpec] = []
@@ -372,7 +385,7 @@ def mesh_sections(mesh) -> list[tuple[str, str]]:
     if isinstance(mesh, PlateMeshSpec):
         return [("mesh.section", mesh.section)] + [
             (f"mesh.ply_sections[{k}]", s) for k, s in enumerate(mesh.ply_sections or ())]
-    if isinstance(mesh, AbaqusMeshSpec):
+    if isinstance(mesh, ImportedMeshSpec):
         return [("mesh.sections", s) for s in mesh.sections.values()]
     out = [("mesh.casing.layer_section", mesh.casing.layer_section),
            ("mesh.blade.section", mesh.blade.section)]
@@ -457,7 +470,7 @@ def warn_missing_symmetry(spec: CaseSpec, source: str = "<dict>") -> None:
 
 def _without_mesh_kind(p: Problem) -> Problem:
     """``mesh.plate.side`` → ``mesh.side``: the kind selects the table, it is not a key."""
-    for kind in ("plate", "abaqus", "containment"):
+    for kind in ("plate", "abaqus", "gmsh", "containment"):
         if p.path.startswith(f"mesh.{kind}."):
             return dataclasses.replace(p, path="mesh." + p.path[len(kind) + 6:])
     return p

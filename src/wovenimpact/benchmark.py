@@ -7,8 +7,9 @@ the crossover solve does real work) and set moving with a smooth transverse velo
 field, is stepped with one thread and with two. Prints one line per case with the
 share of time per stage; ``--json`` prints {"cases": [{"name", "elements", "threads",
 "ns_per_element_cycle", "shares"}]}. ``--sizes=10000,100000`` chooses plate sizes,
-``--kinds=fabric,fabric_reduced`` the plates (``fabric_reduced``: the one-point membrane
-with hourglass springs, for the cost of the 2×2 one), ``--threads=2`` the thread counts and ``--steps=N`` the
+``--kinds=metal,fabric,fabric_reduced`` the plates (``metal``: a J2 aluminium plate at 5
+points through the thickness; ``fabric_reduced``: the one-point membrane with hourglass
+springs, for the cost of the 2×2 one), ``--threads=2`` the thread counts and ``--steps=N`` the
 timed steps per case (20). The threading layer is printed first (``NUMBA_THREADING_LAYER``
 overrides the default of :mod:`wovenimpact.jit`). Each case also reports the memory per
 element (the model's, state's and workspace's arrays), its ratio to the elastic plate of
@@ -27,6 +28,7 @@ import numpy as np
 
 from pathlib import Path
 
+from wovenimpact.errors import InputError
 from wovenimpact.jit import set_threads
 from wovenimpact.materials.metal import MetalParameters
 from wovenimpact.model import BoundaryConditions, Section, build_model
@@ -36,10 +38,19 @@ from wovenimpact.spec import load_material
 from wovenimpact.state import initial_state
 
 DEFAULT_SIZES = (10_000, 100_000, 400_000)
-REFERENCE_FABRIC = Path(__file__).resolve().parents[2] / "examples" / "materials" / "kevlar_thesis.toml"
+MATERIALS = Path(__file__).resolve().parents[2] / "examples" / "materials"
+REFERENCE_FABRIC = MATERIALS / "kevlar_thesis.toml"
+REFERENCE_METAL = MATERIALS / "aluminium.toml"
+# elastic: 1 mm steel, resultant section; metal: 1 mm of the thesis aluminium, J2 at 5
+# Simpson points, one-point membrane (its defaults); fabric(_reduced): the thesis Kevlar
+KINDS = ("elastic", "metal", "fabric", "fabric_reduced")
 
 
 def plate_model(kind: str, n_elements: int):
+    """The benchmark plate of ``kind`` (one of :data:`KINDS`) with about ``n_elements``;
+    the 2 % pre-stretch yields a metal plate, so its points do plastic returns."""
+    if kind not in KINDS:
+        raise InputError(f"bench kind {kind!r}; valid: {', '.join(KINDS)}")
     per_edge = int(round(math.sqrt(n_elements)))
     size = 0.94e-3
     mesh = plate_mesh(per_edge * size, size)
@@ -47,6 +58,8 @@ def plate_model(kind: str, n_elements: int):
         fabric = load_material(REFERENCE_FABRIC)
         sec = Section(fabric, bending_modulus=1e9, transverse_shear_modulus=3.28e9,
                       membrane="reduced" if kind == "fabric_reduced" else "full")
+    elif kind == "metal":
+        sec = Section(load_material(REFERENCE_METAL), thickness=1e-3)
     else:
         steel = MetalParameters(name="steel", kind="elastic", density=7850.0, modulus=210e9,
                                 poisson=0.3)

@@ -1,4 +1,5 @@
-"""``wovenimpact bench``: ns per element-cycle of the explicit step (elastic and fabric plates).
+"""``wovenimpact bench``: ns per element-cycle of the explicit step (elastic, metal and
+fabric plates).
 
 The second of ``make bench``'s three benchmarks (the first is the fabric kernel alone,
 benchmarks/bench_fabric_kernel.py; the third the ply-on-ply contact,
@@ -12,13 +13,14 @@ import json
 import numba
 import typer
 
-from wovenimpact.cli.app import app, console
+from wovenimpact.cli.app import app, console, fail
 
 
 @app.command("bench")
 def bench(
     sizes: str = typer.Option("10000,100000,400000", help="Plate sizes (elements), comma-separated."),
-    kinds: str = typer.Option("elastic,fabric", help="Plates to run: elastic, fabric."),
+    kinds: str = typer.Option("elastic,metal,fabric",
+                             help="Plates to run: elastic, metal, fabric, fabric_reduced."),
     threads: str = typer.Option(None, help="Thread counts, comma-separated (default: 1 and 2)."),
     steps: int = typer.Option(20, min=1, help="Timed steps per case."),
     as_json: bool = typer.Option(False, "--json", help='Print {"cases": [...]} as one JSON object.'),
@@ -29,12 +31,15 @@ def bench(
     """Time the explicit step on square plates (the machine first); prints ns per
     element-cycle and stage shares. ``make bench`` also times the fabric kernel alone and
     the ply-on-ply contact."""
-    from wovenimpact.benchmark import case_line, machine, machine_line, run_cases
+    from wovenimpact.benchmark import KINDS, case_line, machine, machine_line, run_cases
 
     from wovenimpact.jit import capped_threads
 
     counts = (list(dict.fromkeys(capped_threads(int(t), "--threads") for t in threads.split(",")))
               if threads else sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)}))
+    bad = [k for k in kinds.split(",") if k not in KINDS]
+    if bad:
+        fail(f"--kinds: bench kind {bad[0]!r}; valid: {', '.join(KINDS)}")
     if not as_json:
         console.print(machine_line(), highlight=False, soft_wrap=True)
     cases = run_cases(kinds.split(","), [int(s) for s in sizes.split(",")], counts, steps,

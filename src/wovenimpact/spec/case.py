@@ -131,6 +131,9 @@ class PlateMeshSpec(BaseModel):
     spacing: Length | None = None
     quarter: bool = False
     section: str = Field(min_length=1)
+    # a section per ply from the lowest (z = 0) up, e.g. fabric plies behind a metal
+    # plate; without spacing the plies then touch: mid-planes (t_k + t_k+1)/2 apart
+    ply_sections: list[str] | None = None
     warp_direction: Direction = (1.0, 0.0, 0.0)
 
 
@@ -384,7 +387,8 @@ class CaseSpec(BaseModel):
 def mesh_sections(mesh) -> list[tuple[str, str]]:
     """(key, section name) of every section the mesh table names."""
     if isinstance(mesh, PlateMeshSpec):
-        return [("mesh.section", mesh.section)]
+        return [("mesh.section", mesh.section)] + [
+            (f"mesh.ply_sections[{k}]", s) for k, s in enumerate(mesh.ply_sections or ())]
     if isinstance(mesh, ImportedMeshSpec):
         return [("mesh.sections", s) for s in mesh.sections.values()]
     out = [("mesh.casing.layer_section", mesh.casing.layer_section),
@@ -407,9 +411,17 @@ def check_references(spec: CaseSpec) -> list[Problem]:
     if isinstance(spec.mesh, ContainmentMeshSpec) and spec.spin is None:
         problems.append(Problem("spin", "is missing", valid="a [spin] table (rate, "
                                 "release_time) for a containment case"))
-    if isinstance(spec.mesh, PlateMeshSpec) and spec.mesh.plies > 1 and spec.mesh.spacing is None:
+    plate = isinstance(spec.mesh, PlateMeshSpec)
+    if plate and spec.mesh.ply_sections is not None and (
+            len(spec.mesh.ply_sections) != spec.mesh.plies):
+        problems.append(Problem("mesh.ply_sections", f"has {len(spec.mesh.ply_sections)} "
+                                "entries", spec.mesh.ply_sections,
+                                f"one section per ply ({spec.mesh.plies}), lowest first"))
+    if (plate and spec.mesh.plies > 1 and spec.mesh.spacing is None
+            and spec.mesh.ply_sections is None):
         problems.append(Problem("mesh.spacing", "is missing", valid="the distance between ply "
-                                "mid-planes, e.g. '0.5 mm', needed when plies > 1"))
+                                "mid-planes, e.g. '0.5 mm', needed when plies > 1 "
+                                "(or ply_sections: touching plies)"))
     return problems
 
 

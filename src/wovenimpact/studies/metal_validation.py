@@ -72,7 +72,8 @@ def jones_lines(work: Path, figures: Path, log=_quiet) -> list[str]:
 
 def case_lines(work: Path, figures: Path, log=_quiet) -> list[str]:
     """The examples of examples/metal_impact/ (summaries cached in ``work/cases``)."""
-    from wovenimpact.runs import SUMMARY_VERSION, run_case
+    from wovenimpact.runs import reusable_summary, run_case
+    from wovenimpact.spec.case import load_case
 
     lines = ["### Examples (examples/metal_impact/)", "",
              "| case | outcome | residual (m/s) | absorbed (J) | plastic work (J) | eroded "
@@ -80,11 +81,11 @@ def case_lines(work: Path, figures: Path, log=_quiet) -> list[str]:
              "|---|---|---|---|---|---|---|---|---|"]
     for name in METAL_CASES:
         out = work / "cases" / name
-        path = out / "summary.json"
-        s = json.loads(path.read_text()) if path.exists() else {}
-        if s.get("summary_version", 1) < SUMMARY_VERSION:
-            log(f"metal case {name} → {out}")
-            s = run_case(ROOT / "examples" / "metal_impact" / f"{name}.toml", out)
+        case_path = ROOT / "examples" / "metal_impact" / f"{name}.toml"
+        s, why = reusable_summary(out, *load_case(case_path))  # same digest, else run again
+        if s is None:
+            log(f"metal case {name} → {out}" + (f" (run again: {why})" if why else ""))
+            s = run_case(case_path, out)
         hg = s["hourglass_fraction"]
         lines.append(
             f"| {name} | {s['outcome']} | {s['residual_velocity_m_per_s']:.1f} | "

@@ -4,6 +4,7 @@ runs only: an undecided or no-contact run is refused, naming the variant)."""
 from __future__ import annotations
 
 import csv
+import io
 import json
 from pathlib import Path
 
@@ -11,6 +12,7 @@ import typer
 
 from wovenimpact.cli.app import app, emit, fail
 from wovenimpact.errors import InputError
+from wovenimpact.spec.fields import read_text
 from wovenimpact.units import to_si
 
 ballistics_app = typer.Typer(help="Ballistic fits of sweep results.", no_args_is_help=True)
@@ -18,11 +20,12 @@ app.add_typer(ballistics_app, name="ballistics")
 
 
 def _rows(results: Path) -> list[dict]:
+    text = read_text(results, "results file")
     try:
-        with results.open(newline="", encoding="utf-8") as fh:
-            rows = [r for r in csv.DictReader(fh) if r.get("status") == "done"]
-    except OSError as err:
-        raise InputError(f"{results}: cannot read ({err.strerror})") from None
+        rows = [r for r in csv.DictReader(io.StringIO(text, newline=""))
+                if r.get("status") == "done"]
+    except csv.Error as err:
+        raise InputError(f"{results}: not a readable CSV file ({err})") from None
     if not rows or "residual_velocity_m_per_s" not in rows[0]:
         raise InputError(f"{results}: no finished runs with residual_velocity_m_per_s "
                          "(list it in the study's metrics)")

@@ -100,9 +100,11 @@ def element_test(
     from wovenimpact.materials.fabric import FabricParameters
     from wovenimpact.materials.metal import MetalParameters
     from wovenimpact.spec import load_material
+    from wovenimpact.io.outdir import prepare_output_dir
     from wovenimpact.units import to_si
 
     try:
+        prepare_output_dir(out)
         params = load_material(material)
         if isinstance(params, MetalParameters):
             fabric_only = dict(displacement=displacement, homogenisation=homogenisation,
@@ -178,7 +180,17 @@ def element_test(
 
 
 def _write_outputs(out: Path, result, write_csv, plot, test: Test, as_json: bool) -> None:
-    """history.csv, the figures and summary.json into ``out``; print the summary."""
+    """history.csv, the figures and summary.json into ``out``; print the summary (a
+    failed write, e.g. a full disk, is a one-line error)."""
+    from wovenimpact.io.outdir import write_failure
+
+    try:
+        _write_files(out, result, write_csv, plot, test, as_json)
+    except OSError as err:
+        fail(write_failure(err, f"the element test into {out}"))
+
+
+def _write_files(out: Path, result, write_csv, plot, test: Test, as_json: bool) -> None:
     out.mkdir(parents=True, exist_ok=True)
     csv_path = write_csv(result, out / "history.csv")
     figures = plot(result, out)

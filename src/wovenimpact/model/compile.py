@@ -18,6 +18,7 @@ import numpy as np
 from wovenimpact.errors import InputError
 from wovenimpact.model.abaqus import read_inp
 from wovenimpact.model.mesh import Mesh, plate_mesh
+from wovenimpact.model.sanity import check_case
 from wovenimpact.impactor import Impactor
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels.contact_rigid import rigid_contact_forces
@@ -383,6 +384,7 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     w[model.bc_code[:, 3:] == 1] = 0.0
     check_impactor_clearance(model)
     state = initial_state(model, velocity=v, angular_velocity=w)
+    check_case(spec, model, state, mesh, sections)  # model.sanity: before the expensive parts
     if spin is not None:
         spin_blade(model, state, mesh, sections[spec.mesh.blade.section], spin,
                    spec.spin.relaxation_tolerance, warp)

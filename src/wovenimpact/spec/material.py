@@ -47,6 +47,7 @@ from wovenimpact.spec.fields import (
 WIDTH_TOLERANCE = 1e-3  # width may exceed the yarn pitch by 0.1 %: rounding of printed tables
 LENTICULAR_TOLERANCE = 0.05  # warn if A differs from (2/π)·width·thickness by more than 5 %
 H0_TOLERANCE = 0.01  # warn if a given h0 differs from eq. (5.5) by more than 1 %
+MAX_PITCH_WIDTHS = 10.0  # yarns further apart than 10 widths are not a woven fabric
 PLANE_STRESS_TRIAXIALITY = 2.0 / 3.0  # |η| = |σ_m / σ_eq| ≤ 2/3 in plane stress
 MAX_RATE_RATIO = 1e8  # Johnson–Cook rate terms must stay positive up to ε̇/ε̇0 = 1e8
 
@@ -355,6 +356,7 @@ def _check_fabric(spec: FabricSpec, raw: dict) -> list[Problem]:
                     f"a length ≤ {pitch * (1.0 + WIDTH_TOLERANCE) * 1e3:.6g} mm",
                 )
             )
+    problems += _check_weave_geometry(spec, raw)
     if spec.options.failure == "progressive" and spec.options.softening_strain is None:
         problems.append(
             Problem(
@@ -364,6 +366,54 @@ def _check_fabric(spec: FabricSpec, raw: dict) -> list[Problem]:
                 valid="a dimensionless number > 0 such as 0.01",
             )
         )
+    return problems
+
+
+def _check_weave_geometry(spec: FabricSpec, raw: dict) -> list[Problem]:
+    """A weave the crossover cell can hold (theory: material geometry, docs/inputs.md):
+    each yarn fits in its width × thickness box and is no thicker than wide, yarns lie
+    at most MAX_PITCH_WIDTHS widths apart, the two crimp heights (eq. 5.5, or h0 given)
+    add up to at most the two yarn thicknesses (Peirce: about half of them), and the
+    compaction limit a is at most the two thicknesses."""
+    problems = []
+    t_sum = spec.warp.thickness + spec.fill.thickness
+    heights = 0.0
+    for fam, other in (("warp", "fill"), ("fill", "warp")):
+        y: YarnSpec = getattr(spec, fam)
+        pitch = 1.0 / y.thread_count
+        if y.area > y.width * y.thickness:
+            problems.append(Problem(
+                f"material.{fam}.area", "is larger than the yarn's width × thickness box "
+                f"({y.width * y.thickness * 1e6:.4g} mm^2)", _raw(raw, fam, "area"),
+                f"an area ≤ width × thickness; a lenticular yarn has (2/π)·width·thickness = "
+                f"{2 / math.pi * y.width * y.thickness * 1e6:.4g} mm^2"))
+        if y.thickness > y.width:
+            problems.append(Problem(
+                f"material.{fam}.thickness", f"is larger than the yarn width "
+                f"({y.width * 1e3:.4g} mm): a yarn is flattened by weaving, not upright",
+                _raw(raw, fam, "thickness"), f"a length ≤ width = {y.width * 1e3:.4g} mm"))
+        if pitch > MAX_PITCH_WIDTHS * y.width:
+            problems.append(Problem(
+                f"material.{fam}.thread_count", f"puts the {fam} yarns {pitch * 1e3:.4g} mm "
+                f"apart, more than {MAX_PITCH_WIDTHS:g} yarn widths: an open net, not a woven "
+                "fabric", _raw(raw, fam, "thread_count"),
+                f"a thread count ≥ {1.0 / (MAX_PITCH_WIDTHS * y.width) * 0.0254:.4g} 1/in"))
+        half = half_length_from_thread_count(getattr(spec, other).thread_count)
+        heights += crimp_amplitude(half, y.crimp) if y.h0 is None else y.h0
+    if heights > t_sum:
+        problems.append(Problem(
+            "material.warp.crimp / material.fill.crimp (or h0)",
+            f"give crimp heights h_w0 + h_f0 = {heights * 1e3:.4g} mm (eq. 5.5), more than the "
+            f"two yarn thicknesses {t_sum * 1e3:.4g} mm: the yarns cannot undulate that far "
+            "around each other", {"warp": _raw(raw, "warp", "crimp"),
+                                  "fill": _raw(raw, "fill", "crimp")},
+            f"crimps whose heights add up to at most {t_sum * 1e3:.4g} mm (Peirce's geometry: "
+            f"about half, {t_sum * 0.5e3:.4g} mm; woven fabrics have crimps of a few %)"))
+    if spec.compaction.a > t_sum:
+        problems.append(Problem(
+            "material.compaction.a", f"is larger than the two yarn thicknesses "
+            f"({t_sum * 1e3:.4g} mm) it compacts", _raw(raw, "compaction", "a"),
+            f"a length < {t_sum * 1e3:.4g} mm"))
     return problems
 
 

@@ -115,7 +115,7 @@ IMPACT = {
                  {"nodes": "symmetry_x", "type": "symmetry_x"},
                  {"nodes": "symmetry_y", "type": "symmetry_y"}],
     "impactor": {"shape": "cylinder", "radius": "2.78 mm", "length": "5.72 mm",
-                 "mass": "1.1 g", "position": ["0 mm", "0 mm", "1 mm"],
+                 "mass": "1.1 g", "position": ["0 mm", "0 mm", "0.85 mm"],
                  "direction": [0, 0, -1], "velocity": "120 m/s"},
     "run": {"end_time": "2 us", "history_interval": "0.5 us"},
 }
@@ -496,7 +496,7 @@ def build() -> Corpus:
                                   "run.end_time", "300 us"), "warn"),
         ("moving_away", _set(I, "impactor.direction", [0, 0, 1]), "error"),
         ("sideways", _set(I, "impactor.direction", [1, 0, 0]), "error"),
-        ("off_the_plate", _set(I, "impactor.position", ["50 mm", "50 mm", "1 mm"]), "error"),
+        ("off_the_plate", _set(I, "impactor.position", ["50 mm", "50 mm", "0.85 mm"]), "error"),
         ("mass_1e-20g", _set(I, "impactor.mass", "1e-20 g"), "error"),
         ("mass_1e-9g", _set(I, "impactor.mass", "1e-9 g"), "error"),
         ("mass_1e30kg", _set(I, "impactor.mass", "1e30 kg"), "error"),

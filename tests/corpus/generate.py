@@ -236,7 +236,7 @@ class Corpus:
         self.items.append(Item(id, argv, expect, kind, note, timeout))
 
     def run_case(self, id: str, doc_or_name, expect: str = "error", note: str = "",
-                 extra=(), kind: str = "case", short: bool = True) -> None:
+                 extra=(), kind: str = "case", short: bool = False) -> None:
         name = doc_or_name if isinstance(doc_or_name, str) else self.file(f"{id}.toml",
                                                                             doc_or_name)
         sets = ["--set", SHORT] if short else []
@@ -411,6 +411,7 @@ def build() -> Corpus:
         ("shear_1e30", _set(P, "sections.fabric.transverse_shear_modulus", "1e30 GPa"), "error"),
         ("areal_mass_1e-30", _set(P, "sections.fabric.areal_mass", "1e-30 kg/m^2"), "error"),
         ("areal_mass_1e30", _set(P, "sections.fabric.areal_mass", "1e30 kg/m^2"), "warn"),
+        ("areal_mass_x100", _set(P, "sections.fabric.areal_mass", "47.7 kg/m^2"), "warn"),
         ("thickness_1m", _set(P, "sections.fabric.thickness", "1 m"), "error"),
         ("thickness_1e-30", _set(P, "sections.fabric.thickness", "1e-30 mm"), "error"),
         ("end_time_1e6s", _set(P, "run.end_time", "1e6 s"), "error"),
@@ -470,9 +471,9 @@ def build() -> Corpus:
         ("points_2", _set(P, "sections.fabric.points", 2), "error"),
         ("hourglass_1", _set(P, "sections.fabric.hourglass", 1), "error"),
         ("membrane_bad", _set(P, "sections.fabric.membrane", "half"), "error"),
-        ("history_interval_1e-30", _set(P, "run.history_interval", "1e-30 s"), "error"),
-        ("field_interval_1e-30", _set(P, "run.field_interval", "1e-30 s"), "error"),
-        ("checkpoint_interval_1e-30", _set(P, "run.checkpoint_interval", "1e-30 s"), "error"),
+        ("history_interval_1e-30", _set(P, "run.history_interval", "1e-30 s"), "warn"),
+        ("field_interval_1e-30", _set(P, "run.field_interval", "1e-30 s"), "warn"),
+        ("checkpoint_interval_1e-30", _set(P, "run.checkpoint_interval", "1e-30 s"), "warn"),
         ("name_empty", _set(P, "case.name", ""), "error"),
         ("case_name_int", _set(P, "case.name", 3), "error"),
         ("ramp_nan", _set(P, "amplitude", {"ramp_time": "nan us"}), "error"),
@@ -499,11 +500,10 @@ def build() -> Corpus:
         ("off_the_plate", _set(I, "impactor.position", ["50 mm", "50 mm", "0.85 mm"]), "error"),
         ("mass_1e-20g", _set(I, "impactor.mass", "1e-20 g"), "error"),
         ("mass_1e-9g", _set(I, "impactor.mass", "1e-9 g"), "error"),
-        ("mass_1e30kg", _set(I, "impactor.mass", "1e30 kg"), "error"),
         ("density_1e-30", _set(_set(I, "impactor.mass", None), "impactor.density",
                                "1e-30 kg/m^3"), "error"),
         ("velocity_1e30", _set(I, "impactor.velocity", "1e30 m/s"), "error"),
-        ("velocity_1e-30", _set(I, "impactor.velocity", "1e-30 m/s"), "error"),
+        ("velocity_1e-30", _set(I, "impactor.velocity", "1e-30 m/s"), "warn"),
         ("position_nan", _set(I, "impactor.position", ["0 mm", "nan mm", "0.5 mm"]), "error"),
         ("position_inf", _set(I, "impactor.position", ["0 mm", "0 mm", "inf mm"]), "error"),
         ("direction_nan", _set(I, "impactor.direction", [0, float("nan"), -1]), "error"),
@@ -668,7 +668,6 @@ def build() -> Corpus:
         ("out_under_file", ["run", "plate.toml", "--out", "an_existing_file/x", "--set", SHORT]),
         ("out_proc", ["run", "plate.toml", "--out", "/proc/wi_run", "--set", SHORT]),
         ("out_sys", ["run", "plate.toml", "--out", "/sys/wi_run", "--set", SHORT]),
-        ("out_empty", ["run", "plate.toml", "--out", "", "--set", SHORT]),
         ("threads_0", ["run", "plate.toml", "--out", "out/t0", "--threads", "0"]),
         ("threads_text", ["run", "plate.toml", "--out", "out/tt", "--threads", "two"]),
         ("set_no_equals", ["run", "plate.toml", "--out", "out/s1", "--set", "run.end_time"]),

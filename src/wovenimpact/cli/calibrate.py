@@ -14,6 +14,7 @@ import typer
 
 from wovenimpact.cli.app import calibrate_app, emit, fail
 from wovenimpact.errors import InputError
+from wovenimpact.spec.material import MAX_CRIMP
 
 
 def _fail_input(err: InputError) -> None:
@@ -49,7 +50,7 @@ def crimp(
 
     try:
         n = to_si(thread_count, "inverse_length", "--thread-count", gt=0.0)
-        c = to_si(crimp_value, "dimensionless", "--crimp", ge=0.0)
+        c = to_si(crimp_value, "dimensionless", "--crimp", ge=0.0, le=MAX_CRIMP)
     except InputError as err:
         _fail_input(err)
     result = calibrate_crimp(n, c)

@@ -78,7 +78,8 @@ def element_test(
         "0.001 1/s", "--strain-rate", help="Metal: rate of the applied strain (with unit)."
     ),
     thickness: str = typer.Option("1 mm", help="Metal: reference thickness t0 (with unit)."),
-    steps: int = typer.Option(None, min=1, help="Number of load steps (fabric 600, metal 400)."),
+    steps: int = typer.Option(None, min=1, max=1_000_000,
+                              help="Number of load steps (fabric 600, metal 400)."),
     homogenisation: Homogenisation = typer.Option(None, help="Fabric: override the material's."),
     shear_law: ShearLaw = typer.Option(
         None, "--shear-law", help="Fabric: override the material's."

@@ -178,6 +178,9 @@ def erode_at_start(model: Model, state: State, er, key: str) -> None:
     if not hit.any():
         raise InputError(f"{key}: no element centroid lies within {er.radius:g} m of the axis "
                          "through centre (and in the given plies)")
+    if hit.all():
+        raise InputError(f"{key}: radius {er.radius:g} m erodes every element at t = 0 "
+                         "(valid: a hole smaller than the plies)")
     state.elem[hit, S.E_ALIVE] = 0.0
     live = np.zeros(model.n_nodes, dtype=bool)
     live[model.quads[state.elem[:, S.E_ALIVE] != 0.0].ravel()] = True

@@ -36,6 +36,8 @@ from wovenimpact.kernels import shell_layout as S
 MAX_WAVE_SPEED = 2.0e4  # m/s: above any engineering material's (diamond ~18 km/s)
 MAX_CROSSING = 0.5  # of the smallest element length moved in one step
 MIN_IMPACTOR_MASS_RATIO = 1e-3  # impactor mass / mass of the structure under its face
+MIN_THICKNESS = 1e-6  # m
+MIN_RADIUS_ELEMENTS = 0.1  # impactor radius / largest element edge (thesis study: 2.78/6 mm)
 AREAL_MASS_FACTOR = 10.0  # a section's areal mass this far from its material's is warned of
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 
@@ -82,6 +84,10 @@ def check_step_count(model, state, spec) -> float:
     if not (math.isfinite(dt) and dt > 0.0):
         return dt  # the solver names a non-finite step at the first step
     steps = end_time / dt
+    if steps < 1.0:
+        raise InputError(
+            f"run.end_time = {_text(end_time)} is shorter than the first step (Δt = {dt:.3g} s, "
+            f"element {e}): nothing would be simulated (valid: an end time of several steps)")
     if steps <= max_steps:
         return dt
     length = element_length(model, e)
@@ -130,6 +136,19 @@ def check_motion_per_step(model, state, dt: float, spec) -> None:
                 f"the smallest element ({h:.3g} m) (valid: below {2 * limit / dt**2:.3g} m/s^2)")
 
 
+def warn_output_intervals(spec, dt: float) -> None:
+    """An output interval shorter than the first step writes at every step."""
+    if not (math.isfinite(dt) and dt > 0.0):
+        return
+    for key in ("field_interval", "history_interval", "checkpoint_interval"):
+        value = getattr(spec.run, key)
+        if value is not None and value < dt:
+            warnings.warn(
+                f"run.{key} = {_text(value)} is shorter than the first step (Δt = {dt:.3g} s): "
+                f"an output at every step, about {spec.run.end_time / dt:.3g} of them",
+                InputWarning, stacklevel=3)
+
+
 def check_plies(spec, model) -> None:
     """Plies of a plate whose mid-planes are closer than the shell thickness overlap."""
     from wovenimpact.spec.case import PlateMeshSpec
@@ -146,10 +165,17 @@ def check_plies(spec, model) -> None:
 
 
 def check_thickness(model, spec) -> None:
-    """A section thicker than the whole mesh's largest extent is not a shell."""
+    """A section thicker than the whole mesh's largest extent is not a shell, one
+    thinner than MIN_THICKNESS no structure."""
     extent = float(np.max(np.ptp(model.x0, axis=0))) if model.n_nodes else 0.0
     for sec in np.unique(model.elem_section):
         t = float(model.sections[sec, S.C_THICK])
+        if t < MIN_THICKNESS:
+            e = int(np.flatnonzero(model.elem_section == sec)[0])
+            raise InputError(
+                f"sections: thickness {t:.3g} m is below {MIN_THICKNESS:g} m in "
+                f"{_section_text(model, e, spec)} (valid: a structural shell, foil and "
+                "fabric are 10 µm and thicker)")
         if extent > 0.0 and t > extent:
             e = int(np.flatnonzero(model.elem_section == sec)[0])
             raise InputError(
@@ -218,6 +244,14 @@ def check_impactor(spec, model, state) -> None:
             f"structure: {where} (nose tip at {np.round(tip, 6).tolist()} m, direction "
             f"{np.round(direction, 6).tolist()}) (valid: the nose ahead of the plies, "
             "travelling towards them)")
+    p_face = model.x0[model.quads]
+    h = float(np.linalg.norm(np.roll(p_face, -1, axis=1) - p_face, axis=2).max())
+    if im.radius < MIN_RADIUS_ELEMENTS * h:
+        raise InputError(
+            f"impactor.radius = {im.radius:.3g} m is less than {MIN_RADIUS_ELEMENTS:g} of the "
+            f"largest element edge ({h:.3g} m): a needle between the nodes, which the "
+            f"node-on-body contact cannot see (valid: a radius ≥ {MIN_RADIUS_ELEMENTS * h:.3g} "
+            "m, or a finer mesh)")
     gap = float(ahead[under].min() - model.node_offset[under].max())
     arrival = max(gap, 0.0) / im.velocity
     if arrival > spec.run.end_time:
@@ -260,4 +294,5 @@ def check_case(spec, model, state, mesh, sections) -> None:
     warn_areal_mass(spec, sections)
     check_impactor(spec, model, state)
     dt = check_step_count(model, state, spec)
+    warn_output_intervals(spec, dt)
     check_motion_per_step(model, state, dt, spec)

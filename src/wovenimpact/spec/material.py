@@ -47,6 +47,13 @@ from wovenimpact.spec.fields import (
 WIDTH_TOLERANCE = 1e-3  # width may exceed the yarn pitch by 0.1 %: rounding of printed tables
 LENTICULAR_TOLERANCE = 0.05  # warn if A differs from (2/π)·width·thickness by more than 5 %
 H0_TOLERANCE = 0.01  # warn if a given h0 differs from eq. (5.5) by more than 1 %
+# bounds no real material passes (a unit slip, an extra exponent): stiffer than diamond
+# (1.2 TPa), a fibre lighter than air or denser than osmium (22.6 g/cm³); crimps of
+# woven fabrics are a few % (50 % would be a yarn half again as long as the fabric)
+MAX_MODULUS = 2e12
+MIN_DENSITY = 1.0
+MAX_DENSITY = 1e5
+MAX_CRIMP = 0.5
 MAX_PITCH_WIDTHS = 10.0  # yarns further apart than 10 widths are not a woven fabric
 PLANE_STRESS_TRIAXIALITY = 2.0 / 3.0  # |η| = |σ_m / σ_eq| ≤ 2/3 in plane stress
 MAX_RATE_RATIO = 1e8  # Johnson–Cook rate terms must stay positive up to ε̇/ε̇0 = 1e8
@@ -59,9 +66,9 @@ class YarnSpec(BaseModel):
 
     model_config = STRICT
     thread_count: quantity("inverse_length", gt=0)  # threads per length of THIS family
-    crimp: quantity("dimensionless", ge=0, example="0.0421")
+    crimp: quantity("dimensionless", ge=0, le=MAX_CRIMP, example="0.0421")
     area: quantity("area", gt=0)
-    modulus: quantity("pressure", gt=0)
+    modulus: quantity("pressure", gt=0, le=MAX_MODULUS, example="96 GPa")
     ultimate_tension: quantity("force", gt=0)
     width: quantity("length", gt=0, example="0.9407 mm")
     thickness: quantity("length", gt=0, example="0.2499 mm")
@@ -107,7 +114,7 @@ class FabricSpec(BaseModel):
     model_config = STRICT
     name: str = Field(min_length=1)
     kind: Literal["woven_fabric"]
-    fibre_density: quantity("density", gt=0)
+    fibre_density: quantity("density", ge=MIN_DENSITY, le=MAX_DENSITY, example="1.44 g/cm^3")
     areal_density: quantity("areal_density", gt=0, example="0.477 kg/m^2") | None = None
     thickness: quantity("length", gt=0, example="0.4998 mm") | None = None
     warp: YarnSpec
@@ -167,7 +174,7 @@ class J2Spec(BaseModel):
     name: str = Field(min_length=1)
     kind: Literal["j2_plastic"]
     density: quantity("density", gt=0, example="2.78 g/cm^3")
-    modulus: quantity("pressure", gt=0, example="72 GPa")
+    modulus: quantity("pressure", gt=0, le=MAX_MODULUS, example="72 GPa")
     poisson: quantity("dimensionless", ge=0, lt=0.5, example="0.3")
     plasticity: PlasticitySpec
     rate: RateSpec | None = None
@@ -181,7 +188,7 @@ class ElasticSpec(BaseModel):
     name: str = Field(min_length=1)
     kind: Literal["elastic"]
     density: quantity("density", gt=0, example="2.78 g/cm^3")
-    modulus: quantity("pressure", gt=0, example="72 GPa")
+    modulus: quantity("pressure", gt=0, le=MAX_MODULUS, example="72 GPa")
     poisson: quantity("dimensionless", ge=0, lt=0.5, example="0.3")
 
 

@@ -257,10 +257,13 @@ CONNECT_TIMEOUT = "10s"  # an unreachable scheduler is an error after this, not 
 
 
 def check_scheduler(address: str) -> None:
-    """``--scheduler``: ``scheme://host:port`` (or ``host:port``, TCP) with a port 1–65535;
-    an InputError naming the address and what is valid otherwise."""
+    """``--scheduler``: ``scheme://host:port`` (or ``host:port``, TCP) with a port 1–65535,
+    or an ``inproc://`` address; an InputError naming the address and what is valid
+    otherwise."""
     valid = "valid: the address of a running Dask scheduler, e.g. tcp://host:8786"
     scheme, sep, rest = address.strip().rpartition("://")
+    if scheme == "inproc" and rest:  # a scheduler in this process (tests, notebooks)
+        return
     host, colon, port = rest.rpartition(":")
     if (sep and scheme not in SCHEDULER_SCHEMES) or not colon or not host or " " in rest:
         raise InputError(f"--scheduler {address!r}: not a scheduler address ({valid})")

@@ -20,6 +20,9 @@ from wovenimpact.cli.app import app, emit, fail
 from wovenimpact.errors import InputError, MaterialPointError
 
 
+MAX_STRAIN_RATE = 1e8  # 1/s: the Johnson–Cook rate terms are checked up to this
+
+
 class Test(str, Enum):
     uniaxial = "uniaxial"
     uniaxial_free = "uniaxial-free"
@@ -106,6 +109,15 @@ def element_test(
 
     try:
         prepare_output_dir(out)
+        # every quantity flag is checked, also one the chosen test does not use
+        angle_si = to_si(angle, "angle", "--angle", gt=0, le=math.pi / 2)
+        rate_si = to_si(strain_rate, "strain_rate", "--strain-rate", gt=0, le=MAX_STRAIN_RATE)
+        thickness_si = to_si(thickness, "length", "--thickness", ge=1e-6, le=1.0)
+        disp_si = (None if displacement is None else
+                   to_si(displacement, "length", "--displacement", gt=0))
+        if softening_strain is not None and not 0.0 < softening_strain < 1.0:
+            raise InputError(f"--softening-strain = {softening_strain} is not valid: it must "
+                             "be > 0 and < 1 (e.g. 0.01)")
         params = load_material(material)
         if isinstance(params, MetalParameters):
             fabric_only = dict(displacement=displacement, homogenisation=homogenisation,
@@ -134,8 +146,8 @@ def element_test(
                 test.value,
                 strain=strain,
                 n_steps=400 if steps is None else steps,
-                strain_rate=to_si(strain_rate, "strain_rate", "--strain-rate", gt=0),
-                thickness=to_si(thickness, "length", "--thickness", gt=0),
+                strain_rate=rate_si,
+                thickness=thickness_si,
             )
     except (InputError, ValueError, MaterialPointError) as err:
         fail(str(err))
@@ -170,9 +182,15 @@ def element_test(
                 )
             params = dataclasses.replace(params, options=opts)
         if test.value in ("shear", "picture-frame"):
-            amplitude = to_si(angle, "angle", "--angle")
+            amplitude = angle_si
         else:
-            amplitude = to_si(displacement, "length", "--displacement")
+            amplitude = to_si(displacement, "length", "--displacement") if disp_si is None \
+                else disp_si
+            cell = 2.0 * min(params.warp.half_length, params.fill.half_length)
+            if amplitude > cell:
+                raise InputError(f"--displacement = {displacement!r} is more than the unit "
+                                 f"cell's side 2ℓ0 = {cell * 1e3:.4g} mm (100 % strain; the "
+                                 f"yarns break near 2 %) (valid: up to {cell * 1e3:.4g} mm)")
         result = run_element_test(params, test.value, amplitude=amplitude, n_steps=steps)
     except (InputError, ValueError, MaterialPointError) as err:
         fail(str(err))

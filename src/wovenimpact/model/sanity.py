@@ -37,6 +37,7 @@ MAX_WAVE_SPEED = 2.0e4  # m/s: above any engineering material's (diamond ~18 km/
 MAX_CROSSING = 0.5  # of the smallest element length moved in one step
 MIN_IMPACTOR_MASS_RATIO = 1e-3  # impactor mass / mass of the structure under its face
 MIN_THICKNESS = 1e-6  # m
+MAX_RADIUS_EXTENTS = 10.0  # impactor radius / largest extent of the mesh
 MIN_RADIUS_ELEMENTS = 0.1  # impactor radius / largest element edge (thesis study: 2.78/6 mm)
 AREAL_MASS_FACTOR = 10.0  # a section's areal mass this far from its material's is warned of
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
@@ -244,6 +245,11 @@ def check_impactor(spec, model, state) -> None:
             f"structure: {where} (nose tip at {np.round(tip, 6).tolist()} m, direction "
             f"{np.round(direction, 6).tolist()}) (valid: the nose ahead of the plies, "
             "travelling towards them)")
+    extent = float(np.max(np.ptp(model.x0, axis=0)))
+    if im.radius > MAX_RADIUS_EXTENTS * extent:
+        raise InputError(
+            f"impactor.radius = {im.radius:.3g} m is more than {MAX_RADIUS_EXTENTS:g} times the "
+            f"whole structure ({extent:.3g} m across) (valid: an impactor the mesh resolves)")
     p_face = model.x0[model.quads]
     h = float(np.linalg.norm(np.roll(p_face, -1, axis=1) - p_face, axis=2).max())
     if im.radius < MIN_RADIUS_ELEMENTS * h:

@@ -54,6 +54,8 @@ MAX_MODULUS = 2e12
 MIN_DENSITY = 1.0
 MAX_DENSITY = 1e5
 MAX_CRIMP = 0.5
+MAX_COMPACTION_FORCE = 1e6  # N: b of one crossover (Kevlar: 0.98 N)
+MAX_YIELD_STRAIN = 0.1  # initial yield stress / modulus: metals yield below 1 %
 MAX_PITCH_WIDTHS = 10.0  # yarns further apart than 10 widths are not a woven fabric
 PLANE_STRESS_TRIAXIALITY = 2.0 / 3.0  # |η| = |σ_m / σ_eq| ≤ 2/3 in plane stress
 MAX_RATE_RATIO = 1e8  # Johnson–Cook rate terms must stay positive up to ε̇/ε̇0 = 1e8
@@ -81,7 +83,7 @@ class CompactionSpec(BaseModel):
 
     model_config = STRICT
     a: quantity("length", gt=0, example="0.12389 mm")
-    b: quantity("force", gt=0, example="0.98432 N")
+    b: quantity("force", gt=0, le=MAX_COMPACTION_FORCE, example="0.98432 N")
 
 
 class ShearSpec(BaseModel):
@@ -430,7 +432,8 @@ def _metal_parameters(spec: J2Spec | ElasticSpec, raw: dict, source: str) -> Met
     rate = damage = None
     if isinstance(spec, J2Spec):
         table = spec.plasticity.hardening
-        raise_problems(_check_hardening(table, raw) + _check_damage(spec, raw), source)
+        raise_problems(_check_hardening(table, raw) + _check_damage(spec, raw)
+                       + _check_yield_strain(spec, raw), source)
         hardening = tuple((float(e), float(s)) for e, s in table)
         fracture = spec.plasticity.fracture_strain
         if spec.rate is not None:
@@ -491,6 +494,19 @@ def _check_damage(spec: J2Spec, raw: dict) -> list[Problem]:
             )
         )
     return problems
+
+
+def _check_yield_strain(spec: J2Spec, raw: dict) -> list[Problem]:
+    """The initial yield strain σ_y0 / E at most MAX_YIELD_STRAIN (a stress in the
+    wrong unit, or a modulus too small by orders)."""
+    sy0 = spec.plasticity.hardening[0][1]
+    if sy0 <= MAX_YIELD_STRAIN * spec.modulus:
+        return []
+    return [Problem("material.plasticity.hardening[0][1]", f"gives a yield strain σ_y0/E = "
+                    f"{sy0 / spec.modulus:.3g} (modulus {spec.modulus:.3g} Pa)",
+                    _raw(raw, "plasticity", "hardening")[0][1],
+                    f"a yield stress ≤ {MAX_YIELD_STRAIN:g} E = "
+                    f"{MAX_YIELD_STRAIN * spec.modulus / 1e6:.4g} MPa (metals yield below 1 %)")]
 
 
 def _check_hardening(table: list[tuple[float, float]], raw: dict) -> list[Problem]:

@@ -16,9 +16,6 @@ from wovenimpact.cli.app import app, console, fail
 from wovenimpact.errors import InputError
 
 
-MAX_BENCH_ELEMENTS = 5_000_000  # as spec.case.MAX_ELEMENTS
-
-
 def _counts(text: str, flag: str, low: int, high: int) -> list[int]:
     """A comma-separated list of integers from ``low`` to ``high`` (an InputError else)."""
     out = []
@@ -48,9 +45,10 @@ def bench(
     from wovenimpact.benchmark import case_line, machine, machine_line, run_cases
 
     from wovenimpact.jit import capped_threads
+    from wovenimpact.spec.case import MAX_ELEMENTS
 
     try:
-        size_list = _counts(sizes, "--sizes", 1, MAX_BENCH_ELEMENTS)
+        size_list = _counts(sizes, "--sizes", 1, MAX_ELEMENTS)
         thread_list = _counts(threads, "--threads", 1, 1 << 16) if threads else None
         unknown = [k for k in kinds.split(",") if k not in ("elastic", "fabric")]
         if unknown:

@@ -14,7 +14,6 @@ import typer
 
 from wovenimpact.cli.app import calibrate_app, emit, fail
 from wovenimpact.errors import InputError
-from wovenimpact.spec.material import MAX_CRIMP
 
 
 def _fail_input(err: InputError) -> None:
@@ -46,6 +45,7 @@ def crimp(
 ) -> None:
     """Crimp amplitude h0 of eq. (5.5) and the default shell thickness 4·h0 (Table 5-1)."""
     from wovenimpact.calibration.crimp import calibrate_crimp
+    from wovenimpact.spec.material import MAX_CRIMP
     from wovenimpact.units import to_si
 
     try:

@@ -113,8 +113,6 @@ def element_test(
         angle_si = to_si(angle, "angle", "--angle", gt=0, le=math.pi / 2)
         rate_si = to_si(strain_rate, "strain_rate", "--strain-rate", gt=0, le=MAX_STRAIN_RATE)
         thickness_si = to_si(thickness, "length", "--thickness", ge=1e-6, le=1.0)
-        disp_si = (None if displacement is None else
-                   to_si(displacement, "length", "--displacement", gt=0))
         if softening_strain is not None and not 0.0 < softening_strain < 1.0:
             raise InputError(f"--softening-strain = {softening_strain} is not valid: it must "
                              "be > 0 and < 1 (e.g. 0.01)")
@@ -184,8 +182,7 @@ def element_test(
         if test.value in ("shear", "picture-frame"):
             amplitude = angle_si
         else:
-            amplitude = to_si(displacement, "length", "--displacement") if disp_si is None \
-                else disp_si
+            amplitude = to_si(displacement, "length", "--displacement", gt=0)
             cell = 2.0 * min(params.warp.half_length, params.fill.half_length)
             if amplitude > cell:
                 raise InputError(f"--displacement = {displacement!r} is more than the unit "

@@ -61,3 +61,21 @@ def test_fits_refuse_undecided_and_no_contact_runs_naming_them(tmp_path):
                                       "a,1,done,,82.0\nb,2,done,,58.0\nc,4,done,,18.0\n")
     result = CliRunner().invoke(app, ["ballistics", "plies", str(tmp_path / "old.csv")])
     assert result.exit_code == 2 and "no outcome recorded" in " ".join(result.output.split())
+
+
+def test_plies_regression_of_a_containment_study_uses_the_exit_speed_and_layers(tmp_path):
+    """Thesis eq. 8.2: exit speed V(N) = 130 − 2 N − 0.1 N² of the escaped casings (4, 10,
+    20 layers; 30 and 40 contained) → the root 27.4, so 28 layers contain the fragment."""
+    n = [4, 10, 20, 30, 40]
+    v = [max(0.0, 130.0 - 2.0 * k - 0.1 * k * k) for k in n]
+    lines = ["id,mesh.casing.layers,status,error,outcome,fragment_exit_speed_m_per_s"]
+    lines += [f"x{k},{k},done,,{'escaped' if s > 0 else 'contained'},{s}" for k, s in zip(n, v)]
+    (tmp_path / "c.csv").write_text("\n".join(lines) + "\n")
+    result = CliRunner().invoke(app, ["ballistics", "plies", str(tmp_path / "c.csv"), "--json"])
+    assert result.exit_code == 0, result.output
+    out = json.loads(result.stdout)
+    assert out["layers_to_contain"] == 28 and abs(out["root"] - 27.42) < 0.01
+    assert abs(out["c2"] + 0.1) < 1e-9 and abs(out["c0"] - 130.0) < 1e-6
+    (tmp_path / "u.csv").write_text("\n".join(lines).replace(",contained,", ",undecided,") + "\n")
+    bad = CliRunner().invoke(app, ["ballistics", "plies", str(tmp_path / "u.csv")])
+    assert bad.exit_code == 2 and "mesh.casing.layers = 30" in bad.output

@@ -25,7 +25,9 @@ def test_sphere_distance_is_exact(zeta, rho):
     chord = R * (1 - math.cos(math.pi / 800))  # sagitta of one polyline segment
     assert d == pytest.approx(exact, abs=chord + 1e-15)
     r = math.hypot(zeta - R, rho)
-    if abs(exact) > 10 * chord and r > 0.0:  # at the centre every direction is normal
+    # at the centre every direction is normal; near it the polyline's chord ripple moves
+    # the closest point by an angle ≈ √(2 chord / r): < 1e-2 needs r > 2e4 chord ≈ 0.15 R
+    if abs(exact) > 10 * chord and r > 0.25 * R:
         assert nz == pytest.approx((zeta - R) / r, abs=1e-2)
         assert nr == pytest.approx(rho / r, abs=1e-2)
 
@@ -57,7 +59,8 @@ def test_penalty_force_pushes_nodes_out_along_the_normal():
     zero = np.zeros(3)
     # k = β m / Δt² = 1e6 N/m with β = 1, m = 1 kg, Δt = 1 ms; no dashpot, no friction
     rigid_contact_forces(x, np.zeros((3, 3)), np.ones(3, np.int8), np.ones(3),
-                         np.full(3, 0.25e-3), 1.0, 0.0, 0.0, 1e-3, tip, axis, zero, zero, zero,
+                         np.full(3, 0.25e-3), 1.0, 0.0, 0.0, 1e-3, 1e30, tip, axis, zero, zero,
+                         zero,
                          prof[:, 0], prof[:, 1], 10e-3, force, energy)
     gap = 0.25e-3 - 0.1e-3
     assert force[0] == pytest.approx([0.0, 0.0, 1e6 * gap])
@@ -68,8 +71,9 @@ def test_penalty_force_pushes_nodes_out_along_the_normal():
 
 def test_dashpot_and_friction_act_on_the_velocity_relative_to_the_body():
     """Nodes on the flat face of a body that moves at V = (1, 0, −3) m/s and spins at
-    ω = 50 rad/s about its axis: the dashpot force is −c v_n n with c = 2 ζ √β m/Δt and
-    v_n the normal velocity relative to the body's surface point (V + ω × r); friction
+    ω = 50 rad/s about its axis: the dashpot force is −c v_n n with c = 2 ζ √β m_r/Δt,
+    m_r = m/(1 + m_c/M) the node's mass reduced by the body's recoil (here the body's
+    mass M equals the 2 m in contact: m_r = m/2), and v_n the normal velocity relative to the body's surface point (V + ω × r); friction
     opposes the relative tangential velocity with μ |f_n|, capped at ½ m |v_t|/Δt; the
     penalty energy is ½ k g²."""
     imp = Impactor("cylinder", R, 6e-3)
@@ -85,10 +89,10 @@ def test_dashpot_and_friction_act_on_the_velocity_relative_to_the_body():
     force = np.zeros((2, 3))
     energy = np.zeros(2)
     rigid_contact_forces(x, v, np.ones(2, np.int8), np.full(2, m), np.full(2, 0.25e-3), beta,
-                         zeta, mu, dt, tip, axis, body_v, body_w, centre, prof[:, 0],
+                         zeta, mu, dt, 2.0 * m, tip, axis, body_v, body_w, centre, prof[:, 0],
                          prof[:, 1], 10e-3, force, energy)
     k = beta * m / dt**2
-    c = 2.0 * zeta * np.sqrt(beta) * m / dt
+    c = 2.0 * zeta * np.sqrt(beta) * (m / 2.0) / dt
     gap = 0.25e-3 - 0.1e-3
     n = np.array([0.0, 0.0, 1.0])
     for i in range(2):

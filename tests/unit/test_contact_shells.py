@@ -399,3 +399,61 @@ def test_damped_plies_collide_plastically():
     assert restitution[0] > 0.97
     assert all(a > b for a, b in zip(restitution, restitution[1:]))
     assert abs(restitution[-1]) < 0.01
+
+
+def folded_strip_model(t=0.5e-3, gap=0.55e-3, length=8e-3, width=4e-3, size=1e-3):
+    """One surface folded on itself (a single ply): a bottom arm at z = 0 and a top arm at
+    z = gap over x ∈ [0, length], joined at x = length by a wall one element tall."""
+    nx, ny = round(length / size), round(width / size)
+    xs, ys = np.linspace(0.0, length, nx + 1), np.linspace(0.0, width, ny + 1)
+    grid = [(x, y) for x in xs for y in ys]
+    bottom = np.array([[x, y, 0.0] for x, y in grid])
+    top = np.array([[x, y, gap] for x, y in grid])
+    nodes = np.vstack([bottom, top])
+    idx = np.arange(len(grid)).reshape(nx + 1, ny + 1)
+    arm = np.stack([idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(),
+                    idx[:-1, 1:].ravel()], axis=1)
+    end = idx[-1]
+    wall = np.stack([end[:-1], end[1:], end[1:] + len(grid), end[:-1] + len(grid)], axis=1)
+    quads = np.vstack([arm, arm + len(grid), wall])
+    model = build_model(nodes, quads, {"s": Section(STEEL, thickness=t)},
+                        np.zeros(len(quads), int), ply=np.zeros(len(quads), int),
+                        warp_direction=(0.0, 1.0, 0.0))  # in the arms and the wall
+    return model, np.arange(len(grid)), np.arange(len(grid), 2 * len(grid))
+
+
+@pytest.mark.parametrize("self_contact", [True, False])
+def test_a_folded_surface_meets_itself_only_with_self_contact(self_contact):
+    """A single surface folded into a U whose arms close at ±V (free nodes, no shell
+    forces, ζ = 0): with ``self_contact`` the arms collide through their own surface's
+    non-adjacent segments and rebound at ≈ ∓V, no node away from the fold sinking more
+    than 1 % of the thickness into the other arm; without it the surface has no pairs
+    and the arms sink into each other untouched."""
+    t, V = 0.5e-3, 20.0
+    model, bot, top = folded_strip_model(t=t)
+    contact = ShellContact(model, damping=0.0, self_contact=self_contact,
+                           remove_initial_overlap=False)
+    dt = 2e-8
+    x = model.x0.copy()
+    v = np.zeros_like(x)
+    v[top, 2] = -V
+    v[bot, 2] = V
+    m = model.node_mass[:, None]
+    f = np.zeros_like(x)
+    alive = np.ones(model.n_elems)
+    active = np.ones(model.n_nodes, dtype=np.int8)
+    away = x[top, 0] <= 6e-3  # two elements or more from the fold's wall
+    worst, contacts = np.inf, 0
+    for _ in range(200):
+        x += dt * v
+        _, n_active = contact.forces(x, v, dt, alive, active, f)
+        v += dt * f / m
+        worst = min(worst, (x[top, 2] - x[bot, 2])[away].min() - t)
+        contacts += n_active > 0
+    if self_contact:
+        assert contacts > 0 and n_active == 0  # they met, then parted
+        assert worst > -0.01 * t
+        assert np.all(v[top[away], 2] > 0.9 * V) and np.all(v[bot[away], 2] < -0.9 * V)
+    else:
+        assert contacts == 0 and not f.any()
+        assert np.all(v[top, 2] == -V) and worst < -0.1 * t  # sinking into each other

@@ -91,3 +91,33 @@ def test_design_stops_when_a_pack_is_undecided_even_twice_as_long(tmp_path, monk
     monkeypatch.setattr(design, "_run_batch", run_batch)
     with pytest.raises(InputError, match=r"2 plies: undecided even with twice run.end_time"):
         design.design_plies(ROOT / "examples" / "plate_impact" / "plies1_100.toml", tmp_path)
+
+
+def test_design_on_a_containment_case_searches_the_casing_layers(tmp_path, monkeypatch):
+    """On a containment case N is mesh.casing.layers, ``contained`` counts as held and
+    ``escaped`` as through; the answer carries the casing mass of the answer's run
+    (inner shell counted, as its summary reports it)."""
+    import json
+
+    from wovenimpact.studies import design
+
+    def run_batch(docs, base, dirs, workers):
+        out = []
+        for d, where in zip(docs, dirs):
+            n = d["mesh"]["casing"]["layers"]
+            assert "plies" not in d["mesh"]
+            Path(where).mkdir(parents=True, exist_ok=True)
+            (Path(where) / "summary.json").write_text(json.dumps(
+                {"casing_mass_kg": 1.0 + 0.1 * n, "casing_mass_per_area_kg_per_m2": 2.0 * n}))
+            out.append("contained" if n >= 7 else "escaped")
+        return out
+
+    monkeypatch.setattr(design, "_run_batch", run_batch)
+    case = ROOT / "examples" / "containment" / "hybrid_4.toml"
+    result = design.design_plies(case, tmp_path)
+    assert result["layers_to_contain"] == 7
+    assert result["casing_mass_kg"] == pytest.approx(1.7)
+    assert result["runs"]["6"] == "escaped" and result["runs"]["7"] == "contained"
+    assert result["warning"] == ""
+    text = design.monotonic_warning(7, {7: True, 9: False}, "layers", "contain the fragment")
+    assert text.startswith("9 layers did not contain the fragment although 7 did")

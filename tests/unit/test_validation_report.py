@@ -49,7 +49,34 @@ def test_spread_line_reports_the_extremes():
     rows.append({"status": "failed"})
     line = spread_line(rows)
     assert "2 runs" in line and "23.00–24.50 m/s" in line and "7.500–7.600 J" in line
-    assert "from 25% to 50%" in line
+    assert "from 25.0% to 50.0%" in line
+
+
+def test_the_early_impulse_verdict_follows_the_10_percent_limit():
+    rows = [_row("ref", 100.0, 0.0), _row("fine", 104.0, 0.0, 4.0),
+            _row("full", 100.5, 0.0, 0.5)]
+    rows[1]["delta_impulse"] = 0.099
+    assert "moves by +9.9% from the 0.94 mm" in commentary(CASES, rows)[1]
+    assert "(within 10 %)" in commentary(CASES, rows)[1]
+    rows[1]["delta_impulse"] = -0.101
+    assert "(outside 10 %)" in commentary(CASES, rows)[1]
+
+
+def test_early_impulse_is_the_momentum_lost_by_the_window_end(tmp_path):
+    """A body of 2 g slowed linearly from 100 to 60 m/s over 4 µs, sampled every 2 µs:
+    the momentum lost by 3 µs is m·30 m/s = 0.06 N·s, exactly, between samples; the first
+    contact is the first sample with a force."""
+    import json
+
+    from wovenimpact.studies.validation import early_impulse, first_contact_time
+
+    (tmp_path / "history.csv").write_text(
+        "time_s,impactor_velocity_m_per_s,contact_force_full_N\n"
+        "0.0,100.0,0.0\n2e-6,80.0,20000.0\n4e-6,60.0,20000.0\n")
+    (tmp_path / "summary.json").write_text(json.dumps(
+        {"initial_velocity_m_per_s": 100.0, "initial_impactor_kinetic_energy_J": 10.0}))
+    assert abs(early_impulse(tmp_path, 3e-6) - 0.06) < 1e-12
+    assert first_contact_time(tmp_path) == 2e-6
 
 
 def test_undecided_runs_get_no_verdict_and_are_named():

@@ -19,6 +19,10 @@ ballistics_app = typer.Typer(help="Ballistic fits of sweep results.", no_args_is
 app.add_typer(ballistics_app, name="ballistics")
 
 
+RESIDUAL = "residual_velocity_m_per_s"
+EXIT = "fragment_exit_speed_m_per_s"  # a containment run's stand-in for the residual
+
+
 def _rows(results: Path) -> list[dict]:
     text = read_text(results, "results file")
     try:
@@ -26,9 +30,9 @@ def _rows(results: Path) -> list[dict]:
                 if r.get("status") == "done"]
     except csv.Error as err:
         raise InputError(f"{results}: not a readable CSV file ({err})") from None
-    if not rows or "residual_velocity_m_per_s" not in rows[0]:
-        raise InputError(f"{results}: no finished runs with residual_velocity_m_per_s "
-                         "(list it in the study's metrics)")
+    if not rows or not ({RESIDUAL, EXIT} & set(rows[0])):
+        raise InputError(f"{results}: no finished runs with {RESIDUAL} (or {EXIT} for a "
+                         "containment study): list it in the study's metrics")
     return rows
 
 
@@ -62,25 +66,37 @@ def v50(
 
 @ballistics_app.command("plies")
 def plies(
-    results: Path = typer.Argument(..., help="results.csv of a sweep over mesh.plies."),
-    key: str = typer.Option("mesh.plies", help="Parameter column of the number of plies."),
+    results: Path = typer.Argument(..., help="results.csv of a sweep over mesh.plies "
+                                   "(or over mesh.casing.layers of a containment case)."),
+    key: str = typer.Option(None, help="Parameter column of the number of plies (default: "
+                            "mesh.plies, or mesh.casing.layers for a containment study)."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
 ) -> None:
-    """Quadratic regression of residual velocity against plies (thesis eq. 7.1 method)."""
-    from wovenimpact.studies.ballistics import quadratic_ply_regression, require_decided
+    """Quadratic regression of residual velocity against plies (thesis eq. 7.1 method); of
+    a containment study, of the fragment's exit speed against the casing layers (eq. 8.2)."""
+    from wovenimpact.studies.ballistics import (
+        CONTAINMENT_DECIDED,
+        DECIDED,
+        quadratic_ply_regression,
+        require_decided,
+    )
 
     try:
         rows = _rows(results)
+        casing = RESIDUAL not in rows[0]
+        key = key or ("mesh.casing.layers" if casing else "mesh.plies")
         n = [float(v) for v in _column(rows, key, results)]
-        require_decided(rows, key, str(results))
-        vr = [float(r["residual_velocity_m_per_s"]) for r in rows]
-        perforated = [(a, b) for a, b in zip(n, vr) if b > 0]
-        reg = quadratic_ply_regression(*zip(*perforated)) if len(perforated) >= 3 else None
+        require_decided(rows, key, str(results), CONTAINMENT_DECIDED if casing else DECIDED)
+        vr = [float(r[EXIT if casing else RESIDUAL]) for r in rows]
+        through = [(a, b) for a, b in zip(n, vr) if b > 0]
+        reg = quadratic_ply_regression(*zip(*through)) if len(through) >= 3 else None
         if reg is None:
+            held = "contained the fragment" if casing else "stopped the impactor"
             raise InputError(f"{results}: the regression needs three perforated ply counts, got "
-                             f"{len(perforated)} (the others stopped the impactor)")
+                             f"{len(through)} (the others {held})")
     except InputError as err:
         fail(str(err))
     c2, c1, c0 = reg.coefficients
-    emit({"c2": c2, "c1": c1, "c0": c0, "r2": reg.r2, "plies_to_stop": reg.plies_to_stop,
+    answer = "layers_to_contain" if casing else "plies_to_stop"
+    emit({"c2": c2, "c1": c1, "c0": c0, "r2": reg.r2, answer: reg.plies_to_stop,
           "root": reg.root}, as_json, f"{results}: V_r(N) = c2 N² + c1 N + c0")

@@ -26,7 +26,8 @@ def plies(
         "--set 'impactor.velocity=200 m/s' (repeatable)."),
 ) -> None:
     """Search the number of plies (doubling, then bisection) and print the answer with
-    the areal mass of the pack."""
+    the areal mass of the pack; on a containment case, the casing layers that contain the
+    fragment, with the casing's mass."""
     from wovenimpact.io.outdir import prepare_output_dir, write_failure
     from wovenimpact.studies.design import design_plies
 
@@ -49,6 +50,13 @@ def plies(
             shown["reruns"] = ", ".join(f"{k}: {v}" for k, v in result["reruns"].items())
         else:
             del shown["reruns"]
-    emit(shown, as_json, f"{case.name}: plies to stop the impactor")
+    what = ("layers to contain the fragment" if "layers_to_contain" in result
+            else "plies to stop the impactor")
+    emit(shown, as_json, f"{case.name}: {what}")
     if result["warning"] and not as_json:
         err_console.print(f"[bold yellow]warning:[/] {result['warning']}")
+
+
+design_app.command("layers", help="The same search on a containment case: the fewest "
+                   "casing layers (mesh.casing.layers: fabric plies of a hybrid casing, "
+                   "aluminium layers of an all-metal one) that contain the fragment.")(plies)

@@ -59,10 +59,33 @@ def profile_distance(zeta, rho, prof_z, prof_r):
     return (-d if inside else d), nz, nr
 
 
+@kernel
+def node_gap(x, i, offset, tip, axis, prof_z, prof_r, reach, length):
+    """Gap g = h − d of node i against the body (≤ 0: no contact) and the body's outward
+    unit normal (n_x, n_y, n_z) at the node's closest point."""
+    px, py, pz = x[i, 0] - tip[0], x[i, 1] - tip[1], x[i, 2] - tip[2]
+    zeta_ax = px * axis[0] + py * axis[1] + pz * axis[2]
+    if zeta_ax < -reach or zeta_ax > length + reach:
+        return 0.0, 0.0, 0.0, 0.0
+    qx, qy, qz = px - zeta_ax * axis[0], py - zeta_ax * axis[1], pz - zeta_ax * axis[2]
+    rho = math.sqrt(qx * qx + qy * qy + qz * qz)
+    if rho > reach:
+        return 0.0, 0.0, 0.0, 0.0
+    d, nz, nr = profile_distance(zeta_ax, rho, prof_z, prof_r)
+    gap = offset[i] - d
+    if gap <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    if rho > 1e-15:
+        ex, ey, ez = qx / rho, qy / rho, qz / rho
+    else:  # on the axis: only the axial part of the normal is defined
+        ex = ey = ez = 0.0
+    return (gap, nz * axis[0] + nr * ex, nz * axis[1] + nr * ey, nz * axis[2] + nr * ez)
+
+
 @loop_kernel
 def rigid_contact_forces(
-    x, v, node_active, node_mass, offset, beta, zeta, mu, dt, tip, axis, body_v, body_w,
-    body_c, prof_z, prof_r, reach, force, energy,
+    x, v, node_active, node_mass, offset, beta, zeta, mu, dt, body_mass, tip, axis, body_v,
+    body_w, body_c, prof_z, prof_r, reach, force, energy,
 ):
     """Penalty, damping and friction forces on the nodes from a rigid body of revolution.
 
@@ -70,15 +93,18 @@ def rigid_contact_forces(
     outward normal n and velocity relative to the body's surface point
     v_r = v − (V + ω × (p − c)), split into v_n = v_r·n and v_t = v_r − v_n n:
 
-        k = β m / Δt²,  c = min(2 ζ √(k m), m/Δt) = min(2 ζ √β, 1) m / Δt
+        k = β m / Δt²,  c = min(2 ζ √β, 1) m_r / Δt,   m_r = m / (1 + m_c / M)
                                 (ζ: fraction of critical; the cap removes at most the
-                                 whole relative normal velocity in one step)
+                                 whole relative normal velocity in one step, counting
+                                 the body's recoil: m_c is the mass of all the nodes in
+                                 contact, M the body's; m_r = m for a heavy body)
         f_n = k g − c v_n                  (along n; the dashpot also acts while the
                                             node recedes inside the gap: no rebound)
         f_t = −min(μ |f_n|, ½ m |v_t| / Δt) v_t/|v_t|   (Coulomb, capped near sticking)
 
     (theory §6.2). With ζ ≥ 1 a node struck by a face comes to rest on it (a plastic
-    impact, the face's speed) instead of leaving at twice its speed.
+    impact, the face's speed) instead of leaving at twice its speed. Two passes: the
+    gaps (parallel), the contact mass m_c (a serial sum, deterministic), the forces.
 
     Args:
         x, v: (n, 3) node positions x^n and velocities v^{n−1/2}.
@@ -86,6 +112,7 @@ def rigid_contact_forces(
         node_mass: (n,) lumped masses (kg); offset: (n,) contact offsets h (m).
         beta, zeta, mu: penalty scale β, damping ζ, friction coefficient μ.
         dt: the step the forces are for (s).
+        body_mass: the body's mass in the model M (kg; its share in a symmetry model).
         tip, axis: (3,) nose-tip position and unit axis (tip → tail).
         body_v, body_w, body_c: (3,) the body's velocity, global spin and centre of mass.
         prof_z, prof_r: meridian profile polyline.
@@ -96,33 +123,31 @@ def rigid_contact_forces(
     """
     n = x.shape[0]
     length = prof_z[prof_z.shape[0] - 1]
-    c_factor = min(2.0 * zeta * math.sqrt(beta), 1.0)
+    # pass 1: gaps (in energy[i]) and normals (in force[i])
     for i in prange(n):
+        energy[i] = 0.0
         force[i, 0] = 0.0
         force[i, 1] = 0.0
         force[i, 2] = 0.0
-        energy[i] = 0.0
         if node_active[i] == 0:
             continue
-        px, py, pz = x[i, 0] - tip[0], x[i, 1] - tip[1], x[i, 2] - tip[2]
-        zeta_ax = px * axis[0] + py * axis[1] + pz * axis[2]
-        if zeta_ax < -reach or zeta_ax > length + reach:
-            continue
-        qx, qy, qz = px - zeta_ax * axis[0], py - zeta_ax * axis[1], pz - zeta_ax * axis[2]
-        rho = math.sqrt(qx * qx + qy * qy + qz * qz)
-        if rho > reach:
-            continue
-        d, nz, nr = profile_distance(zeta_ax, rho, prof_z, prof_r)
-        gap = offset[i] - d
+        g, nx, ny, nz = node_gap(x, i, offset, tip, axis, prof_z, prof_r, reach, length)
+        if g > 0.0:
+            energy[i] = g
+            force[i, 0] = nx
+            force[i, 1] = ny
+            force[i, 2] = nz
+    m_contact = 0.0
+    for i in range(n):
+        if energy[i] > 0.0:
+            m_contact += node_mass[i]
+    c_factor = min(2.0 * zeta * math.sqrt(beta), 1.0) / (1.0 + m_contact / body_mass)
+    # pass 2: forces
+    for i in prange(n):
+        gap = energy[i]
         if gap <= 0.0:
             continue
-        if rho > 1e-15:
-            ex, ey, ez = qx / rho, qy / rho, qz / rho
-        else:  # on the axis: only the axial part of the normal is defined
-            ex = ey = ez = 0.0
-        nx = nz * axis[0] + nr * ex
-        ny = nz * axis[1] + nr * ey
-        nzz = nz * axis[2] + nr * ez
+        nx, ny, nzz = force[i, 0], force[i, 1], force[i, 2]
         m = node_mass[i]
         k = beta * m / (dt * dt)
         c = c_factor * m / dt

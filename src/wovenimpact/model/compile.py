@@ -203,7 +203,7 @@ def check_impactor_clearance(model: Model) -> None:
         prof = model.body_profiles[b, : int(p[RB.BP_NPTS])]
         # k = 1 N/m per node: energy ½ g², no dashpot
         rigid_contact_forces(model.x0, np.zeros((n, 3)), np.ones(n, np.int8), np.ones(n),
-                             model.node_offset, 1.0, 0.0, 0.0, 1.0, tip, axis, zero, zero, zero,
+                             model.node_offset, 1.0, 0.0, 0.0, 1.0, 1.0, tip, axis, zero, zero, zero,
                              np.ascontiguousarray(prof[:, 0]), np.ascontiguousarray(prof[:, 1]),
                              p[RB.BP_REACH] + float(model.node_offset.max()), force, energy)
         bad = np.flatnonzero(energy > 0.0)

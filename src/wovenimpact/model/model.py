@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from wovenimpact.errors import InputError
-from wovenimpact.impactor import Impactor
+from wovenimpact.impactor import BODY_PENALTY_SCALE, Impactor
 from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as S
@@ -215,7 +215,7 @@ class RigidBody:
     direction: tuple[float, float, float] = (0.0, 0.0, -1.0)
     speed: float = 0.0
     mass: float | None = None
-    beta: float = 0.1
+    beta: float = BODY_PENALTY_SCALE
     damping: float = 1.0
     friction: float = 0.0
     fraction: float = 1.0

@@ -92,7 +92,7 @@ def contact_forces(model, state, cb: ContactBuffers, dt: float, elem_alive,
         prof = model.body_profiles[b, : int(p[RB.BP_NPTS])]
         rigid_contact_forces(
             state.x, state.v, active, model.node_mass, model.node_offset, p[RB.BP_BETA],
-            p[RB.BP_DAMPING], p[RB.BP_FRICTION], dt, tip, axis,
+            p[RB.BP_DAMPING], p[RB.BP_FRICTION], dt, p[RB.BP_MASS], tip, axis,
             np.ascontiguousarray(row[RB.B_V:RB.B_V + 3]), spin,
             np.ascontiguousarray(row[RB.B_X:RB.B_X + 3]),
             np.ascontiguousarray(prof[:, 0]), np.ascontiguousarray(prof[:, 1]),

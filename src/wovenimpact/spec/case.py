@@ -40,7 +40,7 @@ Schema (see README and examples/cases/)::
     [body_force]      acceleration = [ax, ay, az]
     [impactor]        shape = sphere | cylinder, radius, length, nose, nose_length, fillet,
                       density | mass, position (nose tip), direction, velocity,
-                      contact_stiffness (penalty factor β of k = β m / Δt²),
+                      contact_stiffness (penalty factor β of k = β m / Δt²; 0.3),
                       contact_damping (ζ, fraction of critical; 1), friction (μ; 0)
     [contact]         shell–shell contact: surfaces = plies | parts | element_sets |
                       none, self_contact, penalty_scale (β; 0.1), damping (ζ; 0.3),
@@ -62,6 +62,7 @@ from typing import Annotated, Any, Literal
 from pydantic import AfterValidator, BaseModel, Field, ValidationError, model_validator
 
 from wovenimpact.errors import InputError, InputWarning
+from wovenimpact.impactor import BODY_PENALTY_SCALE
 from wovenimpact.spec.fields import (
     STRICT,
     Problem,
@@ -302,7 +303,8 @@ class ImpactorSpec(BaseModel):
     position: tuple[Coordinate, Coordinate, Coordinate]
     direction: Direction = (0.0, 0.0, -1.0)
     velocity: quantity("velocity", gt=0, example="120 m/s")
-    contact_stiffness: quantity("dimensionless", gt=0, le=0.5, example="0.1") = 0.1
+    contact_stiffness: quantity("dimensionless", gt=0, le=0.5,
+                                 example="0.3") = BODY_PENALTY_SCALE
     # dashpot of each node–body pair, a fraction of critical 2 √(k m): 1 makes a struck
     # node come to rest on the face (plastic impact) instead of leaving at twice its speed
     contact_damping: quantity("dimensionless", ge=0, le=2, example="1") = 1.0

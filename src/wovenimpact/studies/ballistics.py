@@ -26,9 +26,10 @@ from wovenimpact.errors import InputError
 
 
 DECIDED = ("perforated", "stopped")
+CONTAINMENT_DECIDED = ("escaped", "contained")
 
 
-def require_decided(rows: list[dict], key: str, source: str) -> None:
+def require_decided(rows: list[dict], key: str, source: str, decided=DECIDED) -> None:
     """Refuse study rows that are not decided runs.
 
     Args:
@@ -36,16 +37,19 @@ def require_decided(rows: list[dict], key: str, source: str) -> None:
             ``outcome``).
         key: the parameter column that names a variant (e.g. ``impactor.velocity``).
         source: what the rows come from (a path), for the message.
+        decided: the outcomes that count as decided (``CONTAINMENT_DECIDED`` for the
+            runs of a casing).
 
     Raises:
-        InputError: a row lacks an outcome, or its outcome is neither ``perforated``
-            nor ``stopped``; the message names each such variant by ``key`` and id.
+        InputError: a row lacks an outcome, or its outcome is not one of ``decided``
+            (``perforated`` or ``stopped``); the message names each such variant by
+            ``key`` and id.
     """
     if any("outcome" not in r or r["outcome"] in ("", None) for r in rows):
         raise InputError(f"{source}: no outcome recorded for some runs (results written "
                          "before outcomes were recorded, or not impact runs): run the study "
                          "again into a new output directory")
-    bad = [r for r in rows if r["outcome"] not in DECIDED]
+    bad = [r for r in rows if r["outcome"] not in decided]
     if bad:
         names = "; ".join(f"{key} = {r.get(key, '?')} (variant {r.get('id', '?')}): "
                           f"{r['outcome']}" for r in bad)

@@ -4,6 +4,9 @@
 ``[impactor]``), re-runs it with N plies (the impactor keeps its clearance above the
 top ply) and searches N: first by doubling until a pack stops the impactor, then by
 bisection between the largest pack that is perforated and the smallest that stops it.
+On a containment case (``mesh.kind = "containment"``) N is ``mesh.casing.layers`` (fabric
+plies of a hybrid casing, aluminium layers of an all-metal one) and the answer is the
+fewest layers that contain the fragment, with the casing's mass (inner shell counted).
 Each round runs its candidates in parallel (local processes). Only decided runs count:
 a pack whose run ends ``undecided`` (still in contact, or intact plies ahead of the
 impactor, at the end time) or ``no contact`` is run once more with twice the end time
@@ -26,6 +29,13 @@ from wovenimpact.studies.ballistics import DECIDED
 from wovenimpact.units import to_si
 
 MAX_PLIES = 64
+HELD = ("stopped", "contained")  # the pack held: the impactor or fragment did not pass
+DECIDED_ANY = DECIDED + ("contained", "escaped")
+
+
+def is_containment(doc: dict) -> bool:
+    """Whether a case document is a containment case (its N is mesh.casing.layers)."""
+    return doc.get("mesh", {}).get("kind") == "containment"
 
 
 def search_plies(stops: Callable[[list[int]], dict[int, bool]], start: int = 1,
@@ -64,9 +74,13 @@ def search_plies(stops: Callable[[list[int]], dict[int, bool]], start: int = 1,
 
 
 def _case_with_plies(doc: dict, n: int) -> dict:
-    """The case document with n plies; the impactor keeps its clearance above the top ply."""
+    """The case document with n plies (the impactor keeps its clearance above the top
+    ply), or, for a containment case, with n casing layers."""
     d = copy.deepcopy(doc)
     mesh = d.get("mesh", {})
+    if is_containment(d):
+        mesh["casing"]["layers"] = n
+        return d
     if mesh.get("kind") != "plate" or "impactor" not in d:
         raise InputError("design plies needs a plate case (mesh.kind = 'plate') with an [impactor]")
     n0 = int(mesh.get("plies", 1))
@@ -152,11 +166,11 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
     def stops(batch: list[int]) -> dict[int, bool]:
         docs = [_case_with_plies(doc, n) for n in batch]
         results = dict(zip(batch, run_batch(docs, [str(out / f"plies_{n}") for n in batch])))
-        again = [n for n in batch if results[n] not in DECIDED]
+        again = [n for n in batch if results[n] not in DECIDED_ANY]
         if again:
             longer = [_longer(d) for n, d in zip(batch, docs) if n in again]
             for n, d in zip(again, longer):
-                log(f"{n} plies: {results[n]} at run.end_time = {docs[batch.index(n)]['run']['end_time']}"
+                log(f"{n} {unit}: {results[n]} at run.end_time = {docs[batch.index(n)]['run']['end_time']}"
                     f"; running it again to {d['run']['end_time']} (plies_{n}_end2x)")
             for n, r in zip(again, run_batch(longer, [str(out / f"plies_{n}_end2x")
                                                       for n in again])):
@@ -164,18 +178,35 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
                 results[n] = r
         for n in batch:
             outcomes[n] = results[n]
-            if results[n] not in DECIDED:
+            if results[n] not in DECIDED_ANY:
                 raise InputError(
-                    f"{n} plies: {results[n]} even with twice run.end_time (the impactor is "
+                    f"{n} {unit}: {results[n]} even with twice run.end_time (the impactor is "
                     "still in contact or intact plies are ahead of it): lengthen run.end_time "
                     "in the case and search again")
-        return {n: results[n] == "stopped" for n in batch}
+        return {n: results[n] in HELD for n in batch}
 
-    n0 = int(doc.get("mesh", {}).get("plies", 1))
+    if is_containment(doc):
+        unit = "layers"
+        n0 = int(doc["mesh"]["casing"]["layers"])
+    else:
+        unit = "plies"
+        n0 = int(doc.get("mesh", {}).get("plies", 1))
     plies, seen = search_plies(stops, start=start or n0)
     extra = [k for k in range(plies + 1, plies + 1 + check) if k not in seen]
     if extra:
         seen.update(stops(extra))
+    if unit == "layers":
+        rerun = out / f"plies_{plies}_end2x"
+        answer = json.loads(((rerun if str(plies) in reruns else out / f"plies_{plies}")
+                             / "summary.json").read_text())
+        return {
+            "layers_to_contain": plies,
+            "casing_mass_kg": answer["casing_mass_kg"],
+            "casing_mass_per_area_kg_per_m2": answer["casing_mass_per_area_kg_per_m2"],
+            "runs": {str(k): v for k, v in sorted(outcomes.items())},
+            "reruns": reruns,
+            "warning": monotonic_warning(plies, seen, "layers", "contain the fragment"),
+        }
     from wovenimpact.model.compile import compile_case
     from wovenimpact.spec.case import case_from_dict
 
@@ -193,13 +224,14 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
     }
 
 
-def monotonic_warning(plies: int, seen: dict[int, bool]) -> str:
-    """"" if every larger pack that ran stopped the impactor, else a warning naming the
-    packs that did not: the search assumes more plies never do worse, and near a
-    ballistic limit the simulated outcome need not be monotonic."""
+def monotonic_warning(plies: int, seen: dict[int, bool], unit: str = "plies",
+                      verb: str = "stop the impactor") -> str:
+    """"" if every larger pack that ran stopped the impactor (or contained the fragment),
+    else a warning naming the packs that did not: the search assumes more plies never do
+    worse, and near a ballistic limit the simulated outcome need not be monotonic."""
     worse = sorted(k for k, stopped in seen.items() if k > plies and not stopped)
     if not worse:
         return ""
-    return (f"{', '.join(map(str, worse))} plies did not stop the impactor although "
-            f"{plies} did: the outcome is not monotonic in the plies near this limit; "
+    return (f"{', '.join(map(str, worse))} {unit} did not {verb} although "
+            f"{plies} did: the outcome is not monotonic in the {unit} near this limit; "
             "take a margin and run the packs around the answer")

@@ -460,9 +460,10 @@ def build() -> Corpus:
         ("points_2", _set(P, "sections.fabric.points", 2), "error"),
         ("hourglass_1", _set(P, "sections.fabric.hourglass", 1), "error"),
         ("membrane_bad", _set(P, "sections.fabric.membrane", "half"), "error"),
-        ("history_interval_1e-30", _set(P, "run.history_interval", "1e-30 s"), "warn"),
-        ("field_interval_1e-30", _set(P, "run.field_interval", "1e-30 s"), "warn"),
-        ("checkpoint_interval_1e-30", _set(P, "run.checkpoint_interval", "1e-30 s"), "warn"),
+        # a frame every step of a 13-step run is fine (a warning beyond 1000 outputs)
+        ("history_interval_1e-30", _set(P, "run.history_interval", "1e-30 s"), "ok"),
+        ("field_interval_1e-30", _set(P, "run.field_interval", "1e-30 s"), "ok"),
+        ("checkpoint_interval_1e-30", _set(P, "run.checkpoint_interval", "1e-30 s"), "ok"),
         ("name_empty", _set(P, "case.name", ""), "error"),
         ("case_name_int", _set(P, "case.name", 3), "error"),
         ("ramp_nan", _set(P, "amplitude", {"ramp_time": "nan us"}), "error"),

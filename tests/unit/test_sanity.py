@@ -151,6 +151,16 @@ def test_absurd_mesh_sizes_are_refused_before_meshing(key, value):
         case_from_dict(_set(PLATE, key, value), source="case.toml")
 
 
+def test_an_output_at_every_step_is_warned_of_only_when_there_are_many():
+    doc = _set(PLATE, "run.field_interval", "1e-30 s")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", InputWarning)
+        compiled(doc)  # 2 µs: about 13 steps, a frame each is fine
+    with pytest.warns(InputWarning, match=r"run.field_interval = 1e-30 s is shorter than "
+                      r"the first step .*about 1.2\d*e\+03 of them"):
+        compiled(_set(doc, "run.end_time", "200 us"))
+
+
 def test_the_case_writer_round_trips():  # the corpus and these tests write TOML with it
     import tomllib
 

@@ -39,6 +39,7 @@ MIN_IMPACTOR_MASS_RATIO = 1e-3  # impactor mass / mass of the structure under it
 MIN_THICKNESS = 1e-6  # m
 MAX_RADIUS_EXTENTS = 10.0  # impactor radius / largest extent of the mesh
 MIN_RADIUS_ELEMENTS = 0.1  # impactor radius / largest element edge (thesis study: 2.78/6 mm)
+MAX_QUIET_OUTPUTS = 1000  # outputs at every step beyond this many are warned of
 AREAL_MASS_FACTOR = 10.0  # a section's areal mass this far from its material's is warned of
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 
@@ -138,8 +139,9 @@ def check_motion_per_step(model, state, dt: float, spec) -> None:
 
 
 def warn_output_intervals(spec, dt: float) -> None:
-    """An output interval shorter than the first step writes at every step."""
-    if not (math.isfinite(dt) and dt > 0.0):
+    """An output interval shorter than the first step writes at every step: warned of
+    when that is more than MAX_QUIET_OUTPUTS outputs."""
+    if not (math.isfinite(dt) and dt > 0.0) or spec.run.end_time / dt <= MAX_QUIET_OUTPUTS:
         return
     for key in ("field_interval", "history_interval", "checkpoint_interval"):
         value = getattr(spec.run, key)

@@ -48,7 +48,9 @@ Schema (see README and examples/cases/)::
     [[initial_erosion]]  centre, radius, plies?: elements eroded at t = 0 (a hole: centroid
                       within radius of the axis through centre along cylinder_axis)
     [run]             end_time, field_interval, history_interval, checkpoint_interval,
-                      alpha, erode_dt_fraction, erode_inverted, threads
+                      alpha, erode_dt_fraction, erode_inverted, threads, max_steps (the
+                      predicted step count end_time/Δt₁ above which the run is refused;
+                      5e6; docs/inputs.md)
 """
 
 from __future__ import annotations

@@ -7,7 +7,8 @@ process, so ~300 items take minutes) under a wall-clock alarm and an address-spa
 limit, and classified:
 
 - ``clean``: what the label asks: exit code 2 with an ``error: …`` message (any item),
-  or exit 0 with a ``warning: …`` (``warn`` items), or exit 0 (``ok`` items);
+  or exit 0 with its ``warning: …`` (``warn`` items: the warning must say what
+  ``Item.warns`` gives), or exit 0 (``ok`` items);
 - ``traceback``: an exception escaped the CLI (or a traceback was printed);
 - ``hang``: no answer within the item's timeout;
 - ``nonsense``: a bad input accepted: exit 0 without error (or without the warning a
@@ -60,8 +61,9 @@ def classify(item: Item, exit_code: int | None, output: str, exception) -> str:
         return "clean" if exit_code == 0 else "refused"
     if exit_code == 2 and ("error:" in output or "Error" in output or "Usage:" in output):
         return "clean"
-    if exit_code == 0 and item.expect == "warn" and "warning:" in output:
-        return "clean"
+    if exit_code == 0 and item.expect == "warn" and "warning:" in output \
+            and item.warns in " ".join(output.split()):
+        return "clean"  # the run went on, with the warning this item is about
     if exit_code == 1 and item.argv[0] == "sweep" and "InputError: " in output:
         return "clean"  # the study ran; its failed variants name their input error
     return "nonsense"

@@ -37,6 +37,7 @@ MAX_WAVE_SPEED = 2.0e4  # m/s: above any engineering material's (diamond ~18 km/
 MAX_CROSSING = 0.5  # of the smallest element length moved in one step
 MIN_IMPACTOR_MASS_RATIO = 1e-3  # impactor mass / mass of the structure under its face
 MIN_THICKNESS = 1e-6  # m
+MAX_EXTENT = 1e3  # m: a structure a kilometre across is a unit slip in an impact model
 MAX_RADIUS_EXTENTS = 10.0  # impactor radius / largest extent of the mesh
 MIN_RADIUS_ELEMENTS = 0.1  # impactor radius / largest element edge (thesis study: 2.78/6 mm)
 MAX_QUIET_OUTPUTS = 1000  # outputs at every step beyond this many are warned of
@@ -87,9 +88,9 @@ def check_step_count(model, state, spec) -> float:
         return dt  # the solver names a non-finite step at the first step
     steps = end_time / dt
     if steps < 1.0:
-        raise InputError(
+        warnings.warn(
             f"run.end_time = {_text(end_time)} is shorter than the first step (Δt = {dt:.3g} s, "
-            f"element {e}): nothing would be simulated (valid: an end time of several steps)")
+            f"element {e}): the run is one step", InputWarning, stacklevel=3)
     if steps <= max_steps:
         return dt
     length = element_length(model, e)
@@ -168,9 +169,13 @@ def check_plies(spec, model) -> None:
 
 
 def check_thickness(model, spec) -> None:
-    """A section thicker than the whole mesh's largest extent is not a shell, one
-    thinner than MIN_THICKNESS no structure."""
+    """A mesh larger than MAX_EXTENT is a unit slip; a section thicker than the whole
+    mesh is not a shell, one thinner than MIN_THICKNESS no structure."""
     extent = float(np.max(np.ptp(model.x0, axis=0))) if model.n_nodes else 0.0
+    if extent > MAX_EXTENT:
+        raise InputError(
+            f"mesh: the structure is {extent:.3g} m across, more than {MAX_EXTENT:g} m (valid: "
+            "an impact model; check the units of the mesh, coordinates are in metres)")
     for sec in np.unique(model.elem_section):
         t = float(model.sections[sec, S.C_THICK])
         if t < MIN_THICKNESS:

@@ -1,7 +1,7 @@
 """``make bench``: the explicit step's cost (see :mod:`wovenimpact.benchmark`).
 
-Options: ``--sizes=10000,100000``, ``--kinds=fabric,fabric_reduced``, ``--threads=1,2``, ``--steps=N``,
-``--json`` (prints {"cases": [{"name", "elements", "threads", "ns_per_element_cycle",
+Options: ``--sizes=10000,100000``, ``--kinds=metal,fabric,fabric_reduced``,
+``--threads=1,2``, ``--steps=N``, ``--json`` (prints {"cases": [{"name", "elements", "threads", "ns_per_element_cycle",
 "shares"}], "machine", "threading_layer"}), ``--no-machine-line`` (``make bench`` prints
 it first). Same as ``wovenimpact bench``.
 """
@@ -18,7 +18,7 @@ from wovenimpact.benchmark import DEFAULT_SIZES, case_line, machine, machine_lin
 
 def main() -> None:
     sizes = DEFAULT_SIZES
-    kinds = ("elastic", "fabric", "fabric_reduced")
+    kinds = ("elastic", "metal", "fabric", "fabric_reduced")
     thread_counts = sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)})
     steps = 20
     for arg in sys.argv[1:]:

@@ -34,6 +34,7 @@ from wovenimpact.io.fields import FieldWriter
 from wovenimpact.io.history import History
 from wovenimpact.io.report import write_run_report
 from wovenimpact.kernels import shell_layout as S
+from wovenimpact.metal_state import has_metal, plastic_work
 from wovenimpact.model.compile import CompiledCase, compile_case
 from wovenimpact.quantities import (
     impactor_row,
@@ -63,6 +64,7 @@ HISTORY_COLUMNS = (
 IMPACT_COLUMNS = ("impactor_velocity_m_per_s", "impactor_displacement_m", "contact_force_full_N",
                   "impactor_nose_ahead_of_intact_m", "intact_material_ahead",
                   "impactor_kinetic_energy_part_J")
+METAL_COLUMNS = ("plastic_work_part_J",)  # models with a J2 (metal) section
 SUMMARY_VERSION = 2  # 2: issue 9's outcome rule and energy keys; older summaries are re-run
 DEFAULT_OUTPUTS = {"history": 1000, "field": 20, "checkpoint": 10}  # per run, if not given
 
@@ -76,8 +78,11 @@ def history_columns(model) -> tuple[str, ...]:
     ``energy_error_fraction`` = |drift| / ``energy_normaliser_part_J``
     (solver.explicit.energy_balance). ``contact_energy_part_J`` is −(work of the contact
     forces): the penalty springs' energy plus ``contact_dissipated_part_J``, what contact
-    dashpots and friction dissipated."""
+    dashpots and friction dissipated. ``plastic_work_part_J`` (models with a metal
+    section): the plastic work of the J2 points (metal_state.plastic_work), a part of
+    the internal work."""
     return (HISTORY_COLUMNS + (IMPACT_COLUMNS if model.body_params.shape[0] else ())
+            + (METAL_COLUMNS if has_metal(model) else ())
             + (CONTAINMENT_COLUMNS if is_containment(model) else ()))
 
 
@@ -91,6 +96,8 @@ def history_row(model, state: State) -> dict:
                   "impactor_kinetic_energy_part_J": eb["impactor_kinetic_J"]}
     if is_containment(model):
         impact.update(fragment_row(model, state))
+    if has_metal(model):
+        impact["plastic_work_part_J"] = plastic_work(model, state)
     return {
         **impact,
         "time_s": float(state.t), "step": int(state.step), "dt_s": float(state.dt),
@@ -311,6 +318,7 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, steps: in
         "eroded_internal_energy_J": factor * eb["eroded_internal_J"],
         "eroded_hourglass_energy_J": factor * eb["eroded_hourglass_J"],
         "eroded_kinetic_energy_J": factor * eb["eroded_kinetic_J"],
+        **({"plastic_work_J": factor * plastic_work(model, state)} if has_metal(model) else {}),
         # undefined (None, "n/a" on the page) while no positive internal work was done,
         # e.g. a spun blade that has only given back part of its pre-stress energy
         "hourglass_fraction": hg_all / w_int if w_int > 0.0 else None,

@@ -11,6 +11,7 @@ import pytest
 from wovenimpact.errors import InputError
 from wovenimpact.io.fields import PVD_NAME, FieldWriter, cell_blocks, read_pvd
 from wovenimpact.kernels import fabric_layout as FL
+from wovenimpact.kernels import j2_layout as J
 from wovenimpact.kernels import shell_layout as S
 from wovenimpact.materials.metal import MetalParameters
 from wovenimpact.model import Section, build_model
@@ -116,6 +117,34 @@ def test_fabric_columns_come_from_the_material_state(tmp_path, model, kevlar):
     assert cd["tension_fill"].tolist() == [0.0, 4.0, 6.0, 0.0]
     assert cd["damage_warp"].tolist() == [0.0, 0.5, 0.5, 0.0]
     assert cd["damage_fill"].tolist() == [0.0, 0.5, 0.5, 0.0]
+
+
+ALUMINIUM = MetalParameters(name="al", kind="j2_plastic", density=2780.0, modulus=72e9,
+                            poisson=0.32, hardening=((0.0, 78e6), (0.18, 214e6)))
+
+
+def test_metal_and_integrated_fabric_columns_in_one_model(tmp_path, kevlar):
+    """Fabric integrated through the thickness (3 points) beside a J2 metal (5 points):
+    a point's block is then Model.point_width (16) wide, and the fabric columns come from
+    the mid-level point's block; a metal element's plastic_strain is the largest ε̄p of
+    its points and its thickness_ratio the Simpson-weighted λ3 (1/12, 4/12, 2/12, 4/12,
+    1/12); a fabric element has 0 and 1, a metal one at rest 0 and 1."""
+    mesh = plate_mesh(0.02, 0.01)
+    sections = {"al": Section(material=ALUMINIUM, thickness=1e-3),
+                "fabric": Section(material=kevlar, transverse_shear_modulus=3.28e9, points=3)}
+    fm = build_model(mesh.nodes, mesh.quads, sections, np.array(["al", "fabric", "fabric", "al"]))
+    w = fm.point_width
+    assert w == J.N_STATE > FL.N_STATE
+    s = initial_state(fm)
+    s.mat[1:3, w + FL.S_TENSION] = [3.0, 5.0]  # level 1 of 3: the mid-surface
+    s.mat[0, np.arange(5) * w + J.S_EPS_P] = [0.01, 0.02, 0.05, 0.02, 0.01]
+    s.mat[0, np.arange(5) * w + J.S_THICK] = [0.9, 0.96, 1.0, 0.96, 0.9]
+    cd = {k: v[0] for k, v in meshio.read(FieldWriter(tmp_path, fm).write(s)).cell_data.items()}
+    assert cd["tension_warp"].tolist() == [0.0, 3.0, 5.0, 0.0]
+    assert cd["plastic_strain"].tolist() == [0.05, 0.0, 0.0, 0.0]
+    assert cd["thickness_ratio"][0] == pytest.approx((0.9 + 4 * 0.96 + 2 + 4 * 0.96 + 0.9) / 12)
+    assert cd["thickness_ratio"][1:3].tolist() == [1.0, 1.0]  # fabric
+    assert cd["thickness_ratio"][3] == pytest.approx(1.0, rel=1e-15)  # metal at rest
 
 
 def test_triangles_go_to_their_own_block(tmp_path):

@@ -7,7 +7,9 @@ configuration ``State.x`` with
 - cell data ``membrane_resultant`` (N_xx, N_yy, N_xy; N/m, corotational frame),
   ``alive`` (1 alive, 0 eroded), ``ply``, ``element`` (the Model's element index),
   and ``tension_warp``, ``tension_fill`` (N), ``damage_warp``, ``damage_fill`` (—),
-  which are 0 for elements that are not fabric.
+  which are 0 for elements that are not fabric, and ``thickness_ratio`` t/t0 and
+  ``plastic_strain`` (the largest ε̄p of the element's points), 1 and 0 for elements
+  that are not metal (metal_state).
 
 Quads are written as VTK quads; an element whose quad repeats a node (a triangle)
 is written as a VTK triangle in a second cell block, so VTK filters never see a
@@ -29,6 +31,7 @@ from wovenimpact.errors import InputError
 from wovenimpact.io.atomic import atomic_path, atomic_write_text
 from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels import shell_layout as S
+from wovenimpact.metal_state import max_plastic_strain, thickness_ratio
 from wovenimpact.state import State
 
 PVD_NAME = "fields.pvd"
@@ -67,7 +70,8 @@ def element_fields(model, state: State, fabric: np.ndarray) -> dict[str, np.ndar
         "element": np.arange(model.n_elems, dtype=np.int64),
     }
     # integrated sections: the mid-surface point (block points // 2 of the state row)
-    mid = (model.sections[model.elem_section, S.C_POINTS].astype(np.int64) // 2) * FL.N_STATE
+    # (a point's block is model.point_width wide: 16 beside a metal section, not FL.N_STATE)
+    mid = (model.sections[model.elem_section, S.C_POINTS].astype(np.int64) // 2) * model.point_width
     rows = np.flatnonzero(fabric)
     for name, col in (("tension_warp", FL.S_TENSION), ("tension_fill", FL.S_TENSION + 1),
                       ("damage_warp", FL.S_DAMAGE), ("damage_fill", FL.S_DAMAGE + 1)):
@@ -75,6 +79,8 @@ def element_fields(model, state: State, fabric: np.ndarray) -> dict[str, np.ndar
         if rows.size:
             values[rows] = state.mat[rows, mid[rows] + col]
         out[name] = values
+    out["thickness_ratio"] = thickness_ratio(model, state)
+    out["plastic_strain"] = max_plastic_strain(model, state)
     return out
 
 

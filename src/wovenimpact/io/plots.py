@@ -23,7 +23,9 @@ def energy_curves(h: dict, symmetry_factor: float = 1.0) -> dict[str, np.ndarray
     Keys: ``structure kinetic``, ``impactor kinetic`` (with an impactor), ``contact
     energy`` and its part ``contact dissipated`` (dashpots and friction, when the
     history has it), ``internal work`` with its parts ``stored (live elements)``,
-    ``hourglass (live elements)`` and ``eroded internal (at erosion)``, ``eroded
+    ``hourglass (live elements)``, ``eroded internal (at erosion)`` and, for metal
+    runs, ``plastic dissipation`` (the J2 points' plastic work, live and eroded
+    elements), ``eroded
     kinetic``, ``external work``, and ``balance error`` = energy_error_fraction ×
     energy_normaliser: exactly the quantity whose largest value summary.json reports as
     ``energy_error_fraction``, drawn in J. The balance is structure kinetic + impactor
@@ -42,6 +44,8 @@ def energy_curves(h: dict, symmetry_factor: float = 1.0) -> dict[str, np.ndarray
     out["stored (live elements)"] = f * h["stored_energy_part_J"]
     out["hourglass (live elements)"] = f * h["hourglass_energy_part_J"]
     out["eroded internal (at erosion)"] = f * h["eroded_internal_energy_part_J"]
+    if "plastic_work_part_J" in h:
+        out["plastic dissipation"] = f * h["plastic_work_part_J"]
     out["eroded kinetic"] = f * h["eroded_kinetic_energy_part_J"]
     out["external work"] = f * h["external_work_part_J"]
     out["balance error"] = f * h["energy_error_fraction"] * h["energy_normaliser_part_J"]
@@ -59,7 +63,7 @@ def energy_plot(h: dict, path: str | Path, title: str = "", symmetry_factor: flo
     t = h["time_s"] * 1e6
     curves = energy_curves(h, symmetry_factor)
     dashed = {"stored (live elements)", "hourglass (live elements)",
-              "eroded internal (at erosion)", "contact dissipated"}
+              "eroded internal (at erosion)", "contact dissipated", "plastic dissipation"}
     fig, ax = plt.subplots(figsize=(7.5, 4.6))
     for label, y in curves.items():
         if label == "balance error":

@@ -102,11 +102,19 @@ def casing_mesh(
                 node_sets=node_sets, elem_sets=elem_sets)
 
 
-def circumferential_directions(mesh: Mesh) -> np.ndarray:
-    """(n_elems, 3) unit e_θ at each element's centroid: the warp of a wrapped fabric."""
+def circumferential_directions(mesh: Mesh, axis=(0.0, 0.0, 1.0)) -> np.ndarray:
+    """(n_elems, 3) unit hoop direction e_θ = a × c/|a × c| at each element's centroid c
+    about the unit axis a through the origin: the warp of a fabric wrapped on a
+    cylinder. An element whose centroid is on the axis has none: InputError."""
     c = mesh.nodes[mesh.quads].mean(axis=1)
-    t = np.stack([-c[:, 1], c[:, 0], np.zeros(len(c))], axis=1)
-    return t / np.linalg.norm(t, axis=1, keepdims=True)
+    t = np.cross(np.asarray(axis, dtype=float), c)
+    norm = np.linalg.norm(t, axis=1)
+    bad = np.flatnonzero(~(norm > 1e-9 * max(1.0, float(np.abs(c).max()))))
+    if bad.size:
+        raise InputError(f"mesh.warp_direction = 'circumferential': element {int(bad[0])} "
+                         f"has its centroid on the axis {list(axis)}; the hoop direction is "
+                         "not defined there (give mesh.axis, or a vector warp_direction)")
+    return t / norm[:, None]
 
 
 def blade_mesh(

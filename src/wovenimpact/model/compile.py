@@ -17,6 +17,7 @@ import numpy as np
 
 from wovenimpact.errors import InputError
 from wovenimpact.model.abaqus import read_inp
+from wovenimpact.model.gmsh import read_msh
 from wovenimpact.model.mesh import Mesh, plate_mesh
 from wovenimpact.model.sanity import check_case
 from wovenimpact.impactor import Impactor
@@ -32,7 +33,7 @@ from wovenimpact.model.model import (
 )
 from wovenimpact.spec.case import (
     DOFS,
-    AbaqusMeshSpec,
+    ImportedMeshSpec,
     CaseSpec,
     ContainmentMeshSpec,
     PlateMeshSpec,
@@ -93,19 +94,32 @@ def load_case_material(base: Path, name: str, ref):
     return material_from_dict(doc, source=f"{path} (with materials.{name}.set)")
 
 
-def make_mesh(spec: CaseSpec, base: Path) -> tuple[Mesh, list[str]]:
+def make_mesh(spec: CaseSpec, base: Path, sections: dict | None = None
+              ) -> tuple[Mesh, list[str]]:
     """The mesh and each element's section name; ``mesh.ply`` labels the contact
-    surfaces (:func:`contact_surfaces`)."""
+    surfaces (:func:`contact_surfaces`). A plate with ``ply_sections`` needs the
+    sections (their thicknesses stack the plies when no spacing is given)."""
     m = spec.mesh
     if isinstance(m, PlateMeshSpec):
-        mesh = plate_mesh(m.side, m.element_size, plies=m.plies, spacing=m.spacing or 0.0,
+        thick = None
+        if m.ply_sections is not None and m.spacing is None:
+            thick = [section_thickness(sections[s], f"mesh.ply_sections[{k}]")
+                     for k, s in enumerate(m.ply_sections)]
+        # touching plies: generated one thickness apart, then stacked by their own
+        spacing = m.spacing if thick is None else max(thick)
+        mesh = plate_mesh(m.side, m.element_size, plies=m.plies, spacing=spacing or 0.0,
                           quarter=m.quarter)
-        return mesh, [m.section] * mesh.n_elems
-    assert isinstance(m, AbaqusMeshSpec)
+        if m.ply_sections is None:
+            return mesh, [m.section] * mesh.n_elems
+        if thick is not None:
+            stack_plies(mesh, thick)
+        return mesh, [m.ply_sections[k] for k in mesh.ply]
+    assert isinstance(m, ImportedMeshSpec)
     path = (base / m.file).resolve()
     if not path.is_file():
         raise InputError(f"mesh.file: {m.file!r} not found (looked for {path})")
-    mesh = read_inp(path)
+    mesh = read_inp(path) if m.kind == "abaqus" else read_msh(path)
+    mesh.nodes *= m.length_unit
     names: list[str | None] = [None] * mesh.n_elems
     for elset, section in m.sections.items():
         if elset not in mesh.elem_sets:
@@ -252,6 +266,15 @@ def containment_mesh(m, sections) -> tuple[Mesh, list[str], np.ndarray]:
     return mesh, elem_sections, warp
 
 
+def stack_plies(mesh: Mesh, thicknesses: list[float]) -> None:
+    """Put ply k's mid-plane at z_k, the plies touching: z_0 = 0, z_k+1 = z_k +
+    (t_k + t_k+1)/2 (each section's own thickness; contact offsets are half of it)."""
+    z = np.concatenate([[0.0], np.cumsum(0.5 * (np.array(thicknesses[:-1])
+                                                + np.array(thicknesses[1:])))])
+    for k, zk in enumerate(z):
+        mesh.nodes[mesh.node_sets[f"ply{k}"], 2] = zk
+
+
 def section_thickness(section: Section, key: str) -> float:
     t = section.thickness if section.thickness is not None else getattr(
         section.material, "shell_thickness", None)
@@ -313,7 +336,9 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     if isinstance(spec.mesh, ContainmentMeshSpec):
         mesh, elem_sections, warp = containment_mesh(spec.mesh, sections)
     else:
-        mesh, elem_sections = make_mesh(spec, base)
+        mesh, elem_sections = make_mesh(spec, base, sections)
+        if isinstance(warp, str):  # "circumferential" (an imported casing)
+            warp = circumferential_directions(mesh, spec.mesh.axis)
     bcs = BoundaryConditions(mesh.n_nodes, ramp_time=spec.amplitude.ramp_time)
     for i, b in enumerate(spec.boundary):
         nodes = node_set(mesh, b.nodes, f"boundary[{i}].nodes")

@@ -154,18 +154,21 @@ def warn_output_intervals(spec, dt: float) -> None:
 
 
 def check_plies(spec, model) -> None:
-    """Plies of a plate whose mid-planes are closer than the shell thickness overlap."""
+    """Plies of a plate whose mid-planes are closer than their shell thicknesses (the
+    mean of two neighbours') overlap."""
     from wovenimpact.spec.case import PlateMeshSpec
 
     m = spec.mesh
-    if not (isinstance(m, PlateMeshSpec) and m.plies > 1):
-        return
-    t = float(model.sections[model.elem_section[0], S.C_THICK])
-    if m.spacing < t * (1.0 - 1e-9):
+    if not (isinstance(m, PlateMeshSpec) and m.plies > 1 and m.spacing is not None):
+        return  # without spacing (ply_sections) the plies are stacked by their thicknesses
+    first = [int(np.flatnonzero(model.ply == k)[0]) for k in range(m.plies)]
+    t = [float(model.sections[model.elem_section[e], S.C_THICK]) for e in first]
+    need = max(0.5 * (a + b) for a, b in zip(t[:-1], t[1:]))
+    if m.spacing < need * (1.0 - 1e-9):
         raise InputError(
-            f"mesh.spacing = {m.spacing:.4g} m is less than the shell thickness {t:.4g} m of "
-            f"section {m.section!r}: the plies overlap (valid: spacing ≥ {t:.4g} m; plies "
-            "that touch are one thickness apart)")
+            f"mesh.spacing = {m.spacing:.4g} m is less than the shell thickness {need:.4g} m of "
+            "the plies: the plies overlap (valid: spacing ≥ "
+            f"{need:.4g} m; plies that touch are one thickness apart)")
 
 
 def check_thickness(model, spec) -> None:

@@ -23,6 +23,7 @@ from wovenimpact.errors import InputError
 from wovenimpact.io.atomic import atomic_write_text
 from wovenimpact.io.report import write_index
 from wovenimpact.studies.ballistics import DECIDED
+from wovenimpact.studies.metal_validation import metal_section
 from wovenimpact.spec.fields import read_toml, set_dotted
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -414,6 +415,7 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
         lines.append("")
     lines += ["## Commentary", "", *commentary(cases, convergence),
               *study_commentary(study_rows)]
+    lines += metal_section(work, figures, log=log)  # issue 10: metal shells
     atomic_write_text(report, "\n".join(lines) + "\n")
     write_index(work, "wovenimpact validate: every run and study")  # WORK/report.html
     return report

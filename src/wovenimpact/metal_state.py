@@ -1,0 +1,86 @@
+"""Per-element quantities of metal (J2) sections, read from their points' states.
+
+A J2 section keeps one state row per material point (kernels/j2_layout.py): element e
+owns ``Model.point_width``-wide blocks in ``State.mat[e]``, in-plane point g (one, or
+four for a 2×2 membrane) and through-thickness level k at block ``g · n_pts + k``
+(kernels/shell.py, ``full_membrane`` / ``section_response``). Weighting a per-point
+quantity per unit reference area by the Simpson weight w_k (Σ w_k = 1) and the in-plane
+weight (A0 for one point, det J_g for the 2×2 points, Σ_g = A0) gives the element's
+value — the same quadrature the shell uses for its forces (docs/theory.md §7.6).
+
+- :func:`plastic_work` (J): Σ over the J2 points of S_PLASTIC_WORK (J/m² of reference
+  area) × weights, live and eroded elements alike (an eroded element's points keep
+  their state): the energy the metal dissipated plastically, a part of the internal
+  work W_int that the balance's ``stored`` does not hold.
+- :func:`max_plastic_strain` (—): the largest equivalent plastic strain ε̄p of an
+  element's points (0 for elements whose material is not J2).
+- :func:`thickness_ratio` (—): t / t0 = Σ_k w_k λ3,k averaged over the in-plane points
+  (λ3 = S_THICK, the thickness stretch from plastic incompressibility and the elastic
+  plane-stress ε33, eq. J10); 1 for elements whose material is not J2.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from wovenimpact.kernels import j2_layout as J
+from wovenimpact.kernels import shell_layout as S
+
+
+def has_metal(model) -> bool:
+    """The model has a J2 (plastic metal) material."""
+    return bool(np.any(model.mat_kind == S.MAT_J2))
+
+
+def simpson_weights(n_pts: int) -> np.ndarray:
+    """w_k of the n-point (odd) Simpson rule on [−t/2, t/2] normalised to Σ w_k = 1;
+    [1.0] for a resultant section (n = 1), as ``section_response`` weights its points."""
+    if n_pts == 1:
+        return np.ones(1)
+    w = np.array([1.0 if k in (0, n_pts - 1) else (4.0 if k % 2 else 2.0) for k in range(n_pts)])
+    return w / (3.0 * (n_pts - 1))
+
+
+def _j2_point_values(model, state, column: int):
+    """For each J2 section: (elements, in-plane weights (m²), Simpson weights, values
+    (elements, in-plane points, levels)) of state column ``column``."""
+    width = model.point_width
+    for sec in range(model.sections.shape[0]):
+        row = model.sections[sec]
+        if model.mat_kind[int(row[S.C_MAT])] != S.MAT_J2:
+            continue
+        elems = np.flatnonzero(model.elem_section == sec)
+        if elems.size == 0:
+            continue
+        n_pts, n_in = int(row[S.C_POINTS]), int(row[S.C_INPLANE])
+        blocks = state.mat[elems, : n_in * n_pts * width].reshape(len(elems), n_in, n_pts, width)
+        if n_in == 4:
+            w_in = model.gauss_weight[elems]
+        else:
+            w_in = model.area0[elems][:, None]
+        yield elems, w_in, simpson_weights(n_pts), blocks[..., column]
+
+
+def plastic_work(model, state) -> float:
+    """Plastic work of every J2 point in the model (J; module docstring)."""
+    total = 0.0
+    for _, w_in, w_k, values in _j2_point_values(model, state, J.S_PLASTIC_WORK):
+        total += float(np.einsum("eg,egk,k->", w_in, values, w_k))
+    return total
+
+
+def thickness_ratio(model, state) -> np.ndarray:
+    """(n_elems,) current thickness over reference thickness (module docstring)."""
+    out = np.ones(model.n_elems)
+    for elems, w_in, w_k, values in _j2_point_values(model, state, J.S_THICK):
+        per_point = np.einsum("egk,k->eg", values, w_k)
+        out[elems] = np.sum(per_point * w_in, axis=1) / np.sum(w_in, axis=1)
+    return out
+
+
+def max_plastic_strain(model, state) -> np.ndarray:
+    """(n_elems,) the largest ε̄p over each element's points (module docstring)."""
+    out = np.zeros(model.n_elems)
+    for elems, _, _, values in _j2_point_values(model, state, J.S_EPS_P):
+        out[elems] = values.reshape(len(elems), -1).max(axis=1)
+    return out

@@ -611,6 +611,13 @@ def build() -> Corpus:
     c.run_case("msh_file", _set(INP_CASE, "mesh.file", msh), kind="mesh")
     c.run_case("msh_binary", _set(INP_CASE, "mesh.file", c.file("bin.msh", bytes(range(256)))),
                kind="mesh")
+    gmsh = _set(INP_CASE, "mesh.kind", "gmsh")
+    for label, data in [("garbage", bytes(range(256)) * 3), ("empty", b""),
+                        ("utf16", "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n".encode("utf-16")),
+                        ("an_inp", plate_inp().encode()),
+                        ("truncated", b"$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 4 1 4\n")]:
+        name = c.file(f"gmsh_{label}.msh", data)
+        c.run_case(f"gmsh_{label}", _set(gmsh, "mesh.file", name), kind="mesh")
     c.run_case("inp_element_1e30", _set(_set(INP_CASE, "mesh.file",
                                              c.file("mesh_big.inp", plate_inp(h=1e27))),
                                         "run.end_time", "2 us"), kind="mesh")

@@ -622,6 +622,15 @@ def build() -> Corpus:
                                              c.file("mesh_big.inp", plate_inp(h=1e27))),
                                         "run.end_time", "2 us"), kind="mesh")
 
+    # a containment case (the example, by absolute path) with one value made absurd
+    hybrid = str(EXAMPLES / "containment" / "hybrid_4.toml")
+    for label, value in [("element_1e30", "mesh.element_size=1e30 mm"),
+                         ("element_1e-300", "mesh.element_size=1e-300 mm"),
+                         ("end_time_1e6", "run.end_time=1e6 s"),
+                         ("layers_0", "mesh.casing.layers=0")]:
+        c.add(f"containment_{label}", ["run", hybrid, "--out", f"out/cont_{label}", "--set",
+                                       value], "error", "case", timeout=120)
+
     # studies
     S = STUDY
     studies = [

@@ -161,6 +161,16 @@ def test_an_output_at_every_step_is_warned_of_only_when_there_are_many():
         compiled(_set(doc, "run.end_time", "200 us"))
 
 
+@pytest.mark.parametrize("value, fragment", [("1e30 mm", "fewer than 2 elements along"),
+                                             ("1e-300 mm", "elements in the mesh")])
+def test_a_containment_mesh_of_absurd_element_size_is_refused(value, fragment):
+    from wovenimpact.spec.case import load_case
+
+    with pytest.raises(InputError, match=fragment):
+        load_case(ROOT / "examples" / "containment" / "hybrid_4.toml",
+                  [f'mesh.element_size="{value}"'])
+
+
 def test_the_case_writer_round_trips():  # the corpus and these tests write TOML with it
     import tomllib
 

@@ -433,7 +433,8 @@ def check_references(spec: CaseSpec) -> list[Problem]:
 
 def check_mesh_size(m) -> list[Problem]:
     """A generated mesh must have at least 2 elements along each modelled edge (a quarter
-    plate's edge is half the side) and at most MAX_ELEMENTS elements in all."""
+    plate's edge is half the side; a casing's length and the released fragment) and at
+    most MAX_ELEMENTS elements in all."""
     if isinstance(m, PlateMeshSpec):
         edge = m.side / 2.0  # the generator puts round(side/2 / h) elements on a half side
         ratio = edge / m.element_size  # a float: 1e30 mm / 1e-300 mm must not overflow
@@ -448,9 +449,14 @@ def check_mesh_size(m) -> list[Problem]:
         context = f"side {m.side:g} m, {m.plies} plies"
     elif isinstance(m, ContainmentMeshSpec):
         c, b = m.casing, m.blade
+        shortest = min(c.length, b.tip_radius - b.crack_radius)  # casing length, fragment
+        if m.element_size > shortest / 2.0:
+            return [Problem("mesh.element_size", f"gives fewer than 2 elements along the "
+                            f"casing's length or the released fragment ({shortest:g} m)",
+                            m.element_size, f"element_size ≤ {shortest / 2.0:.4g} m")]
         area = (c.sector * c.inner_radius * c.length * (c.layers + 1)
                 + (b.tip_radius - b.root_radius) * max(b.root_chord, b.tip_chord))
-        count = area / m.element_size**2
+        count = area / m.element_size / m.element_size  # no underflow to 0 at 1e-300
         context = f"casing and blade, {c.layers} layers"
     else:
         return []

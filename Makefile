@@ -4,7 +4,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: venv run test bench clean
+.PHONY: venv run test bench corpus clean
 
 venv: $(STAMP)
 
@@ -35,6 +35,12 @@ bench: venv
 	$(BIN)/python benchmarks/bench_fabric_kernel.py
 	$(BIN)/python benchmarks/bench_shell.py --no-machine-line
 	$(BIN)/python benchmarks/bench_contact.py
+
+# The acceptance corpus of issue 12: ~430 bad inputs written from the examples into
+# out/corpus and run in process; prints clean / traceback / hang / nonsense counts
+# (out/corpus/results.csv) and fails unless every item is clean. Minutes, not seconds.
+corpus: venv
+	$(BIN)/python -m tests.corpus.runner --dir out/corpus
 
 clean:
 	rm -rf out .pytest_cache

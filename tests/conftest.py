@@ -7,9 +7,11 @@ import dataclasses
 import pytest
 
 from wovenimpact.calibration.crimp import crimp_amplitude
+from wovenimpact.jit import configure_threading
 from wovenimpact.materials.fabric import FabricOptions, FabricParameters, YarnFamily
 
 INCH = 0.0254
+configure_threading()  # the CLI's threading layer in tests too (importing sets nothing)
 
 
 def reference_fabric(**options) -> FabricParameters:

@@ -36,8 +36,15 @@ the user set wins: a layer in ``NUMBA_THREADING_LAYER``, a wait policy in
 user's (``NUMBA_NUM_THREADS`` or :func:`set_threads`). ``WOVENIMPACT_SERIAL=1``
 compiles loop kernels without ``parallel`` (debugging, profiling).
 
+Importing wovenimpact changes no process-wide setting (issue 12): the choices above
+are made by :func:`configure_threading`, which the CLI calls when it starts (and each
+process-pool worker); a program that uses the library and wants them calls it too,
+before the first kernel runs.
+
 Cache: compiled kernels go to ``~/.cache/wovenimpact/numba/<digest of the kernel
 sources>`` (``NUMBA_CACHE_DIR`` overrides), so editing any kernel invalidates them all.
+Numba reads its cache directory when a function is decorated, so it is set only while
+wovenimpact's kernels are decorated and put back at once (:func:`_cache_dir`).
 """
 
 from __future__ import annotations
@@ -69,13 +76,18 @@ def _preload_tbb() -> None:
                 return
 
 
-if "NUMBA_THREADING_LAYER" not in os.environ:
-    _preload_tbb()
-    numba.config.THREADING_LAYER_PRIORITY = ["tbb", "workqueue", "omp"]
-    numba.config.THREADING_LAYER = "default"  # the first of the priority list that loads
-if not any(k in os.environ for k in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT", "KMP_BLOCKTIME")):
-    os.environ["OMP_WAIT_POLICY"] = "passive"  # idle OpenMP workers sleep at once
-    os.environ["KMP_BLOCKTIME"] = "0"  # the same for Intel's runtime
+def configure_threading() -> None:
+    """The threading layer and OpenMP wait policy of the module docstring, for this
+    process (and the processes it starts): TBB, else workqueue, else OpenMP, with
+    passive OpenMP waiting; what the user set in the environment wins. Call it before
+    the first parallel kernel runs (the CLI does, when it starts)."""
+    if "NUMBA_THREADING_LAYER" not in os.environ:
+        _preload_tbb()
+        numba.config.THREADING_LAYER_PRIORITY = ["tbb", "workqueue", "omp"]
+        numba.config.THREADING_LAYER = "default"  # the first of the priority list that loads
+    if not any(k in os.environ for k in ("OMP_WAIT_POLICY", "GOMP_SPINCOUNT", "KMP_BLOCKTIME")):
+        os.environ["OMP_WAIT_POLICY"] = "passive"  # idle OpenMP workers sleep at once
+        os.environ["KMP_BLOCKTIME"] = "0"  # the same for Intel's runtime
 
 def _kernel_source_digest() -> str:
     """SHA-256 (16 hex digits) of every kernel module's source.
@@ -92,11 +104,26 @@ def _kernel_source_digest() -> str:
     return h.hexdigest()[:16]
 
 
-if "NUMBA_CACHE_DIR" not in os.environ:
-    numba.config.CACHE_DIR = str(
-        Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
-        / "wovenimpact" / "numba" / _kernel_source_digest()
-    )
+_CACHE_DIR = None if "NUMBA_CACHE_DIR" in os.environ else str(
+    Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
+    / "wovenimpact" / "numba" / _kernel_source_digest()
+)
+
+
+@contextlib.contextmanager
+def _cache_dir():
+    """Numba's cache directory set to wovenimpact's while a kernel is decorated (Numba
+    reads it then, to place that kernel's cache), and put back afterwards."""
+    if _CACHE_DIR is None:
+        yield
+        return
+    old = numba.config.CACHE_DIR
+    numba.config.CACHE_DIR = _CACHE_DIR
+    try:
+        yield
+    finally:
+        numba.config.CACHE_DIR = old
+
 
 JIT_FLAGS = dict(cache=True, fastmath=False, error_model="numpy", nogil=True)
 PARALLEL = os.environ.get("WOVENIMPACT_SERIAL", "0") not in ("1", "true", "yes")
@@ -104,12 +131,14 @@ PARALLEL = os.environ.get("WOVENIMPACT_SERIAL", "0") not in ("1", "true", "yes")
 
 def kernel(fn):
     """Compile a per-entity function (serial, inlinable into loop kernels)."""
-    return numba.njit(**JIT_FLAGS)(fn)
+    with _cache_dir():
+        return numba.njit(**JIT_FLAGS)(fn)
 
 
 def loop_kernel(fn):
     """Compile a loop over entities; ``prange`` loops run on threads."""
-    return numba.njit(parallel=PARALLEL, **JIT_FLAGS)(fn)
+    with _cache_dir():
+        return numba.njit(parallel=PARALLEL, **JIT_FLAGS)(fn)
 
 
 def set_threads(n: int) -> None:
@@ -135,23 +164,21 @@ def capped_threads(n: int, source: str = "threads") -> int:
     return n
 
 
-KEPT_CONFIG = ("CACHE_DIR", "THREADING_LAYER_PRIORITY", "THREADING_LAYER")
-
-
 def _limit_threads(n: int) -> None:
-    """Process-pool initializer: only ``n`` Numba threads exist in this worker, and the
-    worker ends itself when its parent is gone (:func:`_watch_parent`).
+    """Process-pool initializer: only ``n`` Numba threads exist in this worker, which
+    uses the CLI's threading layer (:func:`configure_threading`) and ends itself when
+    its parent is gone (:func:`_watch_parent`).
 
-    ``reload_config`` rereads every setting from the environment: without restoring them,
-    a worker lost the cache directory keyed on the kernel sources (set at import, above)
-    and loaded Numba's per-file ``__pycache__`` entries, which can hold a kernel compiled
-    against an older inlined callee — pool workers could compute with other code than
-    the parent (a likely cause of the 5e-9 pool/Dask difference of issue 13's test)."""
-    kept = {key: getattr(numba.config, key) for key in KEPT_CONFIG}
+    ``reload_config`` rereads every setting from the environment. The kernels' cache
+    directory does not depend on it: it is set while they are decorated
+    (:func:`_cache_dir`). When it was set at import instead, a worker's reload lost it and
+    the worker loaded Numba's per-file ``__pycache__`` entries, which can hold a kernel
+    compiled against an older inlined callee — pool workers could compute with other
+    code than the parent (a likely cause of the 5e-9 pool/Dask difference of issue 13's
+    test)."""
     os.environ["NUMBA_NUM_THREADS"] = str(n)
     numba.config.reload_config()
-    for key, value in kept.items():
-        setattr(numba.config, key, value)
+    configure_threading()
     threading.Thread(target=_watch_parent, args=(os.getppid(),), daemon=True,
                      name="wovenimpact-parent-watchdog").start()
 
@@ -198,4 +225,5 @@ def process_pool(workers: int, threads: int = 1):
 
 def inline_kernel(fn):
     """A per-entity function inlined into its callers at Numba IR level."""
-    return numba.njit(inline="always", **JIT_FLAGS)(fn)
+    with _cache_dir():
+        return numba.njit(inline="always", **JIT_FLAGS)(fn)

@@ -206,7 +206,7 @@ def test_width_may_exceed_the_pitch_by_the_rounding_tolerance_only():
         ("shear.c_max", 0, "must be > 0 and ≤ 1"),
         ("shear.g1", "0 GPa", "must be > 0"),
         ("shear.g2", "0.01 GPa", "smaller than g1"),
-        ("fibre_density", "-1.44 g/cm^3", "must be > 0"),
+        ("fibre_density", "-1.44 g/cm^3", "must be ≥ 1 and ≤ 100000"),
         ("warp.width", "0.95 mm", "wider than the spacing of parallel warp yarns"),
         ("fill.width", "1 mm", "0.1% allowed for rounding in printed tables"),
         ("warp.thickness", "0 mm", "must be > 0"),
@@ -432,11 +432,17 @@ def test_elastic_material_has_no_plasticity_table():
 # --- property: values round-trip through the file format ------------------------------
 
 
-@given(st.floats(min_value=1e-3, max_value=1e6, allow_nan=False, allow_infinity=False))
+@given(st.floats(min_value=1e-3, max_value=2e3, allow_nan=False, allow_infinity=False))
 def test_any_positive_modulus_round_trips(gpa):
     p = material_from_dict(edited(kevlar_doc(), "warp.modulus", f"{gpa!r} GPa"))
     assert p.warp.modulus == pytest.approx(gpa * 1e9, rel=1e-14)
     assert p.fill.modulus == pytest.approx(96e9, rel=1e-14)
+
+
+def test_a_modulus_stiffer_than_any_material_is_refused():
+    # 2 TPa bound (diamond is 1.2 TPa): a unit slip such as "96e3 GPa" is an error
+    assert "material.warp.modulus: must be > 0 and ≤ 2e+12" in error_of(
+        edited(kevlar_doc(), "warp.modulus", "96e3 GPa"))
 
 
 @given(st.floats(min_value=0.0, max_value=0.3), st.sampled_from(["", " %"]))

@@ -16,6 +16,7 @@ as much as its stiff end; ``weighting="absolute"`` reproduces the App. A cost.
 from __future__ import annotations
 
 import csv
+import io
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -26,6 +27,7 @@ from numpy.typing import NDArray
 from scipy.optimize import least_squares
 
 from wovenimpact.errors import InputError
+from wovenimpact.spec.fields import read_text
 from wovenimpact.units import QuantityError, to_si
 
 MIN_POINTS = 3
@@ -69,6 +71,11 @@ class CompressionFit:
     weighting: str = "relative"
 
 
+MAX_COMPRESSION = 0.1  # m: a ply of fabric compacts by a fraction of a millimetre
+MIN_COMPRESSION = 1e-9  # m
+MAX_FORCE = 1e9  # N
+
+
 def compaction_force(d: NDArray[np.float64] | float, a: float, b: float):
     """F = b·d / (a − d), thesis eq. (5.8) (N for d, a in m and b in N)."""
     return b * np.asarray(d) / (a - np.asarray(d))
@@ -87,6 +94,16 @@ def _check_data(d: NDArray[np.float64], F: NDArray[np.float64], source: str) -> 
     if np.any(d < 0.0) or np.any(F < 0.0):
         raise InputError(
             f"{source}: d and F must be ≥ 0 (compression and compressive force are positive)"
+        )
+    if d.max() > MAX_COMPRESSION or F.max() > MAX_FORCE:
+        raise InputError(
+            f"{source}: largest d = {d.max():g} m, F = {F.max():g} N (valid: a ply's compaction, "
+            f"d ≤ {MAX_COMPRESSION:g} m and F ≤ {MAX_FORCE:g} N; check the units in the header)"
+        )
+    if d.max() < MIN_COMPRESSION:
+        raise InputError(
+            f"{source}: the largest compression d = {d.max():g} m is below {MIN_COMPRESSION:g} m "
+            "(valid: a measured compaction; check the units in the header)"
         )
     if np.unique(d[d > 0.0]).size < 2:
         raise InputError(f"{source}: at least 2 distinct compressions d > 0 are needed")
@@ -212,12 +229,11 @@ def read_compression_csv(path: str | Path) -> CompressionData:
     """
     path = Path(path)
     source = str(path)
+    text = read_text(path, "data file")
     try:
-        with path.open(newline="", encoding="utf-8") as fh:
-            rows = [(n, r) for n, r in enumerate(csv.reader(fh), start=1) if _is_data(r)]
-    except OSError as err:
-        raise InputError(f"{source}: cannot read the data file ({err.strerror})") from None
-    except (csv.Error, UnicodeDecodeError) as err:
+        rows = [(n, r) for n, r in enumerate(csv.reader(io.StringIO(text, newline="")), start=1)
+                if _is_data(r)]
+    except csv.Error as err:
         raise InputError(f"{source}: not a readable CSV file ({err})") from None
     if not rows:
         raise InputError(f"{source}: empty file (valid: a header d_mm,F_mN then data rows)")

@@ -51,7 +51,10 @@ def _main(
                                  help="Print the version and exit."),
 ) -> None:
     """Explicit dynamics of impacts on dry woven fabric and metal."""
+    from wovenimpact.jit import configure_threading
+
     warnings.showwarning = _show_warning
+    configure_threading()  # the library itself sets nothing process-wide (issue 12)
 
 
 def _jsonable(v):

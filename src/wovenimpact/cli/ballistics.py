@@ -4,6 +4,7 @@ runs only: an undecided or no-contact run is refused, naming the variant)."""
 from __future__ import annotations
 
 import csv
+import io
 import json
 from pathlib import Path
 
@@ -11,6 +12,7 @@ import typer
 
 from wovenimpact.cli.app import app, emit, fail
 from wovenimpact.errors import InputError
+from wovenimpact.spec.fields import read_text
 from wovenimpact.units import to_si
 
 ballistics_app = typer.Typer(help="Ballistic fits of sweep results.", no_args_is_help=True)
@@ -22,11 +24,12 @@ EXIT = "fragment_exit_speed_m_per_s"  # a containment run's stand-in for the res
 
 
 def _rows(results: Path) -> list[dict]:
+    text = read_text(results, "results file")
     try:
-        with results.open(newline="", encoding="utf-8") as fh:
-            rows = [r for r in csv.DictReader(fh) if r.get("status") == "done"]
-    except OSError as err:
-        raise InputError(f"{results}: cannot read ({err.strerror})") from None
+        rows = [r for r in csv.DictReader(io.StringIO(text, newline=""))
+                if r.get("status") == "done"]
+    except csv.Error as err:
+        raise InputError(f"{results}: not a readable CSV file ({err})") from None
     if not rows or not ({RESIDUAL, EXIT} & set(rows[0])):
         raise InputError(f"{results}: no finished runs with {RESIDUAL} (or {EXIT} for a "
                          "containment study): list it in the study's metrics")

@@ -14,6 +14,22 @@ import numba
 import typer
 
 from wovenimpact.cli.app import app, console, fail
+from wovenimpact.errors import InputError
+
+
+def _counts(text: str, flag: str, low: int, high: int) -> list[int]:
+    """A comma-separated list of integers from ``low`` to ``high`` (an InputError else)."""
+    out = []
+    for word in text.split(","):
+        try:
+            n = int(word.strip())
+        except ValueError:
+            n = None
+        if n is None or not low <= n <= high:
+            raise InputError(f"{flag} {text!r}: {word.strip()!r} is not valid (valid: whole "
+                             f"numbers {low} to {high:g}, comma-separated)")
+        out.append(n)
+    return out
 
 
 @app.command("bench")
@@ -34,15 +50,21 @@ def bench(
     from wovenimpact.benchmark import KINDS, case_line, machine, machine_line, run_cases
 
     from wovenimpact.jit import capped_threads
+    from wovenimpact.spec.case import MAX_ELEMENTS
 
-    counts = (list(dict.fromkeys(capped_threads(int(t), "--threads") for t in threads.split(",")))
-              if threads else sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)}))
+    try:
+        size_list = _counts(sizes, "--sizes", 1, MAX_ELEMENTS)
+        thread_list = _counts(threads, "--threads", 1, 1 << 16) if threads else None
+    except InputError as err:
+        fail(str(err))
     bad = [k for k in kinds.split(",") if k not in KINDS]
     if bad:
         fail(f"--kinds: bench kind {bad[0]!r}; valid: {', '.join(KINDS)}")
+    counts = (list(dict.fromkeys(capped_threads(t, "--threads") for t in thread_list))
+              if thread_list else sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)}))
     if not as_json:
         console.print(machine_line(), highlight=False, soft_wrap=True)
-    cases = run_cases(kinds.split(","), [int(s) for s in sizes.split(",")], counts, steps,
+    cases = run_cases(kinds.split(","), size_list, counts, steps,
                       report=None if as_json else
                       (lambda c: console.print(case_line(c), soft_wrap=True)))
     if as_json:

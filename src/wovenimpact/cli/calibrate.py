@@ -45,11 +45,12 @@ def crimp(
 ) -> None:
     """Crimp amplitude h0 of eq. (5.5) and the default shell thickness 4·h0 (Table 5-1)."""
     from wovenimpact.calibration.crimp import calibrate_crimp
+    from wovenimpact.spec.material import MAX_CRIMP
     from wovenimpact.units import to_si
 
     try:
         n = to_si(thread_count, "inverse_length", "--thread-count", gt=0.0)
-        c = to_si(crimp_value, "dimensionless", "--crimp", ge=0.0)
+        c = to_si(crimp_value, "dimensionless", "--crimp", ge=0.0, le=MAX_CRIMP)
     except InputError as err:
         _fail_input(err)
     result = calibrate_crimp(n, c)
@@ -93,22 +94,23 @@ def compression(
         plot_compression_fit,
         read_compression_csv,
     )
+    from wovenimpact.io.outdir import prepare_output_dir, write_failure
 
     try:
         if weighting not in ("relative", "absolute"):
             raise InputError(
                 f"--weighting = {weighting!r} is not valid: use 'relative' or 'absolute'"
             )
+        out_dir = data.parent if out is None else out
+        prepare_output_dir(out_dir)
         measured = read_compression_csv(data)
         fit = fit_compression(measured.d_m, measured.F_N, measured.source, weighting)
     except InputError as err:
         _fail_input(err)
-    out_dir = data.parent if out is None else out
     try:
-        out_dir.mkdir(parents=True, exist_ok=True)
         plot = plot_compression_fit(measured, fit, out_dir / f"{data.stem}_fit.png")
     except OSError as err:
-        _fail_input(InputError(f"--out = {str(out_dir)!r}: cannot write the plot ({err})"))
+        _fail_input(InputError(write_failure(err, "the plot")))
     emit(
         {
             "a_m": fit.a_m,

@@ -28,14 +28,19 @@ def plies(
     """Search the number of plies (doubling, then bisection) and print the answer with
     the areal mass of the pack; on a containment case, the casing layers that contain the
     fragment, with the casing's mass."""
+    from wovenimpact.io.outdir import prepare_output_dir, write_failure
     from wovenimpact.studies.design import design_plies
 
+    out = out or Path("out") / f"design_{case.stem}"
     try:
-        result = design_plies(case, out or Path("out") / f"design_{case.stem}", workers=workers,
+        prepare_output_dir(out)
+        result = design_plies(case, out, workers=workers,
                               start=start, overrides=overrides or (), check=check,
                               log=lambda m: err_console.print(f"[yellow]{m}[/]"))
     except InputError as err:
         fail(str(err))
+    except OSError as err:
+        fail(write_failure(err, f"the runs of {case}"))
     shown = dict(result)
     if not as_json:
         shown["runs"] = ", ".join(f"{k}: {v}" for k, v in result["runs"].items())

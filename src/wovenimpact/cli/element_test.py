@@ -20,6 +20,9 @@ from wovenimpact.cli.app import app, emit, fail
 from wovenimpact.errors import InputError, MaterialPointError
 
 
+MAX_STRAIN_RATE = 1e8  # 1/s: the Johnson–Cook rate terms are checked up to this
+
+
 class Test(str, Enum):
     uniaxial = "uniaxial"
     uniaxial_free = "uniaxial-free"
@@ -78,7 +81,8 @@ def element_test(
         "0.001 1/s", "--strain-rate", help="Metal: rate of the applied strain (with unit)."
     ),
     thickness: str = typer.Option("1 mm", help="Metal: reference thickness t0 (with unit)."),
-    steps: int = typer.Option(None, min=1, help="Number of load steps (fabric 600, metal 400)."),
+    steps: int = typer.Option(None, min=1, max=1_000_000,
+                              help="Number of load steps (fabric 600, metal 400)."),
     homogenisation: Homogenisation = typer.Option(None, help="Fabric: override the material's."),
     shear_law: ShearLaw = typer.Option(
         None, "--shear-law", help="Fabric: override the material's."
@@ -100,9 +104,18 @@ def element_test(
     from wovenimpact.materials.fabric import FabricParameters
     from wovenimpact.materials.metal import MetalParameters
     from wovenimpact.spec import load_material
+    from wovenimpact.io.outdir import prepare_output_dir
     from wovenimpact.units import to_si
 
     try:
+        prepare_output_dir(out)
+        # every quantity flag is checked, also one the chosen test does not use
+        angle_si = to_si(angle, "angle", "--angle", gt=0, le=math.pi / 2)
+        rate_si = to_si(strain_rate, "strain_rate", "--strain-rate", gt=0, le=MAX_STRAIN_RATE)
+        thickness_si = to_si(thickness, "length", "--thickness", ge=1e-6, le=1.0)
+        if softening_strain is not None and not 0.0 < softening_strain < 1.0:
+            raise InputError(f"--softening-strain = {softening_strain} is not valid: it must "
+                             "be > 0 and < 1 (e.g. 0.01)")
         params = load_material(material)
         if isinstance(params, MetalParameters):
             fabric_only = dict(displacement=displacement, homogenisation=homogenisation,
@@ -131,8 +144,8 @@ def element_test(
                 test.value,
                 strain=strain,
                 n_steps=400 if steps is None else steps,
-                strain_rate=to_si(strain_rate, "strain_rate", "--strain-rate", gt=0),
-                thickness=to_si(thickness, "length", "--thickness", gt=0),
+                strain_rate=rate_si,
+                thickness=thickness_si,
             )
     except (InputError, ValueError, MaterialPointError) as err:
         fail(str(err))
@@ -167,9 +180,14 @@ def element_test(
                 )
             params = dataclasses.replace(params, options=opts)
         if test.value in ("shear", "picture-frame"):
-            amplitude = to_si(angle, "angle", "--angle")
+            amplitude = angle_si
         else:
-            amplitude = to_si(displacement, "length", "--displacement")
+            amplitude = to_si(displacement, "length", "--displacement", gt=0)
+            cell = 2.0 * min(params.warp.half_length, params.fill.half_length)
+            if amplitude > cell:
+                raise InputError(f"--displacement = {displacement!r} is more than the unit "
+                                 f"cell's side 2ℓ0 = {cell * 1e3:.4g} mm (100 % strain; the "
+                                 f"yarns break near 2 %) (valid: up to {cell * 1e3:.4g} mm)")
         result = run_element_test(params, test.value, amplitude=amplitude, n_steps=steps)
     except (InputError, ValueError, MaterialPointError) as err:
         fail(str(err))
@@ -178,7 +196,17 @@ def element_test(
 
 
 def _write_outputs(out: Path, result, write_csv, plot, test: Test, as_json: bool) -> None:
-    """history.csv, the figures and summary.json into ``out``; print the summary."""
+    """history.csv, the figures and summary.json into ``out``; print the summary (a
+    failed write, e.g. a full disk, is a one-line error)."""
+    from wovenimpact.io.outdir import write_failure
+
+    try:
+        _write_files(out, result, write_csv, plot, test, as_json)
+    except OSError as err:
+        fail(write_failure(err, f"the element test into {out}"))
+
+
+def _write_files(out: Path, result, write_csv, plot, test: Test, as_json: bool) -> None:
     out.mkdir(parents=True, exist_ok=True)
     csv_path = write_csv(result, out / "history.csv")
     figures = plot(result, out)

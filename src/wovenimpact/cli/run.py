@@ -43,8 +43,13 @@ def run(
 ) -> None:
     """Run CASE to its end time; write history.csv, summary.json, report.html, fields/,
     plots/, checkpoints/."""
+    from wovenimpact.io.outdir import prepare_output_dir, write_failure
     from wovenimpact.runs import run_case
 
+    try:
+        prepare_output_dir(out)
+    except InputError as err:
+        fail(str(err))
     bar = _bar(quiet=as_json)
     task = bar.add_task(case.stem, total=1.0, t_us=0.0, end_us=0.0, rate=0.0, eta="?")
     start = {"wall": time.perf_counter(), "step": None}
@@ -72,6 +77,9 @@ def run(
     except SimulationError as err:
         bar.stop()
         fail(f"the run stopped: {err}", code=3)
+    except OSError as err:  # a full disk, the output directory removed mid-run
+        bar.stop()
+        fail(write_failure(err, f"the outputs of {case}"))
     bar.stop()
     emit(summary, as_json, f"{case.name}: summary (also in {out / 'summary.json'})")
     if not as_json:

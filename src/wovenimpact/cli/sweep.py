@@ -26,9 +26,16 @@ def sweep(
 ) -> None:
     """Run every variant of STUDY (finished ones are kept), write results.csv, plots/ and
     report.html (linking each variant's page)."""
-    from wovenimpact.studies.sweep import run_study
+    from wovenimpact.io.outdir import prepare_output_dir, write_failure
+    from wovenimpact.studies.sweep import check_scheduler, run_study
 
     out_dir = out or Path("out") / study.stem
+    try:
+        if scheduler is not None:
+            check_scheduler(scheduler)
+        prepare_output_dir(out_dir)
+    except InputError as err:
+        fail(str(err))
     bar = Progress(TextColumn("[bold]{task.description}"), BarColumn(), MofNCompleteColumn(),
                    TextColumn("{task.fields[last]}"), TimeElapsedColumn(),
                    console=err_console, disable=as_json)
@@ -44,6 +51,8 @@ def sweep(
                              progress=report, overrides=overrides or ())
     except InputError as err:
         fail(str(err))
+    except OSError as err:
+        fail(write_failure(err, f"the results of {study}"))
     failed = [r for r in rows if r["status"] != "done"]
     if as_json:
         typer.echo(json.dumps({"results": rows, "failed": len(failed), "out": str(out_dir)}))

@@ -25,6 +25,7 @@ import numpy as np
 
 from wovenimpact.errors import InputError
 from wovenimpact.model.mesh import Mesh
+from wovenimpact.spec.fields import read_text
 
 SHELL_TYPES = ("quad", "triangle")
 SKIPPED_TYPES = ("line", "line3", "vertex")
@@ -54,6 +55,10 @@ def read_inp(path: str | Path) -> Mesh:
     if not len(quads):
         raise InputError(f"{path}: no shell elements (S4, S4R, S3, S3R) found")
     nodes = _xyz(path, raw.points)
+    bad = np.flatnonzero(~np.all(np.isfinite(nodes), axis=1))
+    if bad.size:
+        raise InputError(f"{path}: node {bad[0] + 1} (in file order) has a non-finite "
+                         f"coordinate {nodes[bad[0]].tolist()} (valid: finite numbers)")
     elem_sets = _elem_sets(raw, scan, offsets)
     node_sets = {name: np.unique(np.asarray(idx, dtype=np.int64))
                  for name, idx in raw.point_sets.items()}
@@ -150,38 +155,59 @@ def _scan_keywords(path: Path) -> _Keywords:
     scan = _Keywords()
     n_node_blocks = 0
     pending_elset: str | None = None  # an *ELSET whose first data line comes next
-    with open(path, encoding="utf-8", errors="replace") as f:
-        for lineno, line in enumerate(f, 1):
-            text = line.strip()
-            if not text or text.startswith("**"):
-                continue
-            if not text.startswith("*"):
-                if pending_elset is not None and not text.split(",")[0].strip().isnumeric():
-                    raise InputError(f"{path}:{lineno}: *ELSET {pending_elset!r} lists other "
-                                     "sets by name; list element numbers instead")
-                pending_elset = None
-                continue
+    block = ""  # the keyword whose data lines follow
+    ids: dict[str, dict[int, int]] = {"NODE": {}, "ELEMENT": {}}  # id → line, per kind
+    continued = False
+    for lineno, line in enumerate(read_text(path, "mesh file").splitlines(), 1):
+        text = line.strip()
+        if not text or text.startswith("**"):
+            continue
+        if not text.startswith("*"):
+            if pending_elset is not None and not text.split(",")[0].strip().isnumeric():
+                raise InputError(f"{path}:{lineno}: *ELSET {pending_elset!r} lists other "
+                                 "sets by name; list element numbers instead")
             pending_elset = None
-            keyword, params = _keyword_line(text)
-            if keyword == "NODE":
-                n_node_blocks += 1
-                if n_node_blocks > 1:
-                    raise InputError(f"{path}:{lineno}: a second *NODE block (parts or "
-                                     "instances?); write the file without parts and assemblies")
-            elif keyword == "INCLUDE":
-                raise InputError(f"{path}:{lineno}: *INCLUDE is not supported; inline the file")
-            elif keyword == "ELEMENT":
-                scan.element_elsets.append(params.get("ELSET"))
-                scan.last_element_line = lineno
-                if params.get("ELSET") is not None:
-                    scan.element_declared.add(params["ELSET"])
-            elif keyword == "NSET":
-                _define(scan.nset_lines, path, lineno, "node set", params.get("NSET", ""))
-            elif keyword == "ELSET":
-                pending_elset = params.get("ELSET", "")
-                _define(scan.elset_lines, path, lineno, "element set", pending_elset)
+            if block in ids and not continued:
+                _check_id(ids[block], path, lineno, block, text)
+            continued = text.endswith(",")  # an element's nodes go on on the next line
+            continue
+        pending_elset = None
+        continued = False
+        keyword, params = _keyword_line(text)
+        block = keyword
+        if keyword == "NODE":
+            n_node_blocks += 1
+            if n_node_blocks > 1:
+                raise InputError(f"{path}:{lineno}: a second *NODE block (parts or "
+                                 "instances?); write the file without parts and assemblies")
+        elif keyword == "INCLUDE":
+            raise InputError(f"{path}:{lineno}: *INCLUDE is not supported; inline the file")
+        elif keyword == "ELEMENT":
+            scan.element_elsets.append(params.get("ELSET"))
+            scan.last_element_line = lineno
+            if params.get("ELSET") is not None:
+                scan.element_declared.add(params["ELSET"])
+        elif keyword == "NSET":
+            _define(scan.nset_lines, path, lineno, "node set", params.get("NSET", ""))
+        elif keyword == "ELSET":
+            pending_elset = params.get("ELSET", "")
+            _define(scan.elset_lines, path, lineno, "element set", pending_elset)
     _check_elset_order(path, scan)
     return scan
+
+
+def _check_id(seen: dict[int, int], path: Path, lineno: int, kind: str, text: str) -> None:
+    """The first field of a *NODE / *ELEMENT data line: a number not given before."""
+    head = text.split(",")[0].strip()
+    try:
+        number = int(head)
+    except ValueError:
+        raise InputError(f"{path}:{lineno}: {head!r} is not a {kind.lower()} number (valid: "
+                         "a positive integer id, then the data)") from None
+    if number in seen:
+        raise InputError(f"{path}:{lineno}: {kind.lower()} {number} is defined again (first "
+                         f"on line {seen[number]}); every {kind.lower()} id must be unique")
+    seen[number] = lineno
 
 
 def _define(lines: dict[str, int], path: Path, lineno: int, kind: str, name: str) -> None:

@@ -19,6 +19,7 @@ from wovenimpact.errors import InputError
 from wovenimpact.model.abaqus import read_inp
 from wovenimpact.model.gmsh import read_msh
 from wovenimpact.model.mesh import Mesh, plate_mesh
+from wovenimpact.model.sanity import check_case
 from wovenimpact.impactor import Impactor
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels.contact_rigid import rigid_contact_forces
@@ -191,6 +192,9 @@ def erode_at_start(model: Model, state: State, er, key: str) -> None:
     if not hit.any():
         raise InputError(f"{key}: no element centroid lies within {er.radius:g} m of the axis "
                          "through centre (and in the given plies)")
+    if hit.all():
+        raise InputError(f"{key}: radius {er.radius:g} m erodes every element at t = 0 "
+                         "(valid: a hole smaller than the plies)")
     state.elem[hit, S.E_ALIVE] = 0.0
     live = np.zeros(model.n_nodes, dtype=bool)
     live[model.quads[state.elem[:, S.E_ALIVE] != 0.0].ravel()] = True
@@ -408,6 +412,7 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     w[model.bc_code[:, 3:] == 1] = 0.0
     check_impactor_clearance(model)
     state = initial_state(model, velocity=v, angular_velocity=w)
+    check_case(spec, model, state, mesh, sections)  # model.sanity: before the expensive parts
     if spin is not None:
         spin_blade(model, state, mesh, sections[spec.mesh.blade.section], spin,
                    spec.spin.relaxation_tolerance, warp)

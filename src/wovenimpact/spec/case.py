@@ -49,7 +49,9 @@ Schema (see README and examples/cases/)::
     [[initial_erosion]]  centre, radius, plies?: elements eroded at t = 0 (a hole: centroid
                       within radius of the axis through centre along cylinder_axis)
     [run]             end_time, field_interval, history_interval, checkpoint_interval,
-                      alpha, erode_dt_fraction, erode_inverted, threads
+                      alpha, erode_dt_fraction, erode_inverted, threads, max_steps (the
+                      predicted step count end_time/Δt₁ above which the run is refused;
+                      5e6; docs/inputs.md)
 """
 
 from __future__ import annotations
@@ -91,6 +93,12 @@ Spin = quantity("angular_velocity", example="1047 rad/s")
 Accel = quantity("acceleration", example="-9.81 m/s^2")
 Coordinate = quantity("length", example="0 mm")
 DOFS = ("ux", "uy", "uz", "rx", "ry", "rz")
+# run.max_steps default: a long casing run (5 ms of 0.5 mm elements at Δt ≈ 5e-8 s is 1e5
+# steps) with 50× to spare; a run of 5e6 steps of 10⁵ elements is days on two cores
+DEFAULT_MAX_STEPS = 5_000_000
+# the largest mesh compiled: 5 million elements (the element and material state alone
+# are ~10 GB); a larger count is a unit slip (mesh.side = "1e30 mm"), not a model
+MAX_ELEMENTS = 5_000_000
 
 
 class CaseInfo(BaseModel):
@@ -291,6 +299,8 @@ class RunSpec(BaseModel):
     # docs/theory.md §5): 1 %, the report's verdict line; the shipped examples and study
     # variants stay below 4e-3
     energy_tolerance: quantity("dimensionless", gt=0, le=1, example="0.01") = 0.01
+    # the predicted step count end_time / Δt₁ above which a run is refused (model.sanity)
+    max_steps: int = Field(default=DEFAULT_MAX_STEPS, ge=1)
 
 
 class ImpactorSpec(BaseModel):
@@ -422,7 +432,42 @@ def check_references(spec: CaseSpec) -> list[Problem]:
         problems.append(Problem("mesh.spacing", "is missing", valid="the distance between ply "
                                 "mid-planes, e.g. '0.5 mm', needed when plies > 1 "
                                 "(or ply_sections: touching plies)"))
-    return problems
+    return problems + check_mesh_size(spec.mesh)
+
+
+def check_mesh_size(m) -> list[Problem]:
+    """A generated mesh must have at least 2 elements along each modelled edge (a quarter
+    plate's edge is half the side; a casing's length and the released fragment) and at
+    most MAX_ELEMENTS elements in all."""
+    if isinstance(m, PlateMeshSpec):
+        edge = m.side / 2.0  # the generator puts round(side/2 / h) elements on a half side
+        ratio = edge / m.element_size  # a float: 1e30 mm / 1e-300 mm must not overflow
+        per_half = round(ratio) if ratio < 1e15 else ratio
+        if per_half < 2:
+            where = "the quarter plate's edge" if m.quarter else "each half of the plate's side"
+            return [Problem("mesh.element_size", f"gives {per_half} element(s) along {where} "
+                            f"({edge:g} m)", m.element_size,
+                            f"element_size ≤ {edge / 1.5:.4g} m (2 elements or more)")]
+        per_side = float(per_half) * (1 if m.quarter else 2)
+        count = per_side * per_side * m.plies
+        context = f"side {m.side:g} m, {m.plies} plies"
+    elif isinstance(m, ContainmentMeshSpec):
+        c, b = m.casing, m.blade
+        shortest = min(c.length, b.tip_radius - b.crack_radius)  # casing length, fragment
+        if m.element_size > shortest / 2.0:
+            return [Problem("mesh.element_size", f"gives fewer than 2 elements along the "
+                            f"casing's length or the released fragment ({shortest:g} m)",
+                            m.element_size, f"element_size ≤ {shortest / 2.0:.4g} m")]
+        area = (c.sector * c.inner_radius * c.length * (c.layers + 1)
+                + (b.tip_radius - b.root_radius) * max(b.root_chord, b.tip_chord))
+        count = area / m.element_size / m.element_size  # no underflow to 0 at 1e-300
+        context = f"casing and blade, {c.layers} layers"
+    else:
+        return []
+    if count > MAX_ELEMENTS:
+        return [Problem("mesh.element_size", f"gives about {count:.3g} elements ({context})",
+                        m.element_size, f"at most {MAX_ELEMENTS:g} elements in the mesh")]
+    return []
 
 
 INTERVALS = ("field_interval", "history_interval", "checkpoint_interval")

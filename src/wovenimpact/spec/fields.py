@@ -101,14 +101,38 @@ class Problem:
         return f"{source}: {self.path}: {self.what}{tail}"
 
 
-def read_toml(path, what: str) -> dict:
-    """The parsed TOML document at ``path``; an InputError naming the file and ``what``
-    it is ("case file", "material file", …) if it cannot be read or parsed."""
+def read_text(path, what: str) -> str:
+    """The text of the input file at ``path``, decoded as UTF-8 (a byte-order mark is
+    accepted); an InputError naming the file and ``what`` it is ("case file",
+    "material file", …) if it cannot be read, is binary or is not UTF-8 (the byte and
+    its line named, UTF-16 recognised by its byte-order mark)."""
     path = Path(path)
     try:
-        text = path.read_text(encoding="utf-8")
+        data = path.read_bytes()
     except OSError as err:
         raise InputError(f"{path}: cannot read the {what} ({err.strerror})") from None
+    if data[:2] in (b"\xff\xfe", b"\xfe\xff"):
+        raise InputError(f"{path}: the {what} is UTF-16 (valid: UTF-8 text; save it as UTF-8)")
+    if b"\x00" in data:
+        at = data.index(b"\x00")
+        line = data.count(b"\n", 0, at) + 1
+        raise InputError(f"{path}: the {what} is not text (a NUL byte at offset {at}, line "
+                         f"{line}; valid: UTF-8 text)")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as err:
+        line = data.count(b"\n", 0, err.start) + 1
+        raise InputError(f"{path}: the {what} is not UTF-8 (byte {data[err.start]:#04x} at "
+                         f"offset {err.start}, line {line}; valid: UTF-8 text, e.g. save "
+                         "it as UTF-8 in the editor)") from None
+
+
+def read_toml(path, what: str) -> dict:
+    """The parsed TOML document at ``path`` (:func:`read_text`); an InputError naming
+    the file and ``what`` it is ("case file", "material file", …) if it cannot be read
+    or parsed."""
+    path = Path(path)
+    text = read_text(path, what)
     try:
         return tomllib.loads(text)
     except tomllib.TOMLDecodeError as err:

@@ -47,6 +47,16 @@ from wovenimpact.spec.fields import (
 WIDTH_TOLERANCE = 1e-3  # width may exceed the yarn pitch by 0.1 %: rounding of printed tables
 LENTICULAR_TOLERANCE = 0.05  # warn if A differs from (2/π)·width·thickness by more than 5 %
 H0_TOLERANCE = 0.01  # warn if a given h0 differs from eq. (5.5) by more than 1 %
+# bounds no real material passes (a unit slip, an extra exponent): stiffer than diamond
+# (1.2 TPa), a fibre lighter than air or denser than osmium (22.6 g/cm³); crimps of
+# woven fabrics are a few % (50 % would be a yarn half again as long as the fabric)
+MAX_MODULUS = 2e12
+MIN_DENSITY = 1.0
+MAX_DENSITY = 1e5
+MAX_CRIMP = 0.5
+MAX_COMPACTION_FORCE = 1e6  # N: b of one crossover (Kevlar: 0.98 N)
+MAX_YIELD_STRAIN = 0.1  # initial yield stress / modulus: metals yield below 1 %
+MAX_PITCH_WIDTHS = 10.0  # yarns further apart than 10 widths are not a woven fabric
 PLANE_STRESS_TRIAXIALITY = 2.0 / 3.0  # |η| = |σ_m / σ_eq| ≤ 2/3 in plane stress
 MAX_RATE_RATIO = 1e8  # Johnson–Cook rate terms must stay positive up to ε̇/ε̇0 = 1e8
 
@@ -58,9 +68,9 @@ class YarnSpec(BaseModel):
 
     model_config = STRICT
     thread_count: quantity("inverse_length", gt=0)  # threads per length of THIS family
-    crimp: quantity("dimensionless", ge=0, example="0.0421")
+    crimp: quantity("dimensionless", ge=0, le=MAX_CRIMP, example="0.0421")
     area: quantity("area", gt=0)
-    modulus: quantity("pressure", gt=0)
+    modulus: quantity("pressure", gt=0, le=MAX_MODULUS, example="96 GPa")
     ultimate_tension: quantity("force", gt=0)
     width: quantity("length", gt=0, example="0.9407 mm")
     thickness: quantity("length", gt=0, example="0.2499 mm")
@@ -73,7 +83,7 @@ class CompactionSpec(BaseModel):
 
     model_config = STRICT
     a: quantity("length", gt=0, example="0.12389 mm")
-    b: quantity("force", gt=0, example="0.98432 N")
+    b: quantity("force", gt=0, le=MAX_COMPACTION_FORCE, example="0.98432 N")
 
 
 class ShearSpec(BaseModel):
@@ -106,7 +116,7 @@ class FabricSpec(BaseModel):
     model_config = STRICT
     name: str = Field(min_length=1)
     kind: Literal["woven_fabric"]
-    fibre_density: quantity("density", gt=0)
+    fibre_density: quantity("density", ge=MIN_DENSITY, le=MAX_DENSITY, example="1.44 g/cm^3")
     areal_density: quantity("areal_density", gt=0, example="0.477 kg/m^2") | None = None
     thickness: quantity("length", gt=0, example="0.4998 mm") | None = None
     warp: YarnSpec
@@ -166,7 +176,7 @@ class J2Spec(BaseModel):
     name: str = Field(min_length=1)
     kind: Literal["j2_plastic"]
     density: quantity("density", gt=0, example="2.78 g/cm^3")
-    modulus: quantity("pressure", gt=0, example="72 GPa")
+    modulus: quantity("pressure", gt=0, le=MAX_MODULUS, example="72 GPa")
     poisson: quantity("dimensionless", ge=0, lt=0.5, example="0.3")
     plasticity: PlasticitySpec
     rate: RateSpec | None = None
@@ -180,7 +190,7 @@ class ElasticSpec(BaseModel):
     name: str = Field(min_length=1)
     kind: Literal["elastic"]
     density: quantity("density", gt=0, example="2.78 g/cm^3")
-    modulus: quantity("pressure", gt=0, example="72 GPa")
+    modulus: quantity("pressure", gt=0, le=MAX_MODULUS, example="72 GPa")
     poisson: quantity("dimensionless", ge=0, lt=0.5, example="0.3")
 
 
@@ -355,6 +365,7 @@ def _check_fabric(spec: FabricSpec, raw: dict) -> list[Problem]:
                     f"a length ≤ {pitch * (1.0 + WIDTH_TOLERANCE) * 1e3:.6g} mm",
                 )
             )
+    problems += _check_weave_geometry(spec, raw)
     if spec.options.failure == "progressive" and spec.options.softening_strain is None:
         problems.append(
             Problem(
@@ -367,13 +378,62 @@ def _check_fabric(spec: FabricSpec, raw: dict) -> list[Problem]:
     return problems
 
 
+def _check_weave_geometry(spec: FabricSpec, raw: dict) -> list[Problem]:
+    """A weave the crossover cell can hold (theory: material geometry, docs/inputs.md):
+    each yarn fits in its width × thickness box and is no thicker than wide, yarns lie
+    at most MAX_PITCH_WIDTHS widths apart, the two crimp heights (eq. 5.5, or h0 given)
+    add up to at most the two yarn thicknesses (Peirce: about half of them), and the
+    compaction limit a is at most the two thicknesses."""
+    problems = []
+    t_sum = spec.warp.thickness + spec.fill.thickness
+    heights = 0.0
+    for fam, other in (("warp", "fill"), ("fill", "warp")):
+        y: YarnSpec = getattr(spec, fam)
+        pitch = 1.0 / y.thread_count
+        if y.area > y.width * y.thickness:
+            problems.append(Problem(
+                f"material.{fam}.area", "is larger than the yarn's width × thickness box "
+                f"({y.width * y.thickness * 1e6:.4g} mm^2)", _raw(raw, fam, "area"),
+                f"an area ≤ width × thickness; a lenticular yarn has (2/π)·width·thickness = "
+                f"{2 / math.pi * y.width * y.thickness * 1e6:.4g} mm^2"))
+        if y.thickness > y.width:
+            problems.append(Problem(
+                f"material.{fam}.thickness", f"is larger than the yarn width "
+                f"({y.width * 1e3:.4g} mm): a yarn is flattened by weaving, not upright",
+                _raw(raw, fam, "thickness"), f"a length ≤ width = {y.width * 1e3:.4g} mm"))
+        if pitch > MAX_PITCH_WIDTHS * y.width:
+            problems.append(Problem(
+                f"material.{fam}.thread_count", f"puts the {fam} yarns {pitch * 1e3:.4g} mm "
+                f"apart, more than {MAX_PITCH_WIDTHS:g} yarn widths: an open net, not a woven "
+                "fabric", _raw(raw, fam, "thread_count"),
+                f"a thread count ≥ {1.0 / (MAX_PITCH_WIDTHS * y.width) * 0.0254:.4g} 1/in"))
+        half = half_length_from_thread_count(getattr(spec, other).thread_count)
+        heights += crimp_amplitude(half, y.crimp) if y.h0 is None else y.h0
+    if heights > t_sum:
+        problems.append(Problem(
+            "material.warp.crimp / material.fill.crimp (or h0)",
+            f"give crimp heights h_w0 + h_f0 = {heights * 1e3:.4g} mm (eq. 5.5), more than the "
+            f"two yarn thicknesses {t_sum * 1e3:.4g} mm: the yarns cannot undulate that far "
+            "around each other", {"warp": _raw(raw, "warp", "crimp"),
+                                  "fill": _raw(raw, "fill", "crimp")},
+            f"crimps whose heights add up to at most {t_sum * 1e3:.4g} mm (Peirce's geometry: "
+            f"about half, {t_sum * 0.5e3:.4g} mm; woven fabrics have crimps of a few %)"))
+    if spec.compaction.a > t_sum:
+        problems.append(Problem(
+            "material.compaction.a", f"is larger than the two yarn thicknesses "
+            f"({t_sum * 1e3:.4g} mm) it compacts", _raw(raw, "compaction", "a"),
+            f"a length < {t_sum * 1e3:.4g} mm"))
+    return problems
+
+
 def _metal_parameters(spec: J2Spec | ElasticSpec, raw: dict, source: str) -> MetalParameters:
     hardening: tuple[tuple[float, float], ...] = ()
     fracture = None
     rate = damage = None
     if isinstance(spec, J2Spec):
         table = spec.plasticity.hardening
-        raise_problems(_check_hardening(table, raw) + _check_damage(spec, raw), source)
+        raise_problems(_check_hardening(table, raw) + _check_damage(spec, raw)
+                       + _check_yield_strain(spec, raw), source)
         hardening = tuple((float(e), float(s)) for e, s in table)
         fracture = spec.plasticity.fracture_strain
         if spec.rate is not None:
@@ -434,6 +494,19 @@ def _check_damage(spec: J2Spec, raw: dict) -> list[Problem]:
             )
         )
     return problems
+
+
+def _check_yield_strain(spec: J2Spec, raw: dict) -> list[Problem]:
+    """The initial yield strain σ_y0 / E at most MAX_YIELD_STRAIN (a stress in the
+    wrong unit, or a modulus too small by orders)."""
+    sy0 = spec.plasticity.hardening[0][1]
+    if sy0 <= MAX_YIELD_STRAIN * spec.modulus:
+        return []
+    return [Problem("material.plasticity.hardening[0][1]", f"gives a yield strain σ_y0/E = "
+                    f"{sy0 / spec.modulus:.3g} (modulus {spec.modulus:.3g} Pa)",
+                    _raw(raw, "plasticity", "hardening")[0][1],
+                    f"a yield stress ≤ {MAX_YIELD_STRAIN:g} E = "
+                    f"{MAX_YIELD_STRAIN * spec.modulus / 1e6:.4g} MPa (metals yield below 1 %)")]
 
 
 def _check_hardening(table: list[tuple[float, float]], raw: dict) -> list[Problem]:

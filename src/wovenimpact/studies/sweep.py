@@ -48,7 +48,7 @@ import warnings
 from concurrent.futures import as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, Literal
 
 from pydantic import BaseModel, Field, ValidationError
 
@@ -79,7 +79,7 @@ class StudyInfo(BaseModel):
 class StudyFile(BaseModel):
     model_config = STRICT
     study: StudyInfo
-    parameters: dict[str, list[Any]] = Field(min_length=1)
+    parameters: dict[str, Annotated[list[Any], Field(min_length=1)]] = Field(min_length=1)
 
 
 @dataclass
@@ -287,7 +287,7 @@ def run_study(
             raise InputError("--scheduler needs dask.distributed: pip install 'dask[distributed]'") from None
         from distributed import as_completed as dask_completed
 
-        with Client(scheduler) as client:
+        with _connect(Client, scheduler) as client:
             futures = {client.submit(run_variant, *a, pure=False): v for a, v in zip(args, todo)}
             for fut in dask_completed(futures):
                 results[futures[fut].id] = fut.result()
@@ -317,6 +317,36 @@ def run_study(
     study_plots(info, variants, rows, out)
     write_study_report(out, info.name, rows)  # OUT/report.html: variants linked, plots
     return rows
+
+
+SCHEDULER_SCHEMES = ("tcp", "tls", "ws", "wss", "ucx")
+CONNECT_TIMEOUT = "10s"  # an unreachable scheduler is an error after this, not a hang
+
+
+def check_scheduler(address: str) -> None:
+    """``--scheduler``: ``scheme://host:port`` (or ``host:port``, TCP) with a port 1–65535,
+    or an ``inproc://`` address; an InputError naming the address and what is valid
+    otherwise."""
+    valid = "valid: the address of a running Dask scheduler, e.g. tcp://host:8786"
+    scheme, sep, rest = address.strip().rpartition("://")
+    if scheme == "inproc" and rest:  # a scheduler in this process (tests, notebooks)
+        return
+    host, colon, port = rest.rpartition(":")
+    if (sep and scheme not in SCHEDULER_SCHEMES) or not colon or not host or " " in rest:
+        raise InputError(f"--scheduler {address!r}: not a scheduler address ({valid})")
+    if not port.isdigit() or not 1 <= int(port) <= 65535:
+        raise InputError(f"--scheduler {address!r}: port {port!r} is not 1 to 65535 ({valid})")
+
+
+def _connect(client_class, address: str):
+    """A Dask client of ``address``; an InputError if none answers within CONNECT_TIMEOUT."""
+    check_scheduler(address)
+    try:
+        return client_class(address, timeout=CONNECT_TIMEOUT)
+    except (OSError, TimeoutError, ValueError) as err:
+        raise InputError(f"--scheduler {address!r}: no scheduler answers ({type(err).__name__}: "
+                         f"{err}; valid: the address of a running Dask scheduler, e.g. "
+                         "tcp://host:8786)") from None
 
 
 def _short(value: Any) -> str:

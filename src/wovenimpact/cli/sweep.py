@@ -27,12 +27,17 @@ def sweep(
     """Run every variant of STUDY (finished ones are kept), write results.csv, plots/ and
     report.html (linking each variant's page)."""
     from wovenimpact.io.outdir import prepare_output_dir, write_failure
-    from wovenimpact.studies.sweep import check_scheduler, run_study
+    import warnings
+
+    from wovenimpact.studies.sweep import check_scheduler, load_study, run_study
 
     out_dir = out or Path("out") / study.stem
     try:
         if scheduler is not None:
             check_scheduler(scheduler)
+        with warnings.catch_warnings():  # run_study reads it again and warns then
+            warnings.simplefilter("ignore")
+            load_study(study, overrides or ())  # a bad study creates no output directory
         prepare_output_dir(out_dir)
     except InputError as err:
         fail(str(err))

@@ -392,6 +392,8 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
     hg_all = eb["hourglass_J"] + eb["eroded_hourglass_J"]
     return {**impact,
         "summary_version": SUMMARY_VERSION,
+        # when this summary was written (UTC): a report that reuses the run can say so
+        "finished_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
         "case": spec.case.name,
         "end_time_s": float(state.t),
         "steps": int(state.step),
@@ -449,7 +451,7 @@ COMMON_SUMMARY_KEYS = (
     "eroded_kinetic_energy_J", "hourglass_fraction", "external_work_J", "body_force_work_J",
     "reaction_work_J", "contact_energy_J", "eroded_elements", "energy_error_fraction",
     "energy_tolerance", "energy_check", "symmetry_factor", "max_displacement_m",
-    "restarted_from_step", "provenance",
+    "restarted_from_step", "provenance", "finished_utc",
     "plastic_work_J",  # runs with a metal section only
 )
 

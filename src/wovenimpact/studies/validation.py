@@ -374,6 +374,11 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
               "![4 plies at 120 m/s](validation/plies4_120_impactor.png)", ""]
     convergence = convergence_runs(work, threads=workers, log=log)
     lines += convergence_lines(convergence)
+    stamps = sorted(r["finished_utc"] for r in [*cases.values(), *convergence]
+                    if r.get("finished_utc"))
+    if stamps:  # reused runs keep their own date: the report says when they were made
+        lines[2] += (f" The example and convergence runs were made between {stamps[0]} "
+                     f"and {stamps[-1]} (UTC).")
     study_rows: dict[str, list[dict]] = {}
     for study in studies:
         if study in DESIGN:

@@ -43,7 +43,9 @@ class Item:
 WARNS = {"areal_mass_1e30": "areal_mass", "areal_mass_x100": "areal_mass",
          "end_time_1e-30": "shorter than the first step",
          "no_boundary_quarter": "no boundary constrains", "threads_1000": "threads",
-         "a_metre_away": "reaches it at", "velocity_1e-30": "reaches it at"}
+         "a_metre_away": "reaches it at", "velocity_1e-30": "reaches it at",
+         # issue 12 item 5: the same value twice in a sweep runs that variant once
+         "study_duplicate_values": "1 of the 2 variants repeat the values of another"}
 
 
 # --- a small TOML writer (the corpus writes documents it then breaks) ------------------
@@ -641,7 +643,6 @@ def build() -> Corpus:
         ("bad_value", _set(S, "parameters", {"mesh.side": ["ten mm"]})),
         ("absurd_value", _set(S, "parameters", {"mesh.side": ["1e30 mm"]})),
         ("unknown_metric", _set(S, "study.metrics", ["max_displacment_m"])),
-        ("duplicate_values", _set(S, "parameters", {"mesh.side": ["10 mm", "10 mm"]})),
         ("missing_case", _set(S, "study.case", "nowhere.toml")),
         ("case_latin1", _set(S, "study.case", "case_latin1_comment.toml")),
         ("case_utf16", _set(S, "study.case", "case_utf16.toml")),
@@ -659,6 +660,11 @@ def build() -> Corpus:
         name = c.file(f"study_{label}.toml", doc)
         c.add(f"study_{label}", ["sweep", name, "--out", f"out/study_{label}", "--json",
                                  "--workers", "1"], "error", "study", timeout=120)
+    # the same value twice: issue 12 item 5 asks that the variant run once (with a word)
+    name = c.file("study_duplicate_values.toml",
+                  _set(S, "parameters", {"mesh.side": ["10 mm", "10 mm"]}))
+    c.add("study_duplicate_values", ["sweep", name, "--out", "out/study_duplicate_values",
+                                     "--json", "--workers", "1"], "warn", "study", timeout=120)
     c.add("sweep_missing", ["sweep", "nowhere.toml"], "error", "study")
     c.add("sweep_out_file", ["sweep", "study.toml", "--out", "an_existing_file"], "error", "flag")
     c.add("sweep_out_proc", ["sweep", "study.toml", "--out", "/proc/wi_sweep"], "error", "flag")

@@ -465,6 +465,22 @@ def summary_keys(spec) -> tuple[str, ...]:
     return tuple(dict.fromkeys(COMMON_SUMMARY_KEYS + extra))
 
 
+def reused_or_run(case_path: str | Path, out: str | Path, log=None, label: str = "case") -> dict:
+    """The summary of the case file ``case_path`` run in ``out``: the one there if it is
+    a finished run of exactly this case, its files and this code
+    (:func:`reusable_summary`), else a new run — ``log(message)`` is told so, with the
+    reason the old one could not be reused."""
+    from wovenimpact.spec.case import load_case
+
+    s, why = reusable_summary(out, *load_case(case_path))
+    if s is None:
+        if log is not None:
+            log(f"{label} {Path(case_path).stem} → {out}"
+                + (f" (run again: {why})" if why else ""))
+        s = run_case(case_path, out)
+    return s
+
+
 def reusable_summary(out: str | Path, spec, base: str | Path) -> tuple[dict | None, str]:
     """The summary.json in ``out`` if it is a finished run of exactly this case, its
     files and this code (provenance digest, current ``summary_version``), else None with

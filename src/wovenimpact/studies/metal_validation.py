@@ -72,8 +72,7 @@ def jones_lines(work: Path, figures: Path, log=_quiet) -> list[str]:
 
 def case_lines(work: Path, figures: Path, log=_quiet) -> list[str]:
     """The examples of examples/metal_impact/ (summaries cached in ``work/cases``)."""
-    from wovenimpact.runs import reusable_summary, run_case
-    from wovenimpact.spec.case import load_case
+    from wovenimpact.runs import reused_or_run
 
     lines = ["### Examples (examples/metal_impact/)", "",
              "| case | outcome | residual (m/s) | absorbed (J) | plastic work (J) | eroded "
@@ -81,11 +80,8 @@ def case_lines(work: Path, figures: Path, log=_quiet) -> list[str]:
              "|---|---|---|---|---|---|---|---|---|"]
     for name in METAL_CASES:
         out = work / "cases" / name
-        case_path = ROOT / "examples" / "metal_impact" / f"{name}.toml"
-        s, why = reusable_summary(out, *load_case(case_path))  # same digest, else run again
-        if s is None:
-            log(f"metal case {name} → {out}" + (f" (run again: {why})" if why else ""))
-            s = run_case(case_path, out)
+        s = reused_or_run(ROOT / "examples" / "metal_impact" / f"{name}.toml", out, log,
+                          "metal case")
         hg = s["hourglass_fraction"]
         lines.append(
             f"| {name} | {s['outcome']} | {s['residual_velocity_m_per_s']:.1f} | "

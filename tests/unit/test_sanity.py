@@ -27,7 +27,15 @@ def compiled(doc: dict, tmp_path: Path | None = None):
     return spec, compile_case(spec, tmp_path or ROOT)
 
 
-def refused(doc: dict, *fragments: str, tmp_path=None) -> str:
+def assert_accepted(doc: dict):
+    """Compiling ``doc`` gives a model with elements (an InputError fails the test)."""
+    spec, c = compiled(doc)
+    assert c.model.n_elems > 0
+    return spec, c
+
+
+def assert_refused(doc: dict, *fragments: str, tmp_path=None) -> str:
+    """Compiling ``doc`` raises a one-line InputError naming every fragment; its text."""
     with pytest.raises(InputError) as err:
         compiled(doc, tmp_path)
     text = str(err.value)
@@ -40,8 +48,8 @@ def refused(doc: dict, *fragments: str, tmp_path=None) -> str:
 @pytest.mark.parametrize("doc", [PLATE, IMPACT, METAL], ids=["fabric", "impact", "metal"])
 def test_the_sane_base_cases_compile_without_warnings(doc):
     with warnings.catch_warnings():
-        warnings.simplefilter("error", InputWarning)
-        compiled(doc)
+        warnings.simplefilter("error", InputWarning)  # a warning fails the test
+        assert_accepted(doc)
 
 
 def test_the_predicted_step_count_is_end_time_over_the_first_step():
@@ -52,9 +60,9 @@ def test_the_predicted_step_count_is_end_time_over_the_first_step():
     assert 1e-8 < dt < 2e-7
     steps = spec.run.end_time / dt
     limit = math.floor(steps) - 1
-    refused(_set(PLATE, "run.max_steps", limit), "run.max_steps", f"Δt = {dt:.3g} s",
+    assert_refused(_set(PLATE, "run.max_steps", limit), "run.max_steps", f"Δt = {dt:.3g} s",
             "the step is normal")
-    compiled(_set(PLATE, "run.max_steps", math.ceil(steps) + 1))
+    assert_accepted(_set(PLATE, "run.max_steps", math.ceil(steps) + 1))
     assert spec.run.max_steps == DEFAULT_MAX_STEPS
 
 
@@ -65,7 +73,7 @@ def test_the_predicted_step_count_is_end_time_over_the_first_step():
 def test_a_collapsed_first_step_is_refused_naming_the_section(key, value):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", InputWarning)  # the areal-mass warning
-        text = refused(_set(PLATE, key, value), "wave speed", "section 'fabric'",
+        text = assert_refused(_set(PLATE, key, value), "wave speed", "section 'fabric'",
                        "material 'kevlar'", "governed by element")
     assert "far above any material's" in text
 
@@ -79,25 +87,25 @@ def test_a_metal_of_no_density_is_refused_by_its_step():
 
 
 def test_a_long_end_time_is_refused_as_long_not_as_stiff():
-    refused(_set(PLATE, "run.end_time", "1e6 s"), "run.end_time = 1e+06 s", "is long")
+    assert_refused(_set(PLATE, "run.end_time", "1e6 s"), "run.end_time = 1e+06 s", "is long")
 
 
 def test_overlapping_plies_are_refused_and_touching_plies_accepted():
-    refused(_set(IMPACT, "mesh.spacing", "0.3 mm"), "mesh.spacing", "the plies overlap")
-    compiled(IMPACT)  # spacing = one shell thickness (0.4992 mm): touching
+    assert_refused(_set(IMPACT, "mesh.spacing", "0.3 mm"), "mesh.spacing", "the plies overlap")
+    assert_accepted(IMPACT)  # spacing = one shell thickness (0.4992 mm): touching
 
 
 def test_a_clamp_and_a_velocity_on_the_same_dof_contradict():
     extra = {"nodes": "edge_outer", "type": "velocity", "dof": "uz", "velocity": "1 m/s"}
-    refused(_set(PLATE, "boundary", PLATE["boundary"] + [extra]), "boundary[3]",
+    assert_refused(_set(PLATE, "boundary", PLATE["boundary"] + [extra]), "boundary[3]",
             "contradicts boundary[0]", "uz")
     # a velocity on a DOF the symmetry planes leave free is no contradiction
     free = {"nodes": "centre", "type": "velocity", "dof": "uz", "velocity": "1 m/s"}
-    compiled(_set(PLATE, "boundary", PLATE["boundary"] + [free]))
+    assert_accepted(_set(PLATE, "boundary", PLATE["boundary"] + [free]))
 
 
 def test_a_section_thicker_than_the_mesh_is_refused():
-    refused(_set(PLATE, "sections.fabric.thickness", "1 m"), "larger than the whole mesh")
+    assert_refused(_set(PLATE, "sections.fabric.thickness", "1 m"), "larger than the whole mesh")
 
 
 @pytest.mark.parametrize("position, direction, fragment", [
@@ -108,7 +116,7 @@ def test_an_impactor_whose_path_misses_the_plies_is_refused(position, direction,
     doc = _set(_set(IMPACT, "impactor.position", position), "impactor.direction", direction)
     doc = _set(doc, "mesh.quarter", False)
     doc = _set(doc, "boundary", [IMPACT["boundary"][0]])
-    refused(doc, "the impactor's path misses the structure", fragment)
+    assert_refused(doc, "the impactor's path misses the structure", fragment)
 
 
 def test_an_impactor_arriving_after_the_end_is_warned_of_with_gap_and_time():
@@ -118,11 +126,11 @@ def test_an_impactor_arriving_after_the_end_is_warned_of_with_gap_and_time():
 
 
 def test_an_impactor_far_lighter_than_what_it_strikes_is_refused():
-    refused(_set(IMPACT, "impactor.mass", "1e-20 g"), "impactor.mass", "times lighter")
+    assert_refused(_set(IMPACT, "impactor.mass", "1e-20 g"), "impactor.mass", "times lighter")
 
 
 def test_an_impactor_crossing_elements_in_one_step_is_refused():
-    refused(_set(IMPACT, "impactor.velocity", "1e30 m/s"), "impactor.velocity",
+    assert_refused(_set(IMPACT, "impactor.velocity", "1e30 m/s"), "impactor.velocity",
             "contact would be missed")
 
 
@@ -130,7 +138,7 @@ def test_duplicate_node_and_element_ids_in_an_inp_are_refused(tmp_path):
     for kw, fragment in (("dup_node", "node 1 is defined again"),
                          ("dup_elem", "element 1 is defined again")):
         (tmp_path / "plate.inp").write_text(plate_inp(**{kw: True}))
-        refused(_set(INP_CASE, "mesh.file", "plate.inp"), fragment, tmp_path=tmp_path)
+        assert_refused(_set(INP_CASE, "mesh.file", "plate.inp"), fragment, tmp_path=tmp_path)
 
 
 @pytest.mark.parametrize("element_size, ok", [("3.3 mm", True), ("3.4 mm", False),
@@ -141,7 +149,7 @@ def test_a_quarter_plate_needs_two_elements_along_its_half_side(element_size, ok
     if ok:
         compiled(doc)
     else:
-        refused(doc, "mesh.element_size", "the quarter plate's edge (0.005 m)")
+        assert_refused(doc, "mesh.element_size", "the quarter plate's edge (0.005 m)")
 
 
 @pytest.mark.parametrize("key, value", [("mesh.side", "1e30 mm"),
@@ -154,8 +162,8 @@ def test_absurd_mesh_sizes_are_refused_before_meshing(key, value):
 def test_an_output_at_every_step_is_warned_of_only_when_there_are_many():
     doc = _set(PLATE, "run.field_interval", "1e-30 s")
     with warnings.catch_warnings():
-        warnings.simplefilter("error", InputWarning)
-        compiled(doc)  # 2 µs: about 13 steps, a frame each is fine
+        warnings.simplefilter("error", InputWarning)  # a warning fails the test
+        assert_accepted(doc)  # 2 µs: about 13 steps, a frame each is fine
     with pytest.warns(InputWarning, match=r"run.field_interval = 1e-30 s is shorter than "
                       r"the first step .*about 1.2\d*e\+03 of them"):
         compiled(_set(doc, "run.end_time", "200 us"))

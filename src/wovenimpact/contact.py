@@ -21,9 +21,11 @@ from wovenimpact.kernels.contact_broad import (
 )
 from wovenimpact.kernels.contact_narrow import (
     N_GEO,
+    N_SEG_GEO,
     assemble_contact_forces,
     initial_overlap,
     penalty_forces,
+    segment_geometry,
 )
 
 
@@ -181,6 +183,7 @@ class ShellContact:
         self.seg_on = np.zeros(ne, dtype=np.int8)
         self.node_on = np.zeros(nn, dtype=np.int8)
         self.box = np.zeros((ne, 6))
+        self.seg_geo = np.zeros((ne, N_SEG_GEO))  # the narrow phase's segment table at x
         self.bucket_ptr = np.zeros(bucket_count(ne) + 1, dtype=np.int64)
         self.bucket_seg = np.zeros(ne, dtype=np.int64)
         self.bucket_cell = np.zeros((ne, 3), dtype=np.int64)
@@ -201,9 +204,10 @@ class ShellContact:
             contact_masks(np.ones(ne, dtype=np.int8), part, np.ones(nn, dtype=np.int8),
                           self.node_part, self.seg_on, self.node_on)
             self._search(x, self.margin)
+            segment_geometry(x, self.quads, self.seg_on, self.seg_geo)
             initial_overlap(x, self.quads, self.ply, self.h_node, self.h_seg, self.margin,
-                            self.pair_ptr,
-                            self.pair_seg, self.geo, self.pair_on, self.overlap)
+                            self.seg_geo, self.pair_ptr, self.pair_seg, self.geo,
+                            self.pair_on, self.overlap)
 
     @property
     def capacity(self) -> int:
@@ -265,10 +269,11 @@ class ShellContact:
             self.node_on_search[:] = self.node_on
             self.searched = self.skin > 0.0
             self.searches += 1
+        segment_geometry(x, self.quads, self.seg_on, self.seg_geo)
         penalty_forces(
             x, v, self.quads, self.ply, self.node_mass, self.h_node, self.h_seg, self.margin,
-            self.overlap,
-            self.beta, self.damping, self.friction, float(dt), self.pair_ptr, self.pair_seg,
+            self.overlap, self.beta, self.damping, self.friction, float(dt), self.seg_geo,
+            self.pair_ptr, self.pair_seg,
             self.geo, self.pair_on, self.pair_f, self.pair_w, self.pair_e, self.node_f,
         )
         energy, n_active = assemble_contact_forces(

@@ -245,7 +245,7 @@ def run_spec(
     normaliser = float(history.arrays()["energy_normaliser_part_J"][-1])
 
     def checkpoint() -> None:
-        meta.update(history_rows=len(history), field_frames=len(fields.entries),
+        meta.update(history_rows=len(history), field_frames=fields.frames,
                     wall_time_s=wall_before + time.perf_counter() - wall0)
         history.write_csv(out / "history.csv")
         save_checkpoint(ckpt_dir, state, digest, meta=meta)

@@ -110,6 +110,23 @@ def test_containment_outputs_bulge_layer_and_material_energies_and_fragment_plot
     assert sum(per_layer) > 0.0
     assert (out / "plots" / "fragment.png").exists()
     assert not (out / "plots" / "ply_deflection.png").exists()
+    # the VTU series: casing and blade as the blocks (parts 0, 1) of each frame, each file
+    # with its own nodes, together every element once
+    import meshio
+
+    from wovenimpact.io.fields import PVD_NAME, read_pvd
+
+    files = [f for _, f in read_pvd(out / "fields" / PVD_NAME)]
+    assert files[:2] == ["step_000000_casing.vtu", "step_000000_blade.vtu"]
+    assert len(files) == 6  # frames at 0, 150 and 300 µs
+    pvd = (out / "fields" / PVD_NAME).read_text()
+    assert 'part="1" file="step_000002_blade.vtu"' in pvd
+    casing, blade = (meshio.read(out / "fields" / f) for f in files[4:])
+    ids = np.concatenate([np.concatenate(m.cell_data["element"]) for m in (casing, blade)])
+    assert np.array_equal(np.sort(ids), np.arange(summary["elements"]))
+    for m in (casing, blade):
+        used = np.unique(np.concatenate([c.data.ravel() for c in m.cells]))
+        assert used.size == m.points.shape[0]  # no point outside the part's cells
 
 
 def test_layer_energies_are_the_generated_plies_energies():

@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from wovenimpact.kernels import shell_layout as S
+from wovenimpact.quantities import held_energy
 
 FRAGMENT = "blade.fragment"
 WINDOW = 1.5  # half-width of the path window, in fragment half-extents
@@ -110,14 +111,7 @@ def layer_energies(model, state) -> list[float]:
     nodes plus the energy of its elements (stored, hourglass, plastic; for eroded
     elements the energy they held at erosion), as ``quantities.ply_energies`` counts a
     ply's."""
-    out = []
-    for elems in layer_elements(model):
-        nodes = np.unique(model.quads[elems])
-        ke = 0.5 * float(np.sum(model.node_mass[nodes] * np.sum(state.v[nodes] ** 2, axis=1)))
-        held = float(np.sum(state.elem[elems, S.E_U_MEMB] + state.elem[elems, S.E_U_BEND]
-                            + state.elem[elems, S.E_U_HG]))
-        out.append(ke + held)
-    return out
+    return [held_energy(model, state, elems) for elems in layer_elements(model)]
 
 
 def layer_materials(model) -> list[str]:

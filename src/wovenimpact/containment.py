@@ -14,6 +14,7 @@ import math
 import numpy as np
 
 from wovenimpact.kernels import shell_layout as S
+from wovenimpact.quantities import held_energy
 
 FRAGMENT = "blade.fragment"
 WINDOW = 1.5  # half-width of the path window, in fragment half-extents
@@ -73,11 +74,65 @@ def fragment_row(model, state) -> dict:
         "fragment_cm_radius_m": float(r_cm),
         "fragment_max_radius_m": float(r_nodes.max()),
         "intact_casing_outside": int(outside),
+        "outer_layer_bulge_m": outer_layer_bulge(model, state),
     }
 
 
 CONTAINMENT_COLUMNS = ("fragment_speed_m_per_s", "fragment_radial_velocity_m_per_s",
-                       "fragment_cm_radius_m", "fragment_max_radius_m", "intact_casing_outside")
+                       "fragment_cm_radius_m", "fragment_max_radius_m", "intact_casing_outside",
+                       "outer_layer_bulge_m")
+
+
+def outer_layer_bulge(model, state) -> float:
+    """The outermost casing layer's largest outward radial displacement (m): max over its
+    nodes of r(x) − r(x0), r the distance from the casing axis (the z axis). Eroded
+    nodes keep their last position, so a bulge once reached is not lost with them."""
+    nodes = model.node_sets[layer_sets(model)[-1]]
+    r0 = np.hypot(model.x0[nodes, 0], model.x0[nodes, 1])
+    r1 = np.hypot(state.x[nodes, 0], state.x[nodes, 1])
+    return float(np.max(r1 - r0))
+
+
+def layer_elements(model) -> list[np.ndarray]:
+    """The elements of each casing layer, innermost first: its element set
+    ``casing.layer{k}`` where the mesh has one, else the elements whose four nodes are all
+    in the layer's node set."""
+    out = []
+    for name in layer_sets(model):
+        elems = model.elem_sets.get(name)
+        if elems is None:
+            elems = np.flatnonzero(np.isin(model.quads, model.node_sets[name]).all(axis=1))
+        out.append(np.asarray(elems, dtype=np.int64))
+    return out
+
+
+def layer_energies(model, state) -> list[float]:
+    """Energy each casing layer holds (J, innermost first): the kinetic energy of its
+    nodes plus the energy of its elements (stored, hourglass, plastic; for eroded
+    elements the energy they held at erosion), as ``quantities.ply_energies`` counts a
+    ply's."""
+    return [held_energy(model, state, elems) for elems in layer_elements(model)]
+
+
+def layer_materials(model) -> list[str]:
+    """The material of each casing layer, innermost first (that of the section most of
+    its elements have): the material's own name, or, for a material file without one
+    (the fabric files), the name of the case's section."""
+    out = []
+    for elems in layer_elements(model):
+        sec = int(np.bincount(model.elem_section[elems]).argmax()) if elems.size else 0
+        name = model.material_names[int(model.sections[sec, S.C_MAT])]
+        out.append(name or model.section_names[sec])
+    return out
+
+
+def energy_per_material(model, state) -> dict[str, float]:
+    """:func:`layer_energies` summed over the layers of each material (J): what the
+    aluminium and what the Kevlar of a hybrid casing absorbed."""
+    out: dict[str, float] = {}
+    for name, e in zip(layer_materials(model), layer_energies(model, state)):
+        out[name] = out.get(name, 0.0) + e
+    return out
 
 
 def containment_outcome(h: dict, inner_radius: float) -> dict:
@@ -118,15 +173,17 @@ def casing_summary(model, state, h: dict) -> dict:
         [model.node_sets[s] for s in layers])).all(axis=1))
     mass = float(np.sum(model.sections[model.elem_section[casing_elems], S.C_AREAL_MASS]
                         * model.area0[casing_elems]))
-    outer = layers[-1]
-    r0 = np.hypot(*model.x0[model.node_sets[outer], :2].T)
-    r1 = np.hypot(*state.x[model.node_sets[outer], :2].T)
     area = float(model.area0[casing_elems].sum())
+    bulge = np.asarray(h.get("outer_layer_bulge_m", ()), dtype=float)
     return {
         **outcome,
         "fragment_mass_kg": float(model.node_mass[nodes].sum()),
         "fragment_initial_speed_m_per_s": float(h["fragment_speed_m_per_s"][0]),
-        "max_bulge_m": float(np.max(r1 - r0)),
+        # the largest over the history rows and the end state (a bulge that springs back
+        # is still the casing's largest deflection)
+        "max_bulge_m": max([outer_layer_bulge(model, state), *bulge.tolist()]),
+        "absorbed_energy_per_layer_J": layer_energies(model, state),
+        "absorbed_energy_per_material_J": energy_per_material(model, state),
         "casing_mass_kg": mass,
         "casing_mass_per_area_kg_per_m2": mass / area * len(layers) if area else None,
         "casing_layers": len(layers),

@@ -204,15 +204,18 @@ def ply_energies(model, state) -> list[float]:
     the stored energy of its elements (for eroded elements, the energy at erosion).
     Energy dissipated by yarns that broke in elements that did not erode is not in it."""
     factor = symmetry_factor(model)
-    out = []
-    for p in np.unique(model.ply):
-        elems = np.flatnonzero(model.ply == p)
-        nodes = np.unique(model.quads[elems])
-        ke = 0.5 * float(np.sum(model.node_mass[nodes] * np.sum(state.v[nodes] ** 2, axis=1)))
-        stored = float(np.sum(state.elem[elems, S.E_U_MEMB] + state.elem[elems, S.E_U_BEND]
-                              + state.elem[elems, S.E_U_HG]))
-        out.append(factor * (ke + stored))
-    return out
+    return [factor * held_energy(model, state, np.flatnonzero(model.ply == p))
+            for p in np.unique(model.ply)]
+
+
+def held_energy(model, state, elems) -> float:
+    """Energy the elements ``elems`` and their nodes hold (J, modelled part): the kinetic
+    energy of their nodes plus the energy in their element state (stored, hourglass; an
+    eroded element's as it held it at erosion)."""
+    nodes = np.unique(model.quads[elems])
+    ke = 0.5 * float(np.sum(model.node_mass[nodes] * np.sum(state.v[nodes] ** 2, axis=1)))
+    return ke + float(np.sum(state.elem[elems, S.E_U_MEMB] + state.elem[elems, S.E_U_BEND]
+                             + state.elem[elems, S.E_U_HG]))
 
 
 def ply_deflections(model, state) -> list[float]:

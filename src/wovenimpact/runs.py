@@ -245,7 +245,7 @@ def run_spec(
     normaliser = float(history.arrays()["energy_normaliser_part_J"][-1])
 
     def checkpoint() -> None:
-        meta.update(history_rows=len(history), field_frames=len(fields.entries),
+        meta.update(history_rows=len(history), field_frames=fields.frames,
                     wall_time_s=wall_before + time.perf_counter() - wall0)
         history.write_csv(out / "history.csv")
         save_checkpoint(ckpt_dir, state, digest, meta=meta)
@@ -273,12 +273,17 @@ def run_spec(
     summary = summarise(spec, compiled, state, meta["wall_time_s"], history.arrays())
     summary["restarted_from_step"] = meta["restarted_from_step"]
     summary["provenance"] = prov
-    from wovenimpact.io.plots import deflection_plot, energy_plot, impactor_plot
+    from wovenimpact.io.plots import deflection_plot, energy_plot, fragment_plot, impactor_plot
 
     h = history.arrays()
     energy_plot(h, out / "plots" / "energy.png", title=spec.case.name,
                 symmetry_factor=symmetry_factor(model))
-    deflection_plot(model, state, out / "plots" / "ply_deflection.png", title=spec.case.name)
+    if is_containment(model):  # a plate's deflection along y = 0 means nothing on a casing
+        fragment_plot(h, out / "plots" / "fragment.png", title=spec.case.name,
+                      outcome=summary.get("outcome", ""))
+    else:
+        deflection_plot(model, state, out / "plots" / "ply_deflection.png",
+                        title=spec.case.name)
     if "impactor_velocity_m_per_s" in h:
         impactor_plot(h, out / "plots" / "impactor.png", title=spec.case.name)
     atomic_write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n")
@@ -372,8 +377,7 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
     factor = symmetry_factor(model)
     impact = {}
     if is_containment(model):
-        impact = {**casing_summary(model, state, h),
-                  "absorbed_energy_per_layer_J": ply_energies(model, state)[:-1]}
+        impact = casing_summary(model, state, h)
     ke_body0 = 0.0
     if model.body_params.shape[0]:
         ke_body0 = factor * float(h["impactor_kinetic_energy_part_J"][0])
@@ -440,7 +444,7 @@ IMPACT_SUMMARY_KEYS = ("outcome", "perforated", "residual_velocity_m_per_s",
 CONTAINMENT_SUMMARY_KEYS = ("outcome", "contained", "fragment_exit_speed_m_per_s",
                             "fragment_mass_kg", "fragment_initial_speed_m_per_s", "max_bulge_m",
                             "casing_mass_kg", "casing_mass_per_area_kg_per_m2", "casing_layers",
-                            "absorbed_energy_per_layer_J")
+                            "absorbed_energy_per_layer_J", "absorbed_energy_per_material_J")
 COMMON_SUMMARY_KEYS = (
     "summary_version", "case", "end_time_s", "steps", "elements", "nodes", "first_time_step_s",
     "last_time_step_s", "wall_time_s", "element_cycles", "ns_per_element_cycle",

@@ -174,3 +174,37 @@ def test_triangles_go_to_their_own_block(tmp_path):
     assert [b.type for b in m.cells] == ["quad", "triangle"]
     assert m.cell_data["element"][1].tolist() == [1]
     assert m.cell_data["membrane_resultant"][1][0, 0] == 9.0
+
+
+def test_parts_are_blocks_of_each_frame_and_resume_by_frame(tmp_path, model):
+    """A series in two parts (the plies here): each frame is a file per part with that
+    part's nodes and elements only, listed in fields.pvd with its part index; a restart
+    counts frames, not files, keeps both files of the kept frames and deletes both of
+    the later ones."""
+    parts = [("lower", np.flatnonzero(model.ply == 0)), ("upper", np.flatnonzero(model.ply == 1))]
+    w = FieldWriter(tmp_path, model, parts=parts)
+    states = [moved(model, k) for k in range(3)]
+    for s in states:
+        w.write(s)
+    assert w.frames == 3 and len(w.entries) == 6
+    root = ET.parse(tmp_path / PVD_NAME).getroot()
+    assert [(d.attrib["file"], d.attrib["part"]) for d in root.iter("DataSet")][:2] == [
+        ("step_000000_lower.vtu", "0"), ("step_000000_upper.vtu", "1")]
+    for name, elems in parts:
+        m = meshio.read(tmp_path / f"step_000002_{name}.vtu")
+        ids = np.concatenate(m.cell_data["element"])
+        assert np.array_equal(np.sort(ids), elems)
+        nodes = np.unique(model.quads[elems])
+        assert np.allclose(m.points, states[2].x[nodes])  # its own nodes, in order
+        # each cell's points are its element's nodes
+        conn = np.concatenate([c.data for c in m.cells])
+        assert np.allclose(m.points[conn], states[2].x[model.quads[ids]])
+    r = FieldWriter.resume(tmp_path, model, frames=2, parts=parts)
+    assert r.frames == 2
+    assert not (tmp_path / "step_000002_lower.vtu").exists()
+    assert not (tmp_path / "step_000002_upper.vtu").exists()
+    r.write(states[2])
+    assert [f for _, f in read_pvd(tmp_path / PVD_NAME)][-2:] == [
+        "step_000002_lower.vtu", "step_000002_upper.vtu"]
+    with pytest.raises(InputError, match="lists 3 frames, the checkpoint counts 4"):
+        FieldWriter.resume(tmp_path, model, frames=4, parts=parts)

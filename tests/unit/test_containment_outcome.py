@@ -73,3 +73,88 @@ def test_a_released_fragment_starts_at_omega_r_cm_and_is_undecided_before_impact
     from tests.io.report_page import check_run_page
 
     check_run_page(tmp_path / "out")
+
+
+def test_containment_outputs_bulge_layer_and_material_energies_and_fragment_plot(tmp_path):
+    """A coarse two-ply hybrid casing (10 mm elements) run into the impact (the tip,
+    moving tangentially, reaches the casing after about 200 µs; 300 µs): the
+    history carries the outermost layer's bulge and the summary's largest bulge is at
+    least every recorded one; each layer's absorbed energy is the one its ply holds
+    (quantities.ply_energies, the blade's ply last) and the materials' energies are
+    those layers' sums (aluminium: the inner shell; Kevlar: the plies); the run draws
+    the fragment plot and not a plate's deflection profile."""
+    from pathlib import Path
+
+    from wovenimpact.containment import layer_energies, layer_materials
+    from wovenimpact.io.history import read_csv
+    from wovenimpact.model.compile import compile_case
+    from wovenimpact.quantities import ply_energies
+    from wovenimpact.runs import run_case
+
+    case = Path(__file__).resolve().parents[2] / "examples" / "containment" / "hybrid_4.toml"
+    out = tmp_path / "out"
+    summary = run_case(case, out, overrides=[
+        'run.end_time="300 us"', 'mesh.element_size="10 mm"', "mesh.casing.layers=2",
+        'run.field_interval="150 us"', 'run.checkpoint_interval="300 us"'])
+    h = read_csv(out / "history.csv")
+    bulge = h["outer_layer_bulge_m"]
+    assert bulge[0] == pytest.approx(0.0, abs=1e-12)
+    assert summary["max_bulge_m"] >= float(np.max(bulge)) > 0.0  # the casing was pushed out
+    per_layer = summary["absorbed_energy_per_layer_J"]
+    assert len(per_layer) == summary["casing_layers"] == 3  # inner shell + 2 plies
+    per_material = summary["absorbed_energy_per_material_J"]
+    assert len(per_material) == 2
+    names = list(per_material)
+    assert per_material[names[0]] == pytest.approx(per_layer[0], rel=1e-12)  # aluminium
+    assert per_material[names[1]] == pytest.approx(per_layer[1] + per_layer[2], rel=1e-12)
+    assert sum(per_layer) > 0.0
+    assert (out / "plots" / "fragment.png").exists()
+    assert not (out / "plots" / "ply_deflection.png").exists()
+    # the VTU series: casing and blade as the blocks (parts 0, 1) of each frame, each file
+    # with its own nodes, together every element once
+    import meshio
+
+    from wovenimpact.io.fields import PVD_NAME, read_pvd
+
+    files = [f for _, f in read_pvd(out / "fields" / PVD_NAME)]
+    assert files[:2] == ["step_000000_casing.vtu", "step_000000_blade.vtu"]
+    assert len(files) == 6  # frames at 0, 150 and 300 µs
+    pvd = (out / "fields" / PVD_NAME).read_text()
+    assert 'part="1" file="step_000002_blade.vtu"' in pvd
+    casing, blade = (meshio.read(out / "fields" / f) for f in files[4:])
+    ids = np.concatenate([np.concatenate(m.cell_data["element"]) for m in (casing, blade)])
+    assert np.array_equal(np.sort(ids), np.arange(summary["elements"]))
+    for m in (casing, blade):
+        used = np.unique(np.concatenate([c.data.ravel() for c in m.cells]))
+        assert used.size == m.points.shape[0]  # no point outside the part's cells
+
+
+def test_layer_energies_are_the_generated_plies_energies():
+    """On a generated casing (layers = plies 0…N, the blade's ply after them) the layer
+    energies equal quantities.ply_energies of those plies for any velocities and element
+    energies, and each layer is named by its material (inner shell aluminium, then the
+    fabric)."""
+    from pathlib import Path
+
+    from wovenimpact.containment import layer_energies, layer_materials
+    from wovenimpact.kernels import shell_layout as S
+    from wovenimpact.model.compile import compile_case
+    from wovenimpact.quantities import ply_energies
+    from wovenimpact.spec.case import case_from_dict
+    from wovenimpact.spec.fields import read_toml, set_dotted
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "containment" / "hybrid_4.toml"
+    doc = read_toml(path, "case")
+    set_dotted(doc, "mesh.element_size", "10 mm")
+    set_dotted(doc, "mesh.casing.layers", 2)
+    compiled = compile_case(case_from_dict(doc, str(path)), path.parent)
+    model, state = compiled.model, compiled.state
+    rng = np.random.default_rng(7)
+    state.v[:] = rng.normal(0.0, 30.0, state.v.shape)
+    for col in (S.E_U_MEMB, S.E_U_BEND, S.E_U_HG):
+        state.elem[:, col] = rng.uniform(0.0, 1e-3, model.n_elems)
+    assert layer_energies(model, state) == pytest.approx(ply_energies(model, state)[:3],
+                                                         rel=1e-12)
+    names = layer_materials(model)
+    assert len(names) == 3 and names[1] == names[2] != names[0]
+    assert names[0] == "aluminium" and names[1] == "fabric"  # material name, else section

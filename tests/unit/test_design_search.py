@@ -104,6 +104,10 @@ def test_a_failed_pack_stops_the_search_with_its_error_and_keeps_the_others(tmp_
 
     def failing(docs, base, dirs, workers):
         out = run_batch(docs, base, dirs, workers)
+        for d in dirs:  # as _run_one leaves it for a run that raised
+            if d.endswith("plies_2"):
+                Path(d).mkdir(parents=True, exist_ok=True)
+                (Path(d) / "error.txt").write_text("SimulationError: element 7 inverted\n")
         return ["failed: SimulationError: element 7 inverted" if d.endswith("plies_2") else o
                 for d, o in zip(dirs, out)]
 
@@ -156,3 +160,14 @@ def test_design_on_a_containment_case_searches_the_casing_layers(tmp_path, monke
     assert result["warning"] == ""
     text = design.monotonic_warning(7, {7: True, 9: False}, "layers", "contain the fragment")
     assert text.startswith("9 layers did not contain the fragment although 7 did")
+
+
+def test_a_pack_that_failed_its_energy_check_is_named_with_its_summary(tmp_path):
+    """A run that finished but failed its energy check leaves no error.txt: the message
+    points at its summary.json instead of a file that does not exist."""
+    from wovenimpact.studies.design import refuse_failed
+
+    (tmp_path / "plies_8").mkdir()
+    with pytest.raises(InputError, match=r"8 plies: the run failed: energy balance failed "
+                       r"\(see .*plies_8/summary.json\)"):
+        refuse_failed({4: "perforated", 8: "failed: energy balance failed"}, tmp_path)

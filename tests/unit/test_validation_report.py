@@ -121,3 +121,18 @@ def test_a_summary_of_an_older_rule_is_not_taken_as_finished(tmp_path):
     current["provenance"] = provenance(case_from_dict(doc), case.parent)
     (tmp_path / "summary.json").write_text(json.dumps(current))
     assert finished(tmp_path, {"a": 1}, doc, case.parent)[0]["outcome"] == "perforated"
+
+
+def test_a_failed_design_search_is_reported_not_fatal(tmp_path, monkeypatch):
+    """A pack whose run fails (e.g. its energy check) stops the design search; validate
+    writes that into the report instead of losing the whole report."""
+    from wovenimpact.errors import InputError
+    from wovenimpact.studies import design, validation
+
+    def failing(*args, **kwargs):
+        raise InputError("8 plies: the run failed: energy balance failed")
+
+    monkeypatch.setattr(design, "design_plies", failing)
+    text = "\n".join(validation.design_lines("design_175", tmp_path, workers=1))
+    assert "## design_175: plies to stop the impactor, by runs" in text
+    assert "**No answer: the search stopped.** 8 plies: the run failed" in text

@@ -16,6 +16,11 @@ is written as a VTK triangle in a second cell block, so VTK filters never see a
 degenerate quad. The ``element`` cell array maps cells back to Model elements.
 After every file ``fields.pvd`` is rewritten atomically to list all files with
 their times; ParaView opens it as one time series.
+
+Parts: a model made of separate bodies can be written one file per body and frame,
+``step_{k:06d}_{part}.vtu`` (each with its own nodes only), listed in ``fields.pvd``
+with the collection's ``part`` index, which ParaView opens as the blocks of one
+multiblock series — a containment run's ``casing`` and ``blade`` (:func:`model_parts`).
 """
 
 from __future__ import annotations
@@ -37,9 +42,23 @@ from wovenimpact.state import State
 PVD_NAME = "fields.pvd"
 
 
-def frame_name(k: int) -> str:
-    """File name of output frame ``k``."""
-    return f"step_{k:06d}.vtu"
+def frame_name(k: int, part: str = "") -> str:
+    """File name of output frame ``k`` (of ``part``, when the series has parts)."""
+    return f"step_{k:06d}_{part}.vtu" if part else f"step_{k:06d}.vtu"
+
+
+def model_parts(model) -> list[tuple[str, np.ndarray]]:
+    """The (name, elements) parts a model's series is written in: a containment model's
+    casing (elements of the ``casing.*`` sets' nodes) and blade (the rest), each its own
+    block; any other model one unnamed part, every element (one file per frame)."""
+    casing_sets = [k for k in model.node_sets if k.startswith("casing.layer")]
+    if "blade.fragment" not in model.node_sets or not casing_sets:
+        return [("", np.arange(model.n_elems, dtype=np.int64))]
+    on = np.zeros(model.n_nodes, dtype=bool)
+    for k in casing_sets:
+        on[model.node_sets[k]] = True
+    casing = on[model.quads].all(axis=1)
+    return [("casing", np.flatnonzero(casing)), ("blade", np.flatnonzero(~casing))]
 
 
 def fabric_elements(model) -> np.ndarray:
@@ -94,14 +113,23 @@ class FieldWriter:
         directory: output directory (created if needed).
         model: the Model the states belong to.
         entries: (time, file name) already in the series (see :meth:`resume`).
+        parts: (name, element indices) of the blocks each frame is written in, one file
+            each (default :func:`model_parts`); one unnamed part writes one file per frame.
     """
 
-    def __init__(self, directory: str | Path, model, entries=()) -> None:
+    def __init__(self, directory: str | Path, model, entries=(), parts=None) -> None:
         self.directory = Path(directory)
         self.directory.mkdir(parents=True, exist_ok=True)
         self.model = model
         self._entries: list[tuple[float, str]] = [(float(t), str(f)) for t, f in entries]
-        self._blocks = cell_blocks(model.quads)
+        self._parts = []
+        for name, elems in (model_parts(model) if parts is None else parts):
+            elems = np.asarray(elems, dtype=np.int64)
+            nodes = np.unique(model.quads[elems])
+            local = np.full(model.n_nodes, -1, dtype=np.int64)
+            local[nodes] = np.arange(nodes.size)
+            self._parts.append((name, elems, nodes, cell_blocks(local[model.quads[elems]])))
+        self._names = [name for name, *_ in self._parts]
         self._fabric = fabric_elements(model)
 
     @property
@@ -109,23 +137,34 @@ class FieldWriter:
         """(time, file name) of every file in the series, in order."""
         return tuple(self._entries)
 
+    @property
+    def frames(self) -> int:
+        """Frames written (each a file per part)."""
+        return len(self._entries) // len(self._parts)
+
     def write(self, state: State, time: float | None = None) -> Path:
-        """Write ``state`` as the next frame (at ``time``, default ``state.t``)."""
+        """Write ``state`` as the next frame (at ``time``, default ``state.t``); returns
+        the path of its (first part's) file."""
         t = float(state.t if time is None else time)
         if state.x.shape != self.model.x0.shape:
             raise InputError(f"state has {state.x.shape[0]} nodes, the model {self.model.n_nodes}")
         if self._entries and not t >= self._entries[-1][0]:
             raise InputError(f"field output time {t!r} s is before the last one "
                              f"({self._entries[-1][0]!r} s); times must not decrease")
-        path = self.directory / frame_name(self._next_frame())
-        with atomic_path(path) as tmp:
-            meshio.write(tmp, self._mesh(state), file_format="vtu")
-        self._entries.append((t, path.name))
+        k = self._next_frame()
+        per_elem = element_fields(self.model, state, self._fabric)
+        paths = []
+        for part in self._parts:
+            path = self.directory / frame_name(k, part[0])
+            with atomic_path(path) as tmp:
+                meshio.write(tmp, self._mesh(state, per_elem, part), file_format="vtu")
+            self._entries.append((t, path.name))
+            paths.append(path)
         self._write_pvd()
-        return path
+        return paths[0]
 
     @classmethod
-    def resume(cls, directory: str | Path, model, frames: int) -> FieldWriter:
+    def resume(cls, directory: str | Path, model, frames: int, parts=None) -> FieldWriter:
         """Continue the series in ``directory`` after a restart whose checkpoint counted
         ``frames`` frames: the series goes on at frame ``frames``. Frames after those
         are dropped from ``fields.pvd`` and their files deleted (the restarted run writes
@@ -133,14 +172,15 @@ class FieldWriter:
         :class:`InputError` (resuming would overwrite or lose frames).
         """
         directory = Path(directory)
+        names = [name for name, _ in (model_parts(model) if parts is None else parts)]
         entries = read_pvd(directory / PVD_NAME)
-        kept = entries[:frames]
-        expected = [frame_name(k) for k in range(frames)]
+        expected = [frame_name(k, name) for k in range(frames) for name in names]
+        kept = entries[:len(expected)]
         if [name for _, name in kept] != expected:
             raise InputError(
-                f"--restart: {directory / PVD_NAME} lists {len(entries)} frames, the checkpoint "
-                f"counts {frames} ({expected[0] if expected else ''}…); resuming would overwrite "
-                "or lose frames: run without --restart to start again")
+                f"--restart: {directory / PVD_NAME} lists {len(entries) // len(names)} frames, "
+                f"the checkpoint counts {frames} ({expected[0] if expected else ''}…); resuming "
+                "would overwrite or lose frames: run without --restart to start again")
         missing = [name for _, name in kept if not (directory / name).exists()]
         if missing:
             raise InputError(f"--restart: {directory / missing[0]} (frame of the checkpoint's "
@@ -149,7 +189,7 @@ class FieldWriter:
             k = _frame_index(old.name)
             if k is not None and k >= frames:
                 old.unlink()
-        writer = cls(directory, model, kept)
+        writer = cls(directory, model, kept, parts=parts)
         writer._write_pvd()
         return writer
 
@@ -157,28 +197,32 @@ class FieldWriter:
         frames = [_frame_index(name) for _, name in self._entries]
         return 1 + max((k for k in frames if k is not None), default=-1)
 
-    def _mesh(self, state: State) -> meshio.Mesh:
-        per_elem = element_fields(self.model, state, self._fabric)
+    def _mesh(self, state: State, per_elem: dict, part) -> meshio.Mesh:
+        _, elems, nodes, blocks = part
         return meshio.Mesh(
-            points=np.ascontiguousarray(state.x, dtype=float),
-            cells=[(kind, conn) for kind, _, conn in self._blocks],
-            point_data={"displacement": state.x - self.model.x0,
-                        "velocity": np.ascontiguousarray(state.v, dtype=float)},
-            cell_data={name: [np.ascontiguousarray(a[idx]) for _, idx, _ in self._blocks]
+            points=np.ascontiguousarray(state.x[nodes], dtype=float),
+            cells=[(kind, conn) for kind, _, conn in blocks],
+            point_data={"displacement": state.x[nodes] - self.model.x0[nodes],
+                        "velocity": np.ascontiguousarray(state.v[nodes], dtype=float)},
+            cell_data={name: [np.ascontiguousarray(a[elems[idx]]) for _, idx, _ in blocks]
                        for name, a in per_elem.items()},
         )
 
     def _write_pvd(self) -> None:
-        atomic_write_text(self.directory / PVD_NAME, pvd_text(self._entries))
+        part_of = {name: i for i, name in enumerate(self._names)}
+        atomic_write_text(self.directory / PVD_NAME, pvd_text(
+            self._entries, [part_of.get(_part_name(f), 0) for _, f in self._entries]))
 
 
-def pvd_text(entries) -> str:
-    """ParaView collection XML listing (time, file) entries."""
+def pvd_text(entries, parts=None) -> str:
+    """ParaView collection XML listing (time, file) entries, each in block ``parts[i]``
+    (default 0)."""
+    parts = [0] * len(entries) if parts is None else parts
     lines = ['<?xml version="1.0"?>',
              '<VTKFile type="Collection" version="0.1" byte_order="LittleEndian">',
              "  <Collection>"]
-    lines += [f'    <DataSet timestep="{float(t)!r}" group="" part="0" file={quoteattr(f)}/>'
-              for t, f in entries]
+    lines += [f'    <DataSet timestep="{float(t)!r}" group="" part="{int(p)}" '
+              f'file={quoteattr(f)}/>' for (t, f), p in zip(entries, parts)]
     lines += ["  </Collection>", "</VTKFile>", ""]
     return "\n".join(lines)
 
@@ -197,6 +241,13 @@ def read_pvd(path: str | Path) -> list[tuple[float, str]]:
 
 
 def _frame_index(name: str) -> int | None:
+    """k of ``step_{k}.vtu`` or ``step_{k}_{part}.vtu``; None for any other name."""
     stem = Path(name).stem
-    digits = stem.removeprefix("step_")
+    digits = stem.removeprefix("step_").split("_", 1)[0]
     return int(digits) if stem.startswith("step_") and digits.isdigit() else None
+
+
+def _part_name(name: str) -> str:
+    """The part of ``step_{k}_{part}.vtu`` ("" for ``step_{k}.vtu``)."""
+    rest = Path(name).stem.removeprefix("step_").split("_", 1)
+    return rest[1] if len(rest) == 2 else ""

@@ -103,6 +103,30 @@ def impactor_plot(h: dict, path: str | Path, title: str = "") -> Path:
     return path
 
 
+def fragment_plot(h: dict, path: str | Path, title: str = "", outcome: str = "") -> Path:
+    """A containment run against time: the fragment's centre-of-mass speed and its
+    radial velocity (outward positive), and the outermost casing layer's bulge (its
+    largest outward radial displacement), from the history columns of
+    ``containment.fragment_row``."""
+    path = Path(path)
+    t = h["time_s"] * 1e6
+    fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
+    a1.plot(t, h["fragment_speed_m_per_s"], label="speed of the centre of mass")
+    a1.plot(t, h["fragment_radial_velocity_m_per_s"], label="radial velocity (outward +)")
+    a1.axhline(0.0, color="k", lw=0.6)
+    a1.set_ylabel("fragment (m/s)")
+    a1.set_title(f"{title}: {outcome}" if outcome else title)
+    a1.grid(alpha=0.3)
+    a1.legend(fontsize=7)
+    a2.plot(t, h["outer_layer_bulge_m"] * 1e3, color="C3")
+    a2.set_ylabel("outermost layer bulge (mm)")
+    a2.set_xlabel("time (µs)")
+    a2.grid(alpha=0.3)
+    fig.tight_layout()
+    _save(fig, path)
+    return path
+
+
 def deflection_plot(model, state, path: str | Path, title: str = "") -> Path:
     """Deflection of each ply along the line y ≈ 0 (the x axis through the impact
     point) at the end of the run."""

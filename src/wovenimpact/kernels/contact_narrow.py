@@ -75,23 +75,44 @@ INSIDE_TOL = 1e-10  # |ξ|, |η| ≤ 1 + tol counts as inside the segment
 GN_ITERATIONS = 12
 
 
+# columns of the per-segment table of ``segment_geometry``: the raw box (b_min, b_max)
+# and the bilinear form x(ξ, η) = x̄ + ξ a + η b + ξη c (module docstring)
+SG_BOX, SG_MID, SG_A, SG_B, SG_C = 0, 6, 9, 12, 15
+N_SEG_GEO = 18
+
+
+@loop_kernel
+def segment_geometry(x, quads, seg_on, seg):
+    """Per live segment s (seg_on[s] ≠ 0; other rows untouched), at x: its raw box
+    b_min, b_max (the narrow phase's box test) and x̄, a, b, c of its bilinear form —
+    computed once per segment and step instead of once per candidate pair."""
+    for s in prange(quads.shape[0]):
+        if seg_on[s] == 0:
+            continue
+        q0, q1, q2, q3 = quads[s, 0], quads[s, 1], quads[s, 2], quads[s, 3]
+        for d in range(3):
+            x1, x2, x3, x4 = x[q0, d], x[q1, d], x[q2, d], x[q3, d]
+            seg[s, SG_BOX + d] = min(x1, x2, x3, x4)
+            seg[s, SG_BOX + 3 + d] = max(x1, x2, x3, x4)
+            seg[s, SG_MID + d] = 0.25 * (x1 + x2 + x3 + x4)
+            seg[s, SG_A + d] = 0.25 * (x2 + x3 - x1 - x4)
+            seg[s, SG_B + d] = 0.25 * (x3 + x4 - x1 - x2)
+            seg[s, SG_C + d] = 0.25 * (x1 + x3 - x2 - x4)
+
+
 @kernel
-def closest_point_on_quad(px, py, pz, x, quads, s):
-    """Closest point of (px, py, pz) on the bilinear segment s (module docstring).
+def closest_point_on_quad(px, py, pz, x, quads, seg, s):
+    """Closest point of (px, py, pz) on the bilinear segment s (module docstring);
+    ``seg``: the segments' table at x (:func:`segment_geometry`).
 
     Returns (ξ, η, c_x, c_y, c_z, n_x, n_y, n_z, inside): natural coordinates and
     position of the closest point, the unit surface normal x,ξ × x,η there (its
     orientation follows the node order of s) and 1 if the point is inside the square.
     """
-    q0, q1, q2, q3 = quads[s, 0], quads[s, 1], quads[s, 2], quads[s, 3]
-    x1, y1, z1 = x[q0, 0], x[q0, 1], x[q0, 2]
-    x2, y2, z2 = x[q1, 0], x[q1, 1], x[q1, 2]
-    x3, y3, z3 = x[q2, 0], x[q2, 1], x[q2, 2]
-    x4, y4, z4 = x[q3, 0], x[q3, 1], x[q3, 2]
-    mx, my, mz = 0.25 * (x1 + x2 + x3 + x4), 0.25 * (y1 + y2 + y3 + y4), 0.25 * (z1 + z2 + z3 + z4)
-    ax, ay, az = 0.25 * (x2 + x3 - x1 - x4), 0.25 * (y2 + y3 - y1 - y4), 0.25 * (z2 + z3 - z1 - z4)
-    bx, by, bz = 0.25 * (x3 + x4 - x1 - x2), 0.25 * (y3 + y4 - y1 - y2), 0.25 * (z3 + z4 - z1 - z2)
-    cx, cy, cz = 0.25 * (x1 + x3 - x2 - x4), 0.25 * (y1 + y3 - y2 - y4), 0.25 * (z1 + z3 - z2 - z4)
+    mx, my, mz = seg[s, SG_MID], seg[s, SG_MID + 1], seg[s, SG_MID + 2]
+    ax, ay, az = seg[s, SG_A], seg[s, SG_A + 1], seg[s, SG_A + 2]
+    bx, by, bz = seg[s, SG_B], seg[s, SG_B + 1], seg[s, SG_B + 2]
+    cx, cy, cz = seg[s, SG_C], seg[s, SG_C + 1], seg[s, SG_C + 2]
     xi = 0.0
     eta = 0.0
     for _ in range(GN_ITERATIONS):
@@ -171,8 +192,8 @@ def shape_functions(xi, eta):
 
 
 @kernel
-def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, pair_ptr, pair_seg, geo,
-                        keep):
+def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, pair_ptr, pair_seg,
+                        geo, keep):
     """Project node p on each of its candidate segments and keep the closest per group.
 
     Writes, for k in pair_ptr[p] … pair_ptr[p + 1] − 1: geo[k] = (ξ, η, d, n_x, n_y,
@@ -180,8 +201,9 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, pair_ptr, pair_
     segment to the node, side = ±1 the node's side of the surface normal; keep[k] = 1
     for the closest candidate of each (ply, side) group, else 0.
 
-    A candidate whose node is outside the segment's box inflated by h_p + h_s +
-    margin at x (the broad phase's test, contact_broad) is passed over (keep 0, side
+    A candidate whose node is outside the segment's box (``seg``, by
+    :func:`segment_geometry` at x) inflated by h_p + h_s + margin (the broad phase's test,
+    contact_broad) is passed over (keep 0, side
     0, d = ∞): a fresh search at x would not have listed it, so candidates kept from
     an earlier search with a skin (ShellContact) give the same result.
     """
@@ -190,21 +212,16 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, pair_ptr, pair_
     for k in range(k0, k1):
         s = pair_seg[k]
         r = h_node[p] + h_seg[s] + margin
-        q0, q1, q2, q3 = quads[s, 0], quads[s, 1], quads[s, 2], quads[s, 3]
-        outside = False
-        for d in range(3):
-            c = x[p, d]
-            if (c < min(x[q0, d], x[q1, d], x[q2, d], x[q3, d]) - r
-                    or c > max(x[q0, d], x[q1, d], x[q2, d], x[q3, d]) + r):
-                outside = True
-                break
-        if outside:
+        lo, hi = SG_BOX, SG_BOX + 3
+        if not (seg[s, lo] - r <= px <= seg[s, hi] + r
+                and seg[s, lo + 1] - r <= py <= seg[s, hi + 1] + r
+                and seg[s, lo + 2] - r <= pz <= seg[s, hi + 2] + r):
             geo[k, GEO_DIST] = math.inf
             geo[k, GEO_SIDE] = 0.0
             keep[k] = 0
             continue
         xi, eta, ox, oy, oz, sx, sy, sz, inside = closest_point_on_quad(
-            px, py, pz, x, quads, s)
+            px, py, pz, x, quads, seg, s)
         rx, ry, rz = px - ox, py - oy, pz - oz
         dn = rx * sx + ry * sy + rz * sz
         side = 1.0 if dn >= 0.0 else -1.0
@@ -222,13 +239,18 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, pair_ptr, pair_
         geo[k, GEO_N + 2] = nz
         geo[k, GEO_SIDE] = side
     for k in range(k0, k1):
-        if geo[k, GEO_SIDE] == 0.0:
+        side_k = geo[k, GEO_SIDE]
+        if side_k == 0.0:
             continue
         sk = pair_seg[k]
         best = True
         for j in range(k0, k1):
+            # the side first: most candidates failed the box test (side 0), and it is
+            # read in order, while ply[pair_seg[j]] is a scattered load
+            if j == k or geo[j, GEO_SIDE] != side_k:
+                continue
             sj = pair_seg[j]
-            if j == k or ply[sj] != ply[sk] or geo[j, GEO_SIDE] != geo[k, GEO_SIDE]:
+            if ply[sj] != ply[sk]:
                 continue
             dj, dk = geo[j, GEO_DIST], geo[k, GEO_DIST]
             if dj < dk or (dj == dk and sj < sk):
@@ -240,7 +262,7 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, pair_ptr, pair_
 @loop_kernel
 def penalty_forces(
     x, v, quads, ply, node_mass, h_node, h_seg, margin, overlap, beta, zeta, mu, dt,
-    pair_ptr, pair_seg, geo, pair_on, pair_f, pair_w, pair_e, node_f,
+    seg, pair_ptr, pair_seg, geo, pair_on, pair_f, pair_w, pair_e, node_f,
 ):
     """Penalty (and friction) force of every candidate pair (module docstring).
 
@@ -252,11 +274,14 @@ def penalty_forces(
         beta: penalty scale β; zeta: damping ζ (fraction of critical); mu: friction
             coefficient μ (0: frictionless).
         dt: the time step the forces are for (s), > 0.
+        seg: (n_elems, N_SEG_GEO) the segments' table at x (:func:`segment_geometry`).
         pair_ptr, pair_seg: candidates (contact_broad.find_candidates).
         geo: (capacity, N_GEO), pair_on: (capacity,) int8: scratch / written.
-        pair_f: (capacity, 3) written: force on the node of each pair (N).
-        pair_w: (capacity, 4) written: N_I(ξ, η) of each pair.
-        pair_e: (capacity,) written: ½ k g² of each pair (J).
+        pair_f: (capacity, 3) written for the active pairs (pair_on ≠ 0): force on the
+            node of each pair (N); rows of the other pairs are left as they were (no
+            reader looks at them).
+        pair_w: (capacity, 4) written for the active pairs: N_I(ξ, η) of each pair.
+        pair_e: (capacity,) written for the active pairs: ½ k g² of each pair (J).
         node_f: (n_nodes, 3) written: Σ of each node's own pair forces (N).
     """
     n_nodes = x.shape[0]
@@ -265,11 +290,9 @@ def penalty_forces(
         fx = fy = fz = 0.0
         k0, k1 = pair_ptr[p], pair_ptr[p + 1]
         if k1 > k0:
-            evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, pair_ptr, pair_seg,
-                                geo, pair_on)
+            evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, pair_ptr,
+                                pair_seg, geo, pair_on)
         for k in range(k0, k1):
-            pair_f[k, 0] = pair_f[k, 1] = pair_f[k, 2] = 0.0
-            pair_e[k] = 0.0
             if pair_on[k] == 0:
                 continue
             s = pair_seg[k]
@@ -311,8 +334,8 @@ def penalty_forces(
 
 
 @loop_kernel
-def initial_overlap(x, quads, ply, h_node, h_seg, margin, pair_ptr, pair_seg, geo, keep,
-                    overlap):
+def initial_overlap(x, quads, ply, h_node, h_seg, margin, seg, pair_ptr, pair_seg, geo,
+                    keep, overlap):
     """Initial-overlap allowance o_p = max(0, max over kept pairs of h_p + h_s − d).
 
     With it the gap g = d − (h_p + h_s − o_p) of every kept pair is ≥ 0 in the
@@ -322,6 +345,7 @@ def initial_overlap(x, quads, ply, h_node, h_seg, margin, pair_ptr, pair_seg, ge
 
     Args:
         x: (n_nodes, 3) initial positions; margin: the search margin (m);
+        seg: the segments' table at x (:func:`segment_geometry`).
         pair_ptr, pair_seg: candidates at x.
         geo, keep: scratch as in ``penalty_forces``.
         overlap: (n_nodes,) written (m).
@@ -330,8 +354,8 @@ def initial_overlap(x, quads, ply, h_node, h_seg, margin, pair_ptr, pair_seg, ge
         o = 0.0
         k0, k1 = pair_ptr[p], pair_ptr[p + 1]
         if k1 > k0:
-            evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, pair_ptr, pair_seg,
-                                geo, keep)
+            evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, pair_ptr,
+                                pair_seg, geo, keep)
             for k in range(k0, k1):
                 if keep[k] != 0:
                     o = max(o, h_node[p] + h_seg[pair_seg[k]] - geo[k, GEO_DIST])

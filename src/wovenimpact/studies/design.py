@@ -254,10 +254,16 @@ def refuse_failed(results: dict[int, str], out: Path, unit: str = "plies",
     """An :class:`InputError` naming every pack whose run failed (``"failed: …"``) and
     where its error.txt is; the packs that ran are kept in ``out`` for the next search."""
     failed = [n for n, r in results.items() if r.startswith("failed")]
+
+    def where(n: int) -> Path:
+        """The pack's error.txt (a run that raised), else its summary.json (a run that
+        finished but failed its energy check)."""
+        pack = out / f"plies_{n}{suffix}"
+        return pack / "error.txt" if (pack / "error.txt").exists() else pack / "summary.json"
+
     if failed:
         raise InputError(
-            "; ".join(f"{n} {unit}: the run {results[n]} (see "
-                      f"{out / f'plies_{n}{suffix}' / 'error.txt'})" for n in failed)
+            "; ".join(f"{n} {unit}: the run {results[n]} (see {where(n)})" for n in failed)
             + ". The packs that ran are kept: fix the case and search again to reuse them")
 
 

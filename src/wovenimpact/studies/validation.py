@@ -307,13 +307,18 @@ def design_lines(name: str, work: Path, workers: int, log=_quiet) -> list[str]:
 
     case, overrides, check = DESIGN[name]
     path = ROOT / "examples" / "plate_impact" / f"{case}.toml"
-    result = design_plies(path, work / name, workers=workers, overrides=overrides,
-                          check=check, log=log)
     sets = " ".join(f"--set '{o}'" for o in overrides)
+    head = [f"## {name}: plies to stop the impactor, by runs", "",
+            f"`wovenimpact design plies examples/plate_impact/{case}.toml {sets} "
+            f"--check {check}` (doubling, then bisection; only decided runs count).", ""]
+    try:
+        result = design_plies(path, work / name, workers=workers, overrides=overrides,
+                              check=check, log=log)
+    except InputError as err:  # a failed pack stops the search: the report says so
+        log(f"design search {name} failed: {err}")
+        return head + [f"**No answer: the search stopped.** {err}", ""]
     runs = ", ".join(f"{n} plies {outcome}" for n, outcome in result["runs"].items())
-    lines = [f"## {name}: plies to stop the impactor, by runs", "",
-             f"`wovenimpact design plies examples/plate_impact/{case}.toml {sets} "
-             f"--check {check}` (doubling, then bisection; only decided runs count).", "",
+    lines = head + [
              f"Answer: **{result['plies_to_stop']} plies** "
              f"({result['areal_mass_kg_per_m2']:.3f} kg/m² of fabric). Runs: {runs}."]
     if result["reruns"]:

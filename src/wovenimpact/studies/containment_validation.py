@@ -1,0 +1,213 @@
+"""The containment report (issue 11): our ladders beside the thesis's (its chapter 8).
+
+:func:`containment_section` runs (or reuses, from ``work``: a run is reused only when its
+provenance digest matches) the two ladder studies of ``examples/studies/`` — the hybrid
+casing (1 mm aluminium shell wrapped in N Kevlar plies) and the all-metal casing (N
+layers of 0.5 mm aluminium) — and returns Markdown lines:
+
+- per ladder, a table of every run (outcome, exit speed, the thesis's exit speed at the
+  same N, casing mass and mass per unit area, largest bulge, energy error, hourglass
+  share, wall time) and a figure of exit speed against N, ours and the thesis's;
+- the quadratic regression of exit speed against N (thesis eq. 8.2) over the decided
+  runs that let the fragment through (``escaped``), and the layers it predicts to contain;
+  beside it the fewest layers that contained the fragment in a run;
+- the mass table: the lightest casing of each kind that contained the fragment in a
+  run, and the one the regression predicts, with its mass per unit area — the inner
+  shell counted (the thesis's Table 8-4 left it out).
+
+Undecided runs (still pushing intact layers at the end time) enter neither the
+regression nor the answer; they are listed with a word. ``wovenimpact validate
+--containment`` writes the section alone to docs/validation_containment.md (the ladders
+take hours: they are not part of the chapter-7 report).
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+from pathlib import Path
+
+from wovenimpact.errors import InputError
+
+ROOT = Path(__file__).resolve().parents[3]
+KEY = "mesh.casing.layers"
+# thesis ch. 8 (MODEL.md §6): exit speed (m/s) of the fragment from 149 m/s
+THESIS_HYBRID = {4: 133.0, 6: 131.0, 8: 129.0, 10: 124.0}
+THESIS_METAL = {4: 123.3, 8: 111.0, 12: 95.5, 18: 81.9, 20: 35.9, 24: 0.6}
+LADDERS = (
+    ("containment_hybrid", "Hybrid casing: 1 mm aluminium shell + N Kevlar plies", "plies",
+     THESIS_HYBRID, "the thesis ran 4–10 plies (its solver failed beyond) and extrapolated "
+     "about 30 to contain"),
+    ("containment_metal", "All-metal casing: N layers of 0.5 mm aluminium", "layers",
+     THESIS_METAL, "the thesis: 25 layers contained the fragment"),
+)
+
+
+def _quiet(message: str) -> None:
+    """The default progress reporter: says nothing."""
+
+
+def _fmt(value, spec: str, missing: str = "") -> str:
+    """``value`` formatted with ``spec``, or ``missing`` for None/NaN/empty."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        return missing
+    return missing if math.isnan(v) else format(v, spec)
+
+
+def _mm(value) -> float | None:
+    """A length in m as mm (None if not a number)."""
+    try:
+        return float(value) * 1e3
+    except (TypeError, ValueError):
+        return None
+
+
+def ladder_result(rows: list[dict]) -> dict:
+    """What a ladder's finished rows say: the regression of the escaped runs' exit speed
+    against N (None with fewer than three distinct N), the fewest layers that contained
+    the fragment in a run (None if none did), the undecided N, and the mass per unit area
+    of a casing of N layers interpolated between the runs (a function of N)."""
+    from wovenimpact.studies.ballistics import quadratic_ply_regression
+
+    done = [r for r in rows if r.get("status") == "done"]
+    escaped = [(float(r[KEY]), float(r["fragment_exit_speed_m_per_s"])) for r in done
+               if r.get("outcome") == "escaped"]
+    contained = sorted(int(float(r[KEY])) for r in done if r.get("outcome") == "contained")
+    undecided = sorted(int(float(r[KEY])) for r in done
+                       if r.get("outcome") not in ("escaped", "contained"))
+    regression = None
+    if len({n for n, _ in escaped}) >= 3:
+        regression = quadratic_ply_regression(*zip(*escaped))
+    per_area = sorted((float(r[KEY]), float(r["casing_mass_per_area_kg_per_m2"])) for r in done)
+
+    def mass_per_area(n: float) -> float | None:
+        """Linear in N between (and beyond) the runs: each layer adds the same mass."""
+        if len(per_area) < 2:
+            return per_area[0][1] if per_area and per_area[0][0] == n else None
+        (n0, m0), (n1, m1) = per_area[0], per_area[-1]
+        return m0 + (m1 - m0) * (n - n0) / (n1 - n0) if n1 != n0 else None
+
+    return {"regression": regression, "fewest_contained": contained[0] if contained else None,
+            "undecided": undecided, "mass_per_area": mass_per_area}
+
+
+def ladder_lines(name: str, title: str, unit: str, thesis: dict, note: str, rows: list[dict],
+                 figures: Path) -> tuple[list[str], dict]:
+    """The table, figure and regression of one ladder (rows: its study results)."""
+    lines = [f"### {title} (examples/studies/{name}.toml)", "", f"Thesis: {note}.", "",
+             f"| {unit} | outcome | exit speed (m/s) | thesis (m/s) | casing (kg) | "
+             "kg/m² | largest bulge (mm) | energy error | hourglass / internal work | wall (s) |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        n = int(float(r[KEY]))
+        if r.get("status") != "done":
+            lines.append(f"| {n} | {r.get('status')}: {r.get('error', '')} | | "
+                         f"{_fmt(thesis.get(n), '.1f')} | | | | | | |")
+            continue
+        lines.append(
+            f"| {n} | {r['outcome']} | {_fmt(r['fragment_exit_speed_m_per_s'], '.1f')} | "
+            f"{_fmt(thesis.get(n), '.1f')} | {_fmt(r['casing_mass_kg'], '.3f')} | "
+            f"{_fmt(r['casing_mass_per_area_kg_per_m2'], '.2f')} | "
+            f"{_fmt(_mm(r.get('max_bulge_m')), '.1f')} | "
+            f"{_fmt(r['energy_error_fraction'], '.1e')} | "
+            f"{_fmt(r.get('hourglass_fraction'), '.1%', 'n/a')} | {_fmt(r.get('wall_time_s'), '.0f')} |")
+    result = ladder_result(rows)
+    reg = result["regression"]
+    lines.append("")
+    if reg is not None:
+        c2, c1, c0 = reg.coefficients
+        lines.append(f"Quadratic regression (eq. 8.2) of the escaped runs: V_exit(N) = "
+                     f"{c2:.4g} N² {c1:+.4g} N {c0:+.4g} (R² = {reg.r2:.3f}); it reaches zero "
+                     + (f"at N = {reg.root:.1f}: **{reg.plies_to_stop} {unit} to contain**."
+                        if reg.plies_to_stop else "nowhere on its decreasing branch."))
+    else:
+        lines.append("No regression: it needs escaped runs at three or more N.")
+    if result["fewest_contained"] is not None:
+        lines.append(f"Fewest {unit} that contained the fragment in a run: "
+                     f"**{result['fewest_contained']}**.")
+    if result["undecided"]:
+        lines.append(f"Undecided (still pushing intact layers at the end time; not used): "
+                     f"{', '.join(map(str, result['undecided']))} {unit} — run them longer.")
+    figure = exit_speed_figure(rows, thesis, title, unit, figures / f"{name}.png", reg)
+    lines += ["", f"![{title}](validation/{figure.name})", ""]
+    return lines, result
+
+
+def exit_speed_figure(rows, thesis: dict, title: str, unit: str, path: Path, regression=None
+                      ) -> Path:
+    """Exit speed against N: our decided runs (contained at 0), the thesis's points and
+    the regression curve."""
+    import numpy as np
+
+    from wovenimpact.io.plots import plt, _save
+
+    fig, ax = plt.subplots(figsize=(7, 4))
+    done = [r for r in rows if r.get("status") == "done"
+            and r.get("outcome") in ("escaped", "contained")]
+    if done:
+        ax.plot([float(r[KEY]) for r in done],
+                [float(r["fragment_exit_speed_m_per_s"]) for r in done], "o", label="wovenimpact")
+    ax.plot(list(thesis), list(thesis.values()), "s", mfc="none", label="thesis")
+    if regression is not None:
+        n = np.linspace(min(float(r[KEY]) for r in done), (regression.root or max(
+            float(r[KEY]) for r in done)), 100)
+        ax.plot(n, regression.predict(n), "-", lw=0.8, label="regression (eq. 8.2)")
+    ax.axhline(0.0, color="k", lw=0.6)
+    ax.set_xlabel(unit)
+    ax.set_ylabel("fragment exit speed (m/s)")
+    ax.set_title(title, fontsize=9)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    fig.tight_layout()
+    _save(fig, path)
+    return path
+
+
+def mass_table(results: dict[str, dict]) -> list[str]:
+    """The lightest casing of each kind that contains the fragment: by runs and by the
+    regression (mass per unit area of the whole casing, the inner shell counted)."""
+    lines = ["### Mass of the lightest casing that contains the fragment", "",
+             "Mass per unit area of the casing wall (every layer, the inner aluminium shell "
+             "included; the thesis's Table 8-4 left the shell out).", "",
+             "| casing | by runs | kg/m² | by regression | kg/m² |", "|---|---|---|---|---|"]
+    for (name, title, unit, _, _), res in zip(LADDERS, results.values()):
+        runs = res["fewest_contained"]
+        reg = res["regression"]
+        by_reg = reg.plies_to_stop if reg is not None else None
+        lines.append(
+            f"| {title.split(':')[0]} | {f'{runs} {unit}' if runs else 'none contained'} | "
+            f"{_fmt(res['mass_per_area'](runs) if runs else None, '.2f', '—')} | "
+            f"{f'{by_reg} {unit}' if by_reg else '—'} | "
+            f"{_fmt(res['mass_per_area'](by_reg) if by_reg else None, '.2f', '—')} |")
+    return lines + [""]
+
+
+def containment_section(work: str | Path, figures: str | Path, log=_quiet, workers: int = 2
+                        ) -> list[str]:
+    """The containment report (module docstring): the runs live in ``work/containment``,
+    the figures go to ``figures``."""
+    from wovenimpact.studies.sweep import run_study
+
+    work = Path(work) / "containment"
+    figures = Path(figures)
+    figures.mkdir(parents=True, exist_ok=True)
+    lines = ["## Fan-blade containment (thesis chapter 8; issue 11)", "",
+             "A titanium fragment released at 1047 rad/s (examples/containment/; geometry, "
+             "spin state and release: docs/theory.md §8) against a 120° casing sector. The "
+             "thesis's numbers are trends to compare with, not targets; nothing is tuned to "
+             "them.", ""]
+    results = {}
+    for name, title, unit, thesis, note in LADDERS:
+        path = ROOT / "examples" / "studies" / f"{name}.toml"
+        if not path.exists():
+            raise InputError(f"no study file {path}")
+        log(f"study {name} → {work / name}")
+        rows = run_study(path, work / name, workers=workers)
+        ladder, results[name] = ladder_lines(name, title, unit, thesis, note, rows, figures)
+        lines += ladder
+        plots = work / name / "plots"
+        for png in sorted(plots.glob("*.png")) if plots.exists() else ():
+            shutil.copy(png, figures / f"{name}_{png.name}")
+    return lines + mass_table(results)

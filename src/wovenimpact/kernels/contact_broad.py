@@ -1,4 +1,4 @@
-"""Broad phase of the shell–shell contact: hashed uniform-grid search (MODEL.md §4).
+"""Broad phase of the shell–shell contact: hashed uniform-grid bucket search (MODEL.md §4).
 
 Candidates are (node, segment) pairs, a segment being the quad of a live element
 that takes part in contact. A node p (offset h_p, the half-thickness of its shell) is
@@ -11,34 +11,25 @@ and is neither a node of s nor of an element of the same ply as s (with
 ``self_contact`` on: of an element of the same ply sharing a node with s). The
 narrow phase (:mod:`contact_narrow`) then measures the exact gap.
 
-Search (cost linear in nodes + segments, independent of the thickest section):
+Search (cost linear in nodes + segments):
 
-1. boxes: per segment its raw box [b_min, b_max]; the cell edge L_d along each axis is
-   the mean over the live segments of their box inflated by their own offset and the
-   margin, b_max − b_min + 2 (h_s + m) (at least ``cell_min`` and a quarter of the
-   largest node offset, so that a node visits at most ~9 cells per axis); the grid's
-   origin is offset by a fraction of a cell so that a regular mesh's edges do not fall
-   on cell edges;
-2. cells: each segment is entered in every cell its box inflated by h_s + m overlaps
-   (usually 1–8), the cells hashed into a table of 2^k buckets; a counting sort over
-   bucket indices (segments in increasing order inside a bucket) builds the bucket
-   CSR — deterministic;
-3. queries: a node p visits the cells its own interval [p − h_p, p + h_p] overlaps
-   (usually one). A pair (p, s) passes the box test only if that interval and the
-   segment's inflated box overlap, so it is met in at least one common cell; it is
-   taken only in the first of them (per axis the larger of the two lower cell indices),
-   so never twice. Each bucket entry is checked against its true cell (hash collisions
-   cost time, never duplicates), then the exact box test and the exclusion test. A
-   counting pass gives each node's number of candidates, a serial prefix sum their
-   offsets, and a writing pass fills them, each node's in increasing segment order: the
-   output is node-major (a CSR ``pair_ptr``/``pair_seg``), the same for any thread count
-   and for any cell size. When the pairs exceed the capacity of ``pair_seg``, or the
-   cell entries that of the bucket arrays, nothing more is written and the needs are
-   returned: the caller grows the buffers and calls again.
-
-Before issue 13 the cell was the largest inflated box of any segment, padded with the
-largest node offset: a casing's plies were scanned in cubes as wide as the blade is
-thick (20 mm cells, ~300 segments per node, more with every ply).
+1. boxes: per segment, its raw box [b_min, b_max] and its bin corner
+   c_s = b_min − (h_s + H + m), H = max h_p; the largest inflated box along each
+   axis E_d = (1 + 1e-9) · max_s (b_max − b_min + 2 (h_s + H + m))_d and the cell
+   edge L_d = E_d (at least ``cell_min``);
+2. buckets: each segment goes into the cell floor(c_s / L), and cells are hashed
+   into a table of 2^k buckets; a counting sort over bucket indices (segments in
+   increasing order inside a bucket) builds the bucket CSR — deterministic;
+3. queries: a node p can only be a candidate of segments with p − E ≤ c_s ≤ p,
+   binned in the cells floor((p − E)/L) … floor(p/L) per axis (at most 2 per axis
+   when L = E: 8 cells). Each bucket entry is checked against the
+   segment's true cell (so hash collisions cost time, never duplicates), then the
+   exact box test and the exclusion test. A counting pass gives each node's
+   number of candidates, a serial prefix sum their offsets, and a writing pass
+   fills them: the output is node-major (a CSR ``pair_ptr``/``pair_seg``) and the
+   same for any thread count. When the total exceeds the capacity of
+   ``pair_seg`` nothing is written and the total is returned: the caller grows the
+   buffer and calls again.
 """
 
 from __future__ import annotations
@@ -54,7 +45,9 @@ from wovenimpact.jit import inline_kernel, kernel, loop_kernel
 _P1 = 73856093
 _P2 = 19349663
 _P3 = 83492791
-CELL_SLACK = 1e-9  # cell ranges widened by this fraction of the cell edge (rounding)
+CELL_SLACK = 1e-9  # relative margin over the largest inflated box E
+CELL_FRACTION = 1.0  # cell edge L = E: 2 cells per axis to visit (E/2: 3 smaller cells
+# per axis scan fewer segments but measured ~15 % slower, the 27 hash lookups dominate)
 
 
 @inline_kernel
@@ -63,18 +56,14 @@ def cell_bucket(ix, iy, iz, mask):
     return ((ix * _P1) ^ (iy * _P2) ^ (iz * _P3)) & mask
 
 
-CELL_OFFSET = 0.3819660112501051  # grid origin at this fraction of a cell (2 − φ): a
-# mesh whose nodes sit on round coordinates does not put its segments' edges on cell edges
-
-
 @inline_kernel
-def cell_range(lo, hi, length):
-    """Cells floor((lo − o)/L) … floor((hi − o)/L), o = CELL_OFFSET · L, of the interval
-    [lo, hi] widened by CELL_SLACK · L at both ends."""
-    slack = CELL_SLACK * length
-    origin = CELL_OFFSET * length
-    return (np.int64(math.floor((lo - slack - origin) / length)),
-            np.int64(math.floor((hi + slack - origin) / length)))
+def segment_cell(box, s, pad, l0, l1, l2):
+    """Cell of segment s: floor((b_min − pad) / L) per axis, pad = h_s + H + m."""
+    return (
+        np.int64(math.floor((box[s, 0] - pad) / l0)),
+        np.int64(math.floor((box[s, 1] - pad) / l1)),
+        np.int64(math.floor((box[s, 2] - pad) / l2)),
+    )
 
 
 @kernel
@@ -105,23 +94,10 @@ def in_inflated_box(x, p, box, k, r):
     )
 
 
-@kernel
-def sort_segments(pair_seg, start, count):
-    """Sort pair_seg[start : start + count] in increasing order (insertion sort: a node
-    has a few tens of candidates at most)."""
-    for i in range(start + 1, start + count):
-        v = pair_seg[i]
-        j = i - 1
-        while j >= start and pair_seg[j] > v:
-            pair_seg[j + 1] = pair_seg[j]
-            j -= 1
-        pair_seg[j + 1] = v
-
-
 @loop_kernel
 def find_candidates(
     x, quads, ply, seg_on, node_on, h_node, h_seg, margin, cell_min, self_contact,
-    node_ptr, node_elem, box, seg_cells, bucket_ptr, bucket_seg, bucket_cell, pair_ptr,
+    node_ptr, node_elem, box, bucket_ptr, bucket_seg, bucket_cell, bucket_box, pair_ptr,
     pair_seg,
 ):
     """Candidate (node, segment) pairs by the hashed-grid search of the module docstring.
@@ -133,84 +109,76 @@ def find_candidates(
         node_on: (n_nodes,) nonzero for a node taking part now (active and selected).
         h_node: (n_nodes,) node offsets h_p; h_seg: (n_elems,) segment offsets h_s (m).
         margin: extra inflation m of the boxes (m, ≥ 0).
-        cell_min: smallest cell edge (m); 0: the mean inflated box alone.
+        cell_min: smallest cell edge (m); by default (0) the largest inflated box.
         self_contact: 0: no pair within one ply; 1: pairs within a ply unless the node's
             element shares a node with the segment.
         node_ptr, node_elem: node → element CSR (Model).
         box: (n_elems, 6) scratch: b_min, b_max of each segment.
-        seg_cells: (n_elems, 6) int64 scratch: each segment's lower and upper cells.
-        bucket_ptr: (n_buckets + 1,) int64 scratch, n_buckets a power of two ≥ 2 entries.
-        bucket_seg: (entry capacity,) int64 and bucket_cell: (entry capacity, 3) int64
-            scratch: the cell entries (segment, cell) in bucket order.
+        bucket_ptr: (n_buckets + 1,) int64 scratch, n_buckets a power of two.
+        bucket_seg: (n_elems,) int64 scratch: segments in bucket order, with
+        bucket_cell: (n_elems, 3) int64 and bucket_box: (n_elems, 6) scratch: their
+            cells and boxes in the same order (a bucket is scanned contiguously).
         pair_ptr: (n_nodes + 1,) int64 written: candidates of node p are
-            pair_seg[pair_ptr[p]:pair_ptr[p + 1]], in increasing segment order.
+            pair_seg[pair_ptr[p]:pair_ptr[p + 1]].
         pair_seg: (capacity,) int64 written when the total fits.
 
     Returns:
-        (n_pairs, n_entries, L_x, L_y, L_z): total candidates (> capacity: overflow,
-        pair_seg not written; −1 when the entries did not fit), the cell entries (more
-        than bucket_seg holds, or more than half the buckets: grow them and call again)
-        and the cell edges used.
+        (n_pairs, L_x, L_y, L_z): total candidates (> capacity: overflow, pair_seg not
+        written) and the cell edges used.
     """
     n_nodes = x.shape[0]
     n_el = quads.shape[0]
-    # 1. raw boxes of the live segments and the mean inflated box
-    for s in prange(n_el):
-        if seg_on[s] == 0:
-            continue
-        for d in range(3):
-            lo = hi = x[quads[s, 0], d]
-            for a in range(1, 4):
-                q = quads[s, a]
-                lo = min(lo, x[q, d])
-                hi = max(hi, x[q, d])
-            box[s, d] = lo
-            box[s, 3 + d] = hi
-    sum0 = sum1 = sum2 = 0.0
-    n_live = 0
-    for s in range(n_el):
-        if seg_on[s] == 0:
-            continue
-        pad = 2.0 * (h_seg[s] + margin)
-        sum0 += box[s, 3] - box[s, 0] + pad
-        sum1 += box[s, 4] - box[s, 1] + pad
-        sum2 += box[s, 5] - box[s, 2] + pad
-        n_live += 1
-    n_live = max(n_live, 1)
-    # a node visits the cells of [p − h_p, p + h_p]: at most ~9 per axis
+    n_buckets = bucket_ptr.shape[0] - 1
+    mask = n_buckets - 1
     h_max = 0.0
     for p in range(n_nodes):
         if node_on[p] != 0 and h_node[p] > h_max:
             h_max = h_node[p]
-    floor_len = max(cell_min, 0.25 * h_max, 1e-9 * max(sum0, sum1, sum2) / n_live, 1e-300)
-    l0 = max(sum0 / n_live, floor_len)
-    l1 = max(sum1 / n_live, floor_len)
-    l2 = max(sum2 / n_live, floor_len)
-    # 2. cell ranges, entries, bucket lists (counting sort by bucket; segment order)
-    n_entries = 0
+    # 1. raw boxes of the live segments
+    for s in prange(n_el):
+        if seg_on[s] == 0:
+            continue
+        lo0 = hi0 = x[quads[s, 0], 0]
+        lo1 = hi1 = x[quads[s, 0], 1]
+        lo2 = hi2 = x[quads[s, 0], 2]
+        for a in range(1, 4):
+            q = quads[s, a]
+            lo0 = min(lo0, x[q, 0])
+            hi0 = max(hi0, x[q, 0])
+            lo1 = min(lo1, x[q, 1])
+            hi1 = max(hi1, x[q, 1])
+            lo2 = min(lo2, x[q, 2])
+            hi2 = max(hi2, x[q, 2])
+        box[s, 0] = lo0
+        box[s, 1] = lo1
+        box[s, 2] = lo2
+        box[s, 3] = hi0
+        box[s, 4] = hi1
+        box[s, 5] = hi2
+    # cell size: the largest inflated box along each axis
+    ext0 = ext1 = ext2 = 0.0
     for s in range(n_el):
         if seg_on[s] == 0:
             continue
-        pad = h_seg[s] + margin
-        a0, b0 = cell_range(box[s, 0] - pad, box[s, 3] + pad, l0)
-        a1, b1 = cell_range(box[s, 1] - pad, box[s, 4] + pad, l1)
-        a2, b2 = cell_range(box[s, 2] - pad, box[s, 5] + pad, l2)
-        seg_cells[s, 0], seg_cells[s, 1], seg_cells[s, 2] = a0, a1, a2
-        seg_cells[s, 3], seg_cells[s, 4], seg_cells[s, 5] = b0, b1, b2
-        n_entries += (b0 - a0 + 1) * (b1 - a1 + 1) * (b2 - a2 + 1)
-    n_buckets = bucket_ptr.shape[0] - 1
-    if n_entries > bucket_seg.shape[0] or 2 * n_entries > n_buckets:
-        return -1, n_entries, l0, l1, l2
-    mask = n_buckets - 1
+        pad = 2.0 * (h_seg[s] + h_max + margin)
+        ext0 = max(ext0, box[s, 3] - box[s, 0] + pad)
+        ext1 = max(ext1, box[s, 4] - box[s, 1] + pad)
+        ext2 = max(ext2, box[s, 5] - box[s, 2] + pad)
+    ext0 *= 1.0 + CELL_SLACK
+    ext1 *= 1.0 + CELL_SLACK
+    ext2 *= 1.0 + CELL_SLACK
+    floor_len = max(cell_min, 1e-9 * max(ext0, ext1, ext2), 1e-300)
+    l0 = max(CELL_FRACTION * ext0, floor_len)
+    l1 = max(CELL_FRACTION * ext1, floor_len)
+    l2 = max(CELL_FRACTION * ext2, floor_len)
+    # 2. bucket lists (counting sort by bucket; segments in increasing order)
     for b in range(n_buckets + 1):
         bucket_ptr[b] = 0
     for s in range(n_el):
         if seg_on[s] == 0:
             continue
-        for cx in range(seg_cells[s, 0], seg_cells[s, 3] + 1):
-            for cy in range(seg_cells[s, 1], seg_cells[s, 4] + 1):
-                for cz in range(seg_cells[s, 2], seg_cells[s, 5] + 1):
-                    bucket_ptr[cell_bucket(cx, cy, cz, mask) + 1] += 1
+        ix, iy, iz = segment_cell(box, s, h_seg[s] + h_max + margin, l0, l1, l2)
+        bucket_ptr[cell_bucket(ix, iy, iz, mask) + 1] += 1
     for b in range(n_buckets):
         bucket_ptr[b + 1] += bucket_ptr[b]
     # fill in segment order, bucket_ptr[b] serving as the cursor of bucket b (it ends
@@ -218,20 +186,20 @@ def find_candidates(
     for s in range(n_el):
         if seg_on[s] == 0:
             continue
-        for cx in range(seg_cells[s, 0], seg_cells[s, 3] + 1):
-            for cy in range(seg_cells[s, 1], seg_cells[s, 4] + 1):
-                for cz in range(seg_cells[s, 2], seg_cells[s, 5] + 1):
-                    b = cell_bucket(cx, cy, cz, mask)
-                    k = bucket_ptr[b]
-                    bucket_seg[k] = s
-                    bucket_cell[k, 0] = cx
-                    bucket_cell[k, 1] = cy
-                    bucket_cell[k, 2] = cz
-                    bucket_ptr[b] = k + 1
+        ix, iy, iz = segment_cell(box, s, h_seg[s] + h_max + margin, l0, l1, l2)
+        b = cell_bucket(ix, iy, iz, mask)
+        k = bucket_ptr[b]
+        bucket_seg[k] = s
+        bucket_cell[k, 0] = ix
+        bucket_cell[k, 1] = iy
+        bucket_cell[k, 2] = iz
+        for c in range(6):
+            bucket_box[k, c] = box[s, c]
+        bucket_ptr[b] = k + 1
     for b in range(n_buckets, 0, -1):  # shift back: bucket_ptr[b] = start of b
         bucket_ptr[b] = bucket_ptr[b - 1]
     bucket_ptr[0] = 0
-    # 3. queries: count, prefix sum, write (each node's candidates sorted)
+    # 3. queries: count, prefix sum, write
     capacity = pair_seg.shape[0]
     for sweep in range(2):
         write = sweep == 1
@@ -239,26 +207,23 @@ def find_candidates(
             count = 0
             if node_on[p] != 0:
                 base = pair_ptr[p] if write else 0
-                hp = h_node[p]
-                i0, j0 = cell_range(x[p, 0] - hp, x[p, 0] + hp, l0)
-                i1, j1 = cell_range(x[p, 1] - hp, x[p, 1] + hp, l1)
-                i2, j2 = cell_range(x[p, 2] - hp, x[p, 2] + hp, l2)
-                for cx in range(i0, j0 + 1):
-                    for cy in range(i1, j1 + 1):
-                        for cz in range(i2, j2 + 1):
+                jx = np.int64(math.floor(x[p, 0] / l0))
+                jy = np.int64(math.floor(x[p, 1] / l1))
+                jz = np.int64(math.floor(x[p, 2] / l2))
+                ix = np.int64(math.floor((x[p, 0] - ext0) / l0))
+                iy = np.int64(math.floor((x[p, 1] - ext1) / l1))
+                iz = np.int64(math.floor((x[p, 2] - ext2) / l2))
+                for cx in range(ix, jx + 1):
+                    for cy in range(iy, jy + 1):
+                        for cz in range(iz, jz + 1):
                             b = cell_bucket(cx, cy, cz, mask)
                             for k in range(bucket_ptr[b], bucket_ptr[b + 1]):
                                 if (bucket_cell[k, 0] != cx or bucket_cell[k, 1] != cy
                                         or bucket_cell[k, 2] != cz):
                                     continue  # another cell hashed into this bucket
                                 s = bucket_seg[k]
-                                # the first common cell of node and segment only
-                                if (cx != max(i0, seg_cells[s, 0])
-                                        or cy != max(i1, seg_cells[s, 1])
-                                        or cz != max(i2, seg_cells[s, 2])):
-                                    continue
-                                r = h_seg[s] + hp + margin
-                                if not in_inflated_box(x, p, box, s, r):
+                                r = h_seg[s] + h_node[p] + margin
+                                if not in_inflated_box(x, p, bucket_box, k, r):
                                     continue
                                 if excluded_pair(p, s, quads, ply, node_ptr, node_elem,
                                                  self_contact):
@@ -266,8 +231,6 @@ def find_candidates(
                                 if write:
                                     pair_seg[base + count] = s
                                 count += 1
-                if write:
-                    sort_segments(pair_seg, base, count)
             if not write:
                 pair_ptr[p + 1] = count
         if not write:
@@ -276,12 +239,12 @@ def find_candidates(
                 pair_ptr[p + 1] += pair_ptr[p]
             if pair_ptr[n_nodes] > capacity:
                 break
-    return pair_ptr[n_nodes], n_entries, l0, l1, l2
+    return pair_ptr[n_nodes], l0, l1, l2
 
 
-def bucket_count(n_entries: int) -> int:
-    """Hash-table size for ``n_entries`` cell entries: the power of two ≥ 2 n (at least 64)."""
-    return 1 << max(6, int(math.ceil(math.log2(max(2 * n_entries, 1)))))
+def bucket_count(n_segments: int) -> int:
+    """Hash-table size for ``n_segments`` segments: the power of two ≥ 2 n (at least 64)."""
+    return 1 << max(6, int(math.ceil(math.log2(max(2 * n_segments, 1)))))
 
 
 @loop_kernel

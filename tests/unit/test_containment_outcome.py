@@ -79,10 +79,11 @@ def test_containment_outputs_bulge_layer_and_material_energies_and_fragment_plot
     """A coarse two-ply hybrid casing (10 mm elements) run into the impact (the tip,
     moving tangentially, reaches the casing after about 200 µs; 300 µs): the
     history carries the outermost layer's bulge and the summary's largest bulge is at
-    least every recorded one; each layer's absorbed energy is the one its ply holds
-    (quantities.ply_energies, the blade's ply last) and the materials' energies are
-    those layers' sums (aluminium: the inner shell; Kevlar: the plies); the run draws
-    the fragment plot and not a plate's deflection profile."""
+    least every recorded one; there is an absorbed energy per layer (the next test checks
+    them against quantities.ply_energies) and the materials' energies are those layers'
+    sums (aluminium: the inner shell; the fabric section: the plies); the run draws the
+    fragment plot and not a plate's deflection profile, and writes casing and blade as
+    two VTU blocks."""
     from pathlib import Path
 
     from wovenimpact.containment import layer_energies, layer_materials

@@ -172,7 +172,8 @@ def mass_table(results: dict[str, dict]) -> list[str]:
              "Mass per unit area of the casing wall (every layer, the inner aluminium shell "
              "included; the thesis's Table 8-4 left the shell out).", "",
              "| casing | by runs | kg/m² | by regression | kg/m² |", "|---|---|---|---|---|"]
-    for (name, title, unit, _, _), res in zip(LADDERS, results.values()):
+    for name, title, unit, _, _ in LADDERS:
+        res = results[name]
         runs = res["fewest_contained"]
         reg = res["regression"]
         by_reg = reg.plies_to_stop if reg is not None else None

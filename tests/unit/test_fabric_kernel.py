@@ -331,6 +331,40 @@ def test_broken_family_stretched_past_the_limit_erodes_the_point(kevlar, fill_st
         assert out[L.S_DAMAGE] == 1.0 and out[L.S_DAMAGE + 1] == 1.0
 
 
+@pytest.mark.parametrize("broken", [0, 1])
+@pytest.mark.parametrize("crushed", [0, 1])
+@pytest.mark.parametrize("stretch, eroded", [(0.9, False), (0.51, False), (0.49, True)])
+def test_a_family_crushed_below_the_limit_erodes_a_broken_point(
+    kevlar, broken, crushed, stretch, eroded
+):
+    """With one family broken, a point crushed below erode_broken_crush (0.5 by default)
+    along either family is a sliver: slack intact yarns across broken ones, or intact
+    yarns bunched with nothing holding them apart. It erodes before its step collapses
+    (theory §1.4; the 8-ply 175 m/s blow-up of §4)."""
+    p = kevlar.to_array()
+    state = initial_state(kevlar)[0]
+    state[L.S_DAMAGE + broken] = 1.0
+    stretches = [1.01, 1.01]
+    stretches[crushed] = stretch
+    out = update_points(p, np.eye(2), np.diag(stretches), state).state[0]
+    assert (out[L.S_ALIVE] == 0.0) == eroded
+    if eroded:
+        assert out[L.S_DAMAGE] == 1.0 and out[L.S_DAMAGE + 1] == 1.0
+
+
+def test_crushing_an_intact_point_or_with_the_limit_off_does_not_erode():
+    """The crush limit is about broken families only; 0 switches it off."""
+    intact = reference_fabric(**EXACT)
+    out = update_points(intact.to_array(), np.eye(2), np.diag([0.3, 1.0]),
+                        initial_state(intact)[0]).state[0]
+    assert out[L.S_ALIVE] == 1.0
+    off = reference_fabric(erode_broken_crush=0.0, **EXACT)
+    state = initial_state(off)[0]
+    state[L.S_DAMAGE] = 1.0
+    out = update_points(off.to_array(), np.eye(2), np.diag([0.3, 1.0]), state).state[0]
+    assert out[L.S_ALIVE] == 1.0
+
+
 def test_both_yarns_broken_erodes_the_point(kevlar):
     p = kevlar.to_array()
     state = initial_state(kevlar)[0]

@@ -46,6 +46,7 @@ from wovenimpact.kernels.fabric_layout import (
     P_CROSSOVER,
     P_E,
     P_ELL0,
+    P_ERODE_CRUSH,
     P_ERODE_STRETCH,
     P_FAILURE,
     P_FRAME,
@@ -575,10 +576,15 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
     s_out[i, S_TENSION] = t_w
     s_out[i, S_TENSION + 1] = t_f
     s_out[i, S_ITER] = iters
-    # eroded (theory §1.4): both families broken, or a broken family stretched beyond
-    # P_ERODE_STRETCH (the element is a sliver held by nothing across the break)
+    # eroded (theory §1.4): both families broken, or one broken and the point a sliver:
+    # the broken family stretched beyond P_ERODE_STRETCH (held by nothing across the
+    # break), or either family crushed below P_ERODE_CRUSH (slack intact yarns, or intact
+    # yarns bunched with nothing holding them apart)
     lim = p[m, P_ERODE_STRETCH]
-    if lim > 0.0 and ((d_w >= 1.0 and lam_w > lim) or (d_f >= 1.0 and lam_f > lim)):
+    crush = p[m, P_ERODE_CRUSH]
+    if (lim > 0.0 and ((d_w >= 1.0 and lam_w > lim) or (d_f >= 1.0 and lam_f > lim))) or (
+        crush > 0.0 and (d_w >= 1.0 or d_f >= 1.0) and min(lam_w, lam_f) < crush
+    ):
         d_w = 1.0
         d_f = 1.0
         s_out[i, S_DAMAGE] = 1.0

@@ -61,6 +61,9 @@ class FabricOptions:
     # a point whose broken family is stretched beyond this erodes (0: only when both
     # families are broken); nothing holds the element together across broken yarns
     erode_broken_stretch: float = 2.0
+    # ... or either family crushed below this stretch (0: never): the point is then a
+    # sliver (slack intact yarns, or intact yarns bunched) whose step shrinks like λ
+    erode_broken_crush: float = 0.5
     # crossover evaluation (theory §1.9): "table" interpolates the tabulated stored
     # energy while both families are intact and inside the table (fibre frame only),
     # "exact" always runs the height solve (the reference)
@@ -191,6 +194,7 @@ class FabricParameters:
         ]
         p[L.P_AREAL_MASS] = self.areal_mass
         p[L.P_ERODE_STRETCH] = o.erode_broken_stretch
+        p[L.P_ERODE_CRUSH] = o.erode_broken_crush
         p[L.P_TAB_START] = L.N_PARAM
         if o.crossover == "table" and o.frame == "fibre":
             from wovenimpact.materials.fabric_table import with_table

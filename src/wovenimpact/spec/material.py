@@ -106,6 +106,8 @@ class OptionsSpec(BaseModel):
     softening_strain: quantity("dimensionless", gt=0, example="0.01") | None = None
     # erode a point once a broken yarn family is stretched past this (0: never)
     erode_broken_stretch: quantity("dimensionless", ge=0, example="2.0") = 2.0
+    # ... or, with a family broken, either family crushed below this (0: never; < 1)
+    erode_broken_crush: quantity("dimensionless", ge=0, lt=1, example="0.5") = 0.5
     # crossover evaluation (docs/theory.md §1.9): tabulated stored energy or exact solve
     crossover: Literal["table", "exact"] = FabricOptions.crossover
 
@@ -321,6 +323,7 @@ def _fabric_parameters(
         failure=o.failure,
         softening_strain=o.softening_strain if o.failure == "progressive" else 0.0,
         erode_broken_stretch=o.erode_broken_stretch,
+        erode_broken_crush=o.erode_broken_crush,
         crossover=o.crossover,
     )
     return FabricParameters(

@@ -65,7 +65,7 @@ from wovenimpact.containment import (
 from wovenimpact.provenance import changed_parts, digest_of, provenance, restart_parts
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.spec.case import load_case
-from wovenimpact.state import KINETIC0, State
+from wovenimpact.state import KINETIC0, MASS_SCALING, State
 
 HISTORY_COLUMNS = (
     "time_s", "step", "dt_s", "structure_kinetic_energy_part_J", "internal_work_part_J",
@@ -79,6 +79,7 @@ IMPACT_COLUMNS = ("impactor_velocity_m_per_s", "impactor_displacement_m", "conta
                   "impactor_nose_ahead_of_intact_m", "intact_material_ahead",
                   "impactor_kinetic_energy_part_J")
 METAL_COLUMNS = ("plastic_work_part_J",)  # models with a J2 (metal) section
+MASS_SCALING_COLUMNS = ("added_mass_part_kg", "mass_scaling_energy_part_J", "mass_scaled_elements")
 SUMMARY_VERSION = 3  # 2: issue 9's outcome rule and energy keys; 3: issue 12's energy
 #                     normalisation and provenance; older summaries are re-run
 DEFAULT_OUTPUTS = {"history": 1000, "field": 20, "checkpoint": 10}  # per run, if not given
@@ -99,9 +100,13 @@ def history_columns(model) -> tuple[str, ...]:
     ``contact_energy_part_J`` is −(work of the contact forces): the penalty springs' energy
     plus ``contact_dissipated_part_J``, what contact dashpots and friction dissipated.
     ``plastic_work_part_J`` (models with a metal section): the plastic work of the J2
-    points (metal_state.plastic_work), a part of the internal work."""
+    points (metal_state.plastic_work), a part of the internal work. With mass scaling
+    (``run.mass_scaling_fraction``): ``added_mass_part_kg``, ``mass_scaling_energy_part_J``
+    (the kinetic energy the added mass brought, an input of the balance) and
+    ``mass_scaled_elements``."""
     return (HISTORY_COLUMNS + (IMPACT_COLUMNS if model.body_params.shape[0] else ())
             + (METAL_COLUMNS if has_metal(model) else ())
+            + (MASS_SCALING_COLUMNS if model.mass_scaling_fraction > 0.0 else ())
             + (CONTAINMENT_COLUMNS if is_containment(model) else ()))
 
 
@@ -119,6 +124,8 @@ def history_row(model, state: State, normaliser: float = 0.0) -> dict:
         impact.update(fragment_row(model, state))
     if has_metal(model):
         impact["plastic_work_part_J"] = plastic_work(model, state)
+    if model.mass_scaling_fraction > 0.0:
+        impact.update(mass_scaling_row(state))
     return {
         **impact,
         "time_s": float(state.t), "step": int(state.step), "dt_s": float(state.dt),
@@ -136,6 +143,14 @@ def history_row(model, state: State, normaliser: float = 0.0) -> dict:
         "energy_normaliser_part_J": scale, "max_displacement_m": float(disp),
         "eroded_elements": int(np.sum(state.elem[:, S.E_ALIVE] == 0.0)),
     }
+
+
+def mass_scaling_row(state: State) -> dict:
+    """Mass added by mass scaling so far (modelled part), the kinetic energy it brought
+    and the number of elements that carry some."""
+    return {"added_mass_part_kg": float(np.sum(state.added_mass)),
+            "mass_scaling_energy_part_J": float(state.energy[MASS_SCALING]),
+            "mass_scaled_elements": int(np.count_nonzero(state.mass_ratio))}
 
 
 class Schedule:
@@ -421,6 +436,8 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
         "eroded_hourglass_energy_J": factor * eb["eroded_hourglass_J"],
         "eroded_kinetic_energy_J": factor * eb["eroded_kinetic_J"],
         **({"plastic_work_J": factor * plastic_work(model, state)} if has_metal(model) else {}),
+        **(mass_scaling_summary(model, state, factor) if model.mass_scaling_fraction > 0.0
+           else {}),
         # undefined (None, "n/a" on the page) while no positive internal work was done,
         # e.g. a spun blade that has only given back part of its pre-stress energy
         "hourglass_fraction": hg_all / w_int if w_int > 0.0 else None,
@@ -435,6 +452,16 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
         "symmetry_factor": factor,
         "max_displacement_m": float(np.sqrt(np.max(np.sum((state.x - model.x0) ** 2, axis=1)))),
     }
+
+
+def mass_scaling_summary(model, state: State, factor: float) -> dict:
+    """summary.json keys of a run with mass scaling: the added mass (whole problem), its
+    fraction of the model's mass, the kinetic energy it brought and the elements scaled."""
+    row = mass_scaling_row(state)
+    return {"added_mass_kg": factor * row["added_mass_part_kg"],
+            "added_mass_fraction": row["added_mass_part_kg"] / float(np.sum(model.node_mass)),
+            "mass_scaling_energy_J": factor * row["mass_scaling_energy_part_J"],
+            "mass_scaled_elements": row["mass_scaled_elements"]}
 
 
 IMPACT_SUMMARY_KEYS = ("outcome", "perforated", "residual_velocity_m_per_s",
@@ -457,6 +484,8 @@ COMMON_SUMMARY_KEYS = (
     "energy_tolerance", "energy_check", "symmetry_factor", "max_displacement_m",
     "restarted_from_step", "provenance", "finished_utc",
     "plastic_work_J",  # runs with a metal section only
+    # runs with mass scaling only
+    "added_mass_kg", "added_mass_fraction", "mass_scaling_energy_J", "mass_scaled_elements",
 )
 
 

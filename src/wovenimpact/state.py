@@ -28,10 +28,11 @@ CONTACT_WORK = 7  # work of the contact forces on nodes and bodies (−penalty e
 NODE_CONTACT_WORK = 8  # the part of W_EXT done by contact forces on the nodes
 CONTACT_PENALTY = 9  # energy of the contact springs at the last whole step; the rest
 #                      of −CONTACT_WORK was dissipated by contact dashpots and friction
-N_ENERGY = 10
+MASS_SCALING = 10  # kinetic energy added with the mass of mass scaling (an input)
+N_ENERGY = 11
 ENERGY_NAMES = ("internal_work", "external_work", "kinetic", "eroded_kinetic",
                 "eroded_internal", "initial_kinetic", "body_kinetic", "contact_work",
-                "node_contact_work", "contact_penalty")
+                "node_contact_work", "contact_penalty", "mass_scaling")
 
 
 @dataclass
@@ -54,6 +55,8 @@ class State:
         dt_first: the first stable step (s), reference of the Δt-collapse check.
         bodies: (n_bodies, N_BODY_STATE) rigid impactors (kernels.rigid_body layout).
         f_contact: (n_nodes, 3) contact forces on the nodes at x^n (for their work).
+        mass_ratio: (n_elems,) added-mass ratio r_e of mass scaling (kernels.mass_scaling).
+        added_mass: (n_nodes,) mass added to each node by mass scaling (kg).
     """
 
     t: float
@@ -71,6 +74,8 @@ class State:
     dt_first: float = 0.0
     bodies: np.ndarray = field(default_factory=lambda: np.zeros((0, RB.N_BODY_STATE)))
     f_contact: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    mass_ratio: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    added_mass: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def copy(self) -> State:
         return State(**{f.name: (getattr(self, f.name).copy() if isinstance(
@@ -132,7 +137,7 @@ def initial_state(model, velocity=None, angular_velocity=None) -> State:
     return State(t=0.0, step=0, dt=0.0, x=model.x0.copy(), v=v, omega=w, elem=elem, mat=mat,
                  f_int=np.zeros((n, 6)), f_ext=np.zeros((n, 6)),
                  node_active=np.ones(n, dtype=np.int8), energy=energy, bodies=bodies,
-                 f_contact=np.zeros((n, 3)))
+                 f_contact=np.zeros((n, 3)), mass_ratio=np.zeros(ne), added_mass=np.zeros(n))
 
 
 def rigid_rotation_velocity(x: np.ndarray, omega, centre=(0.0, 0.0, 0.0)) -> np.ndarray:

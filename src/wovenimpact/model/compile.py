@@ -390,6 +390,8 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         release_elems=mesh.elem_sets.get("blade.release") if spin is not None else None,
         release_time=spec.spin.release_time if spin is not None else math.inf,
         erode_inverted=spec.run.erode_inverted,
+        mass_scaling_fraction=spec.run.mass_scaling_fraction,
+        max_added_mass_fraction=spec.run.max_added_mass_fraction,
     )
     v = np.zeros((mesh.n_nodes, 3))
     w = np.zeros((mesh.n_nodes, 3))

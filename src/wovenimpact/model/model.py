@@ -314,6 +314,12 @@ class Model:
         release_elems, release_time: elements eroded at ``release_time`` (s) — the
             tie between a blade's hub part and its fragment (theory §8.2); none by default.
         section_names, material_names: labels for reports.
+        mass_scaling_fraction: elements whose step α L_e/c_e falls below this fraction
+            of the first step get mass so that it is that fraction again
+            (kernels.mass_scaling; 0: off).
+        max_added_mass_fraction: a run whose added mass exceeds this fraction of the
+            model's mass stops (mass scaling is then no longer a small perturbation).
+        elem_mass: (n_elems,) mass of each element, μ A0 (kg).
     """
 
     x0: np.ndarray
@@ -352,6 +358,9 @@ class Model:
     release_time: float = math.inf
     section_names: tuple = ()
     material_names: tuple = ()
+    mass_scaling_fraction: float = 0.0
+    max_added_mass_fraction: float = 0.02
+    elem_mass: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def n_nodes(self) -> int:
@@ -372,7 +381,8 @@ class Model:
             h.update(str(a.dtype).encode() + str(a.shape).encode())
             h.update(a.tobytes())
         h.update(repr((self.ramp_time, self.alpha, self.erode_dt_fraction,
-                       self.shell_contact, self.release_time, self.erode_inverted)).encode())
+                       self.shell_contact, self.release_time, self.erode_inverted,
+                       self.mass_scaling_fraction, self.max_added_mass_fraction)).encode())
         h.update(np.ascontiguousarray(self.release_elems).tobytes())
         return h.hexdigest()
 
@@ -493,6 +503,8 @@ def build_model(
     release_elems=None,
     release_time: float = math.inf,
     erode_inverted: bool = False,
+    mass_scaling_fraction: float = 0.0,
+    max_added_mass_fraction: float = 0.02,
 ) -> Model:
     """Assemble a :class:`Model` from a mesh, named sections and constraints.
 
@@ -512,6 +524,10 @@ def build_model(
         bodies: rigid impactors.
         shell_contact: shell–shell contact parameters (default ShellContactParams()).
         release_elems, release_time: elements eroded at that time (a blade's release).
+        mass_scaling_fraction: add mass to elements whose step falls below this fraction
+            of the first one, erode_dt_fraction < f < 1 (0: never, the default).
+        max_added_mass_fraction: stop once the added mass exceeds this fraction of the
+            model's mass, 0 < f ≤ 1; default 0.02.
     """
     x0 = np.ascontiguousarray(nodes, dtype=float)
     q = np.ascontiguousarray(quads, dtype=np.int64)
@@ -527,6 +543,16 @@ def build_model(
         )
     if not 0.0 < alpha <= 1.0:
         raise InputError(f"alpha = {alpha!r}: the stable-step factor must be in (0, 1]")
+    if mass_scaling_fraction != 0.0 and not erode_dt_fraction < mass_scaling_fraction < 1.0:
+        raise InputError(
+            f"mass_scaling_fraction = {mass_scaling_fraction!r}: valid 0 (off) or "
+            f"erode_dt_fraction ({erode_dt_fraction!r}) < f < 1 — below the erosion "
+            "fraction an element erodes before it would be scaled"
+        )
+    if not 0.0 < max_added_mass_fraction <= 1.0:
+        raise InputError(
+            f"max_added_mass_fraction = {max_added_mass_fraction!r}: valid 0 < f ≤ 1"
+        )
     names = list(sections)
     # materials: one table row per distinct material object
     mats: list = []
@@ -620,4 +646,6 @@ def build_model(
         release_elems=release_array(release_elems, len(q)), release_time=float(release_time),
         erode_inverted=bool(erode_inverted),
         section_names=tuple(names), material_names=tuple(getattr(m, "name", "") for m in mats),
+        mass_scaling_fraction=float(mass_scaling_fraction),
+        max_added_mass_fraction=float(max_added_mass_fraction), elem_mass=m_el,
     )

@@ -31,6 +31,7 @@ from wovenimpact.errors import SimulationError
 from wovenimpact.kernels import shell_layout as S
 from wovenimpact.kernels.gather import gather_nodal_forces
 from wovenimpact.kernels.integrate import force_pair_power, gather_and_update, smooth_step
+from wovenimpact.kernels.mass_scaling import node_masses, scale_element_masses, scaled_node_masses
 from wovenimpact.solver.contact_stage import ContactBuffers, advance_bodies, contact_forces
 from wovenimpact.kernels.shell import internal_force_for_shells
 from wovenimpact.state import (
@@ -42,6 +43,7 @@ from wovenimpact.state import (
     ERODED_KINETIC,
     KINETIC,
     KINETIC0,
+    MASS_SCALING,
     W_EXT,
     W_INT,
     State,
@@ -72,6 +74,9 @@ class Workspace:
     w_ext: np.ndarray
     ke: np.ndarray
     ke_eroded: np.ndarray
+    node_mass: np.ndarray  # nodal masses with those added by mass scaling (kg)
+    node_inertia: np.ndarray  # rotary inertias, scaled like the masses (kg m²)
+    added_ke: np.ndarray  # kinetic energy each node gained with added mass, last step (J)
     contact: object = None  # solver.contact_stage.ContactBuffers
     dt_min: float = math.inf  # min_e L_e/c_e of the last element stage
     n_eroded: int = 0  # elements eroded in the last element stage
@@ -88,6 +93,11 @@ class Workspace:
     @classmethod
     def for_model(cls, model, state: State) -> Workspace:
         n, ne = model.n_nodes, model.n_elems
+        if state.added_mass.shape != (n,):
+            state.added_mass = np.zeros(n)
+        if state.mass_ratio.shape != (ne,):
+            state.mass_ratio = np.zeros(ne)
+        mass, inertia = node_masses(model.node_mass, model.node_inertia, state.added_mass)
         return cls(
             elem=np.empty_like(state.elem), mat=np.empty_like(state.mat),
             blocks=np.zeros((ne, 4, 6)), status=np.zeros(ne, dtype=np.int32),
@@ -95,6 +105,7 @@ class Workspace:
             f_int=np.zeros((n, 6)),
             f_ext=np.zeros((n, 6)), live=np.zeros(n, dtype=np.int64), w_int=np.zeros(n),
             w_ext=np.zeros(n), ke=np.zeros(n), ke_eroded=np.zeros(n),
+            node_mass=mass, node_inertia=inertia, added_ke=np.zeros(n),
             contact=ContactBuffers.for_model(model),
         )
 
@@ -129,12 +140,41 @@ def element_forces(model, state: State, ws: Workspace) -> None:
     ws.tick("gather", t0)
 
 
+def scale_masses(model, state: State, ws: Workspace) -> None:
+    """Stage 3a, with ``run.mass_scaling_fraction`` f > 0: elements whose step α L_e/c_e
+    is below f Δt₁ get mass so that it is f Δt₁ (kernels.mass_scaling); the nodal masses,
+    the kinetic energy the added mass brings (booked as an input, ``MASS_SCALING``) and
+    ``ws.dt_min`` follow. Stops once the added mass passes ``max_added_mass_fraction``."""
+    if model.mass_scaling_fraction <= 0.0 or state.dt_first <= 0.0:
+        return
+    target = model.mass_scaling_fraction * state.dt_first / model.alpha
+    raised, ws.dt_min = scale_element_masses(ws.elem, S.E_DT, ws.alive, state.mass_ratio, target)
+    if not raised:
+        return
+    scaled_node_masses(model.node_ptr, model.node_elem, state.mass_ratio, model.elem_mass,
+                       model.node_mass, model.node_inertia, state.v, state.omega,
+                       state.added_mass, ws.node_mass, ws.node_inertia, ws.added_ke)
+    state.energy[MASS_SCALING] += float(np.sum(ws.added_ke))
+    added, total = float(np.sum(state.added_mass)), float(np.sum(model.node_mass))
+    if added > model.max_added_mass_fraction * total:
+        e = int(np.argmax(state.mass_ratio))
+        raise SimulationError(
+            f"mass scaling added {added:.4g} kg at t = {state.t:.6e} s, {added / total:.2%} of "
+            f"the model's {total:.4g} kg, above run.max_added_mass_fraction = "
+            f"{model.max_added_mass_fraction:g} (most scaled: element {e}, mass × "
+            f"{1.0 + state.mass_ratio[e]:.3g}): too many elements are crushed; refine the "
+            "mesh, lower run.mass_scaling_fraction or let them erode"
+        )
+
+
 def stable_step(model, state: State, ws: Workspace, dt_cap: float) -> float:
     """Stage 3: Δt = α min_e L_e/c_e (eq. 4.8), at most dt_cap; stops on collapse.
 
-    The minimum is the force kernel's (``ws.dt_min``); the governing element is
-    looked up only for an error message.
+    The minimum is the force kernel's (``ws.dt_min``), or with mass scaling that of the
+    scaled elements (:func:`scale_masses`); the governing element is looked up only for
+    an error message.
     """
+    scale_masses(model, state, ws)
     dt = min(model.alpha * ws.dt_min, dt_cap)
     if not math.isfinite(dt) or dt <= 0.0:
         dt_el = ws.elem[:, S.E_DT]
@@ -187,7 +227,7 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     amplitude = smooth_step(state.t + 0.5 * dt_new, model.ramp_time)
     n_bad = gather_and_update(
         model.node_ptr, model.node_elem, model.node_corner, ws.blocks, ws.alive,
-        model.node_mass, model.node_inertia, model.bc_code, model.bc_velocity, model.body_accel,
+        ws.node_mass, ws.node_inertia, model.bc_code, model.bc_velocity, model.body_accel,
         cb.f_con, amplitude, state.dt, dt_new, ws.f_int, state.f_int, state.f_ext,
         state.x, state.v, state.omega, state.node_active, ws.f_ext,
         ws.w_int, ws.w_ext, ws.ke, ws.ke_eroded,
@@ -317,9 +357,9 @@ def energy_balance(model, state: State) -> dict[str, float]:
     reaction = external - body
     contact = -en[CONTACT_WORK]
     kinetic = en[KINETIC] + en[BODY_KINETIC]
-    total = kinetic + en[W_INT] + en[ERODED_KINETIC] - external + contact
+    total = kinetic + en[W_INT] + en[ERODED_KINETIC] - external + contact - en[MASS_SCALING]
     drift = total - en[KINETIC0]
-    scale = max(en[KINETIC0], abs(external), abs(body), abs(reaction), 1e-300)
+    scale = max(en[KINETIC0], abs(external), abs(body), abs(reaction), en[MASS_SCALING], 1e-300)
     return {
         "kinetic_J": float(en[KINETIC]),
         "impactor_kinetic_J": float(en[BODY_KINETIC]),

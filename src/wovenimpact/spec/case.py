@@ -49,7 +49,8 @@ Schema (see README and examples/cases/)::
     [[initial_erosion]]  centre, radius, plies?: elements eroded at t = 0 (a hole: centroid
                       within radius of the axis through centre along cylinder_axis)
     [run]             end_time, field_interval, history_interval, checkpoint_interval,
-                      alpha, erode_dt_fraction, erode_inverted, threads, max_steps (the
+                      alpha, erode_dt_fraction, erode_inverted, mass_scaling_fraction,
+                      max_added_mass_fraction, threads, max_steps (the
                       predicted step count end_time/Δt₁ above which the run is refused;
                       5e6; docs/inputs.md)
 """
@@ -294,6 +295,11 @@ class RunSpec(BaseModel):
     erode_dt_fraction: quantity("dimensionless", ge=0, lt=1, example="0.05") = 0.05
     # an element crushed through itself is eroded (true) or stops the run (false)
     erode_inverted: bool = False
+    # selective mass scaling (docs/theory.md §4): elements whose step falls below this
+    # fraction of the first get mass so that it is that fraction again (0: off)
+    mass_scaling_fraction: quantity("dimensionless", ge=0, lt=1, example="0.3") = 0.0
+    # the run stops once the added mass exceeds this fraction of the model's mass
+    max_added_mass_fraction: quantity("dimensionless", gt=0, le=1, example="0.02") = 0.02
     threads: int | None = Field(default=None, ge=1)
     # largest energy-balance error fraction of a run that ends with exit 0 (runs.summarise;
     # docs/theory.md §5): 1 %, the report's verdict line; the shipped examples and study
@@ -301,6 +307,16 @@ class RunSpec(BaseModel):
     energy_tolerance: quantity("dimensionless", gt=0, le=1, example="0.01") = 0.01
     # the predicted step count end_time / Δt₁ above which a run is refused (model.sanity)
     max_steps: int = Field(default=DEFAULT_MAX_STEPS, ge=1)
+
+    @model_validator(mode="after")
+    def _scaling_above_erosion(self):
+        f, e = self.mass_scaling_fraction, self.erode_dt_fraction
+        if f != 0.0 and f <= e:
+            raise ValueError(
+                f"mass_scaling_fraction = {f:g} must be 0 (off) or above erode_dt_fraction "
+                f"= {e:g}: an element erodes before its step would reach the scaling target"
+            )
+        return self
 
 
 class ImpactorSpec(BaseModel):

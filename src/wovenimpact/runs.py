@@ -34,7 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
-from wovenimpact.errors import InputError, InputWarning
+from wovenimpact.errors import InputError, InputWarning, SimulationError
 from wovenimpact.io.atomic import atomic_write_text
 from wovenimpact.io.checkpoint import (
     checkpoint_meta,
@@ -269,7 +269,13 @@ def run_spec(
     while state.t < run.end_time:
         if max_steps is not None and taken >= max_steps:
             return {"interrupted_at_step": state.step, "time_s": state.t}
-        step(model, state, ws)
+        try:
+            step(model, state, ws)
+        except SimulationError:
+            # the history up to the failure is what explains it: write it (rows beyond
+            # the last checkpoint are dropped again by a restart, resume → keep_first)
+            history.write_csv(out / "history.csv")
+            raise
         taken += 1
         if h_sched.due(state.t) or state.t >= run.end_time:
             row = history_row(model, state, normaliser)

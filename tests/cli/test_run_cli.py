@@ -523,3 +523,31 @@ def test_a_reused_output_directory_is_cleared_of_an_earlier_runs_outputs(tmp_pat
     frames = sorted(p.name for p in (out / "fields").glob("*.vtu"))
     assert frames == [f"step_{k:06d}.vtu" for k in range(len(frames))]
     assert summary["steps"] > 0 and not (out / "plots" / "impactor.png").exists()
+
+
+def test_a_run_stopped_by_the_solver_keeps_its_history_up_to_the_stop(tmp_path, monkeypatch):
+    """A run that stops on a SimulationError (a collapse, too much added mass) writes the
+    history up to the step that failed, not only to its last checkpoint: that history is
+    what explains the stop. A restart still resumes from the checkpoint."""
+    import wovenimpact.runs as runs
+    from wovenimpact.errors import SimulationError
+
+    case = write_case(tmp_path, end="12 us")
+    out = tmp_path / "out"
+    real_step = runs.step
+
+    def failing_step(model, state, ws, *a, **k):
+        if state.t > 10e-6:  # past the 8 µs checkpoint
+            raise SimulationError("stopped on purpose")
+        real_step(model, state, ws, *a, **k)
+
+    monkeypatch.setattr(runs, "step", failing_step)
+    with pytest.raises(SimulationError, match="on purpose"):
+        run_case(case, out)
+    t = read_csv(out / "history.csv")["time_s"]
+    assert t[-1] > 10e-6 - 0.5e-6 and t[-1] <= 10e-6 + 1e-6  # rows to the stop, past 8 µs
+    monkeypatch.setattr(runs, "step", real_step)
+    whole = run_case(case, tmp_path / "whole")
+    resumed = run_case(case, out, restart=True)
+    assert resumed["restarted_from_step"] > 0 and resumed["steps"] == whole["steps"]
+    assert (out / "history.csv").read_text() == (tmp_path / "whole" / "history.csv").read_text()

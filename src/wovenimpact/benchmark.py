@@ -99,17 +99,15 @@ def measure(kind: str, n_elements: int, threads: int, steps: int = 20) -> dict:
 
 
 def array_bytes(*holders) -> int:
-    """Bytes of the NumPy arrays the objects hold as attributes, directly or in a tuple
-    (the bundles of kernels.bundles) (model, state and workspace of a run: what the step
-    reads and writes; a shared array counted once)."""
+    """Bytes of the NumPy arrays the objects hold as attributes (model, state and
+    workspace of a run: what the step reads and writes; a shared array counted once)."""
     seen: dict[int, int] = {}
     for h in holders:
         for value in vars(h).values():
-            for a in value if isinstance(value, tuple) else (value,):
-                if isinstance(a, np.ndarray):
-                    base = a if a.base is None else a.base
-                    if isinstance(base, np.ndarray):
-                        seen[id(base)] = base.nbytes
+            if isinstance(value, np.ndarray):
+                base = value if value.base is None else value.base
+                if isinstance(base, np.ndarray):
+                    seen[id(base)] = base.nbytes
     return sum(seen.values())
 
 

@@ -89,8 +89,8 @@ def update_node(
 ):
     """Central-difference update of node n (in place: x, v, omega, node_active; written:
     f_ext[n], w_int[n], w_ext[n], ke[n], ke_eroded[n]). ``live``: its live elements
-    (0 → the node is eroded now); dt_mid = ½(Δt^{n−1/2} + Δt^{n+1/2}). The arrays are
-    the fields of :func:`gather_and_update`'s bundles (``kernels.bundles``), unpacked.
+    (0 → the node is eroded now); dt_mid = ½(Δt^{n−1/2} + Δt^{n+1/2}). The arguments
+    are those of :func:`gather_and_update`.
     """
     # the sums accumulate in locals (stored once: the arrays may alias as far as the
     # compiler knows, so += on them goes through memory); same order as ever
@@ -169,57 +169,34 @@ def update_node(
 
 
 @loop_kernel
-def gather_and_update(nodes, elements, motion, forces, energy, amplitude, dt_old, dt_new):
-    """Gather the internal forces of every node and advance it by one step: for node a,
-    f_int,a = Σ blocks[e, c] over its (element, corner) pairs, then the central
-    difference v^{n+1/2} = v^{n−1/2} + Δt^n M⁻¹ (f_ext^n − f_int^n), x^{n+1} = x^n +
-    Δt^{n+1/2} v^{n+1/2} (eq. 4.4–4.7, module docstring) with the work and kinetic
-    energy terms.
+def gather_and_update(
+    node_ptr, node_elem, node_corner, blocks, alive,
+    mass, inertia, bc_code, bc_velocity, body_accel, f_con, amplitude, dt_old, dt_new,
+    f_int, f_int_old, f_ext_old, x, v, omega, node_active,
+    f_ext, w_int, w_ext, ke, ke_eroded,
+):
+    """Gather the internal forces of every node and advance it by one step.
 
     Args:
-        nodes: ``bundles.NodeArrays`` (Model): CSR map, masses, constraints, body forces.
-        elements: ``bundles.ElementOutput`` of this step's shell kernel: reads ``blocks``
-            (corner forces and moments at x^n) and ``alive``.
-        motion: ``bundles.NodeMotion``: x, v, omega, node_active advanced in place.
-        forces: ``bundles.NodeForces``: f_int, f_ext written at x^n (f_int gathered from
-            the blocks, f_ext body forces plus reactions); f_int_old, f_ext_old at
-            x^{n−1}; f_con the contact forces at x^n.
-        energy: ``bundles.NodeEnergy``, written: per-node internal and external work
-            over [x^{n−1}, x^n], kinetic energy at t^n (½ m v^{n−1/2} · v^{n+1/2}, see the
-            module docstring), and kinetic energy removed with nodes eroded this step.
+        node_ptr, node_elem, node_corner: CSR map (Model).
+        blocks: (n_elems, 4, 6) element corner forces and moments at x^n.
+        alive: (n_elems,) uint8, 1 for a live element (written by the force kernel).
+        mass, inertia, bc_code, bc_velocity, body_accel: Model arrays.
+        f_con: (n, 3) contact forces at x^n (external loads of the shells).
         amplitude: prescribed-velocity amplitude at t^{n+1/2}.
         dt_old, dt_new: Δt^{n−1/2}, Δt^{n+1/2}.
+        f_int: (n, 6) written: internal forces at x^n (gathered from blocks).
+        f_int_old, f_ext_old: internal and external forces at x^{n−1}.
+        x, v, omega, node_active: advanced in place.
+        (Kinetic energy of the node: ½ m v^{n−1/2} · v^{n+1/2}, see the module docstring.)
+        f_ext: (n, 6) written: body forces plus reactions at x^n.
+        w_int, w_ext, ke, ke_eroded: (n,) written: per-node internal and external
+            work increments over [x^{n−1}, x^n], kinetic energy at t^n, and kinetic
+            energy removed with nodes eroded this step.
 
     Returns:
         the number of nodes whose position x^{n+1} is not finite (0 when all is well).
     """
-    # The fields as locals before the parallel loop, so that the loop body sees plain
-    # arrays. One field per statement: Numba knows `a = bundle.a` aliases the argument,
-    # but not `a, b = bundle.a, bundle.b` (a tuple built and unpacked), and then drops
-    # the writes to an array the kernel does not read again as dead code (bundles.py).
-    node_ptr = nodes.node_ptr
-    node_elem = nodes.node_elem
-    node_corner = nodes.node_corner
-    mass = nodes.mass
-    inertia = nodes.inertia
-    bc_code = nodes.bc_code
-    bc_velocity = nodes.bc_velocity
-    body_accel = nodes.body_accel
-    blocks = elements.blocks
-    alive = elements.alive
-    x = motion.x
-    v = motion.v
-    omega = motion.omega
-    node_active = motion.node_active
-    f_int = forces.f_int
-    f_ext = forces.f_ext
-    f_int_old = forces.f_int_old
-    f_ext_old = forces.f_ext_old
-    f_con = forces.f_con
-    w_int = energy.w_int
-    w_ext = energy.w_ext
-    ke = energy.ke
-    ke_eroded = energy.ke_eroded
     nn = x.shape[0]
     dt_mid = 0.5 * (dt_old + dt_new)
     n_bad = 0

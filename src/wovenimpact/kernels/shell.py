@@ -673,63 +673,30 @@ def shell_force(
 
 
 @loop_kernel
-def internal_force_for_shells(shells, motion, states, out, dt, dt_erode, erode_inverted):
-    """``shell_force`` for every element (prange; each element writes its own rows): the
-    internal corner forces f_int,e at x^n of the corotational shell (module docstring,
-    theory §2), the element and material state at the end of the step, and the
-    element's stable step L_e/c_e (eq. 4.9–4.11).
+def internal_force_for_shells(
+    x, v, omega, dt, quads, elem_section, sections, mat_kind, mat_params, area0, ref_grad,
+    gauss_grad, gauss_weight, el_in, el_out, m_in, m_out, point_width, blocks, status,
+    eroded_now, alive, dt_erode, erode_inverted,
+):
+    """``shell_force`` for every element (prange; each element writes its own rows).
 
-    Args:
-        shells: ``bundles.ShellArrays`` (Model): connectivity, sections, materials,
-            reference geometry, point_width.
-        motion: ``bundles.NodeMotion``: reads x^n, v^{n−1/2}, ω^{n−1/2} (node_active
-            unused).
-        states: ``bundles.ElementStates``: element and material state in (start of the
-            step) and out (written; mat_*: (n_elems, width), an element's points' state
-            blocks of ``point_width`` values side by side).
-        out: ``bundles.ElementOutput``, written: blocks (n_elems, 4, 6); status and
-            eroded_now (n_elems,); alive (n_elems,) uint8, 1 for an element alive at the
-            end of the step (a compact copy of ``elem_out[:, E_ALIVE]`` for the node
-            kernels).
-        dt: Δt^{n−1/2}, the step the rates act over (0 at the start).
-        dt_erode: an element whose own stable step L_e/c_e falls below it is eroded
-            (crushed or collapsed elements, e.g. fabric with one yarn family broken;
-            0 disables).
-        erode_inverted: an element inverted (non-positive area or Jacobian) is eroded
-            instead of stopping the run.
+    Args: positions/velocities/spins (n_nodes, 3); dt; Model arrays; element and
+    material state in/out (m_in, m_out: (n_elems, width), an element's points' state
+    blocks of ``point_width`` values side by side); blocks (n_elems, 4, 6) written; status, eroded_now
+    (n_elems,) written; alive (n_elems,) uint8 written: 1 for an element alive at
+    the end of the step (a compact copy of ``el_out[:, E_ALIVE]`` for the node
+    kernels); dt_erode: an element whose own stable step L_e/c_e falls below it is
+    eroded (crushed or collapsed elements, e.g. fabric with one yarn family
+    broken; 0 disables); erode_inverted: an element inverted (non-positive area or
+    Jacobian) is eroded instead of stopping the run.
 
     Returns:
         (n_failed, n_eroded, dt_min): elements with a non-OK status, elements
         eroded this step (integer counts: exact, so the same for any thread count),
-        and min_e ``elem_out[e, E_DT]`` (inf if every element is eroded; a minimum is
+        and min_e ``el_out[e, E_DT]`` (inf if every element is eroded; a minimum is
         exact in any order, so also the same for any thread count; meaningful only
         when n_failed is 0).
     """
-    # The fields as locals before the parallel loop, so that the loop body sees plain
-    # arrays. One field per statement: Numba knows `a = bundle.a` aliases the argument,
-    # but not `a, b = bundle.a, bundle.b` (a tuple built and unpacked), and then drops
-    # the writes to an array the kernel does not read again as dead code (bundles.py).
-    quads = shells.quads
-    elem_section = shells.elem_section
-    sections = shells.sections
-    mat_kind = shells.mat_kind
-    mat_params = shells.mat_params
-    area0 = shells.area0
-    ref_grad = shells.ref_grad
-    gauss_grad = shells.gauss_grad
-    gauss_weight = shells.gauss_weight
-    point_width = shells.point_width
-    x = motion.x
-    v = motion.v
-    omega = motion.omega
-    el_in = states.elem_in
-    el_out = states.elem_out
-    m_in = states.mat_in
-    m_out = states.mat_out
-    blocks = out.blocks
-    status = out.status
-    eroded_now = out.eroded_now
-    alive = out.alive
     ne = quads.shape[0]
     n_failed = 0
     n_eroded = 0

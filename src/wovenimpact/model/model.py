@@ -13,7 +13,6 @@ from __future__ import annotations
 import hashlib
 import math
 from dataclasses import dataclass, field
-from functools import cached_property
 
 import numpy as np
 
@@ -22,7 +21,6 @@ from wovenimpact.impactor import BODY_PENALTY_SCALE, Impactor
 from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as SL
-from wovenimpact.kernels.bundles import NodeArrays, ShellArrays
 from wovenimpact.materials.fabric import FabricParameters
 from wovenimpact.materials.fabric import initial_state as fabric_initial_state
 from wovenimpact.materials.metal import MetalParameters, j2_parameter_row
@@ -362,27 +360,6 @@ class Model:
     @property
     def n_elems(self) -> int:
         return self.quads.shape[0]
-
-    @cached_property
-    def node_arrays(self) -> NodeArrays:
-        """The arrays the node update reads (``integrate.gather_and_update``), bundled
-        once: the same arrays as the attributes, not copies."""
-        return NodeArrays(
-            node_ptr=self.node_ptr, node_elem=self.node_elem, node_corner=self.node_corner,
-            mass=self.node_mass, inertia=self.node_inertia, bc_code=self.bc_code,
-            bc_velocity=self.bc_velocity, body_accel=self.body_accel,
-        )
-
-    @cached_property
-    def shell_arrays(self) -> ShellArrays:
-        """The arrays the shell force kernel reads (``shell.internal_force_for_shells``),
-        bundled once: the same arrays as the attributes, not copies."""
-        return ShellArrays(
-            quads=self.quads, elem_section=self.elem_section, sections=self.sections,
-            mat_kind=self.mat_kind, mat_params=self.mat_params, area0=self.area0,
-            ref_grad=self.ref_grad, gauss_grad=self.gauss_grad,
-            gauss_weight=self.gauss_weight, point_width=self.point_width,
-        )
 
     def digest(self) -> str:
         """SHA-256 of every array: a checkpoint is only resumed on the same Model."""

@@ -29,13 +29,6 @@ import numpy as np
 
 from wovenimpact.errors import SimulationError
 from wovenimpact.kernels import shell_layout as SL
-from wovenimpact.kernels.bundles import (
-    ElementOutput,
-    ElementStates,
-    NodeEnergy,
-    NodeForces,
-    NodeMotion,
-)
 from wovenimpact.kernels.gather import gather_nodal_forces
 from wovenimpact.kernels.integrate import force_pair_power, gather_and_update, smooth_step
 from wovenimpact.solver.contact_stage import ContactBuffers, advance_bodies, contact_forces
@@ -64,22 +57,21 @@ STATUS_TEXT = {
 
 @dataclass
 class Workspace:
-    """Preallocated scratch of one Model.
-
-    ``elem``, ``mat``, ``f_int``, ``f_ext`` are swapped with the State's arrays each step
-    (the end-of-step values become the State's). ``element_out`` (blocks, alive, status,
-    eroded_now: what the shell kernel writes besides the element state) and
-    ``node_energy`` (the node update's per-node work and kinetic energy) are bundles
-    (``kernels.bundles``) built once, passed to the kernels as they are.
-    """
+    """Preallocated scratch of one Model: swapped with the State's buffers each step."""
 
     elem: np.ndarray
     mat: np.ndarray
-    element_out: ElementOutput
+    blocks: np.ndarray
+    status: np.ndarray
+    eroded_now: np.ndarray
+    alive: np.ndarray
     f_int: np.ndarray
     f_ext: np.ndarray
     live: np.ndarray
-    node_energy: NodeEnergy
+    w_int: np.ndarray
+    w_ext: np.ndarray
+    ke: np.ndarray
+    ke_eroded: np.ndarray
     contact: object = None  # solver.contact_stage.ContactBuffers
     dt_min: float = math.inf  # min_e L_e/c_e of the last element stage
     n_eroded: int = 0  # elements eroded in the last element stage
@@ -98,43 +90,31 @@ class Workspace:
         n, ne = model.n_nodes, model.n_elems
         return cls(
             elem=np.empty_like(state.elem), mat=np.empty_like(state.mat),
-            element_out=ElementOutput(
-                blocks=np.zeros((ne, 4, 6)), alive=np.zeros(ne, dtype=np.uint8),
-                status=np.zeros(ne, dtype=np.int32), eroded_now=np.zeros(ne, dtype=np.int32),
-            ),
-            f_int=np.zeros((n, 6)), f_ext=np.zeros((n, 6)), live=np.zeros(n, dtype=np.int64),
-            node_energy=NodeEnergy(
-                w_int=np.zeros(n), w_ext=np.zeros(n), ke=np.zeros(n), ke_eroded=np.zeros(n),
-            ),
+            blocks=np.zeros((ne, 4, 6)), status=np.zeros(ne, dtype=np.int32),
+            eroded_now=np.zeros(ne, dtype=np.int32), alive=np.zeros(ne, dtype=np.uint8),
+            f_int=np.zeros((n, 6)),
+            f_ext=np.zeros((n, 6)), live=np.zeros(n, dtype=np.int64), w_int=np.zeros(n),
+            w_ext=np.zeros(n), ke=np.zeros(n), ke_eroded=np.zeros(n),
             contact=ContactBuffers.for_model(model),
         )
-
-
-def node_motion(state: State) -> NodeMotion:
-    """The State's nodal kinematics as the kernels take them (the State's own arrays;
-    assembled at each call, since a caller may give the State new ones)."""
-    return NodeMotion(x=state.x, v=state.v, omega=state.omega, node_active=state.node_active)
 
 
 def shell_forces(model, state: State, ws: Workspace) -> None:
     """Stage 1: element forces at x^n into ws (blocks, element and material state,
     alive bytes, dt_min, n_eroded); stops naming the first failed element."""
     n_failed, ws.n_eroded, ws.dt_min = internal_force_for_shells(
-        model.shell_arrays,
-        node_motion(state),
-        ElementStates(elem_in=state.elem, elem_out=ws.elem, mat_in=state.mat, mat_out=ws.mat),
-        ws.element_out,
-        dt=state.dt,
-        dt_erode=model.erode_dt_fraction * state.dt_first / model.alpha,
-        erode_inverted=model.erode_inverted,
+        state.x, state.v, state.omega, state.dt, model.quads, model.elem_section,
+        model.sections, model.mat_kind, model.mat_params, model.area0, model.ref_grad,
+        model.gauss_grad, model.gauss_weight, state.elem, ws.elem, state.mat, ws.mat,
+        model.point_width, ws.blocks, ws.status, ws.eroded_now, ws.alive,
+        model.erode_dt_fraction * state.dt_first / model.alpha, model.erode_inverted,
     )
     if n_failed:
-        status = ws.element_out.status
-        bad = np.flatnonzero(status)
+        bad = np.flatnonzero(ws.status)
         e = int(bad[0])
         raise SimulationError(
             f"element {e} (nodes {model.quads[e].tolist()}) at t = {state.t:.6e} s, step "
-            f"{state.step}: {STATUS_TEXT.get(int(status[e]), 'unknown failure')}"
+            f"{state.step}: {STATUS_TEXT.get(int(ws.status[e]), 'unknown failure')}"
             + (f"; {bad.size} elements in this state" if bad.size > 1 else "")
         )
 
@@ -144,9 +124,8 @@ def element_forces(model, state: State, ws: Workspace) -> None:
     t0 = time.perf_counter()
     shell_forces(model, state, ws)
     t0 = ws.tick("shell forces", t0)
-    out = ws.element_out
-    gather_nodal_forces(model.node_ptr, model.node_elem, model.node_corner, out.blocks,
-                        out.alive, ws.f_int, ws.live)
+    gather_nodal_forces(model.node_ptr, model.node_elem, model.node_corner, ws.blocks, ws.alive,
+                        ws.f_int, ws.live)
     ws.tick("gather", t0)
 
 
@@ -199,7 +178,7 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     dt_new = stable_step(model, state, ws, dt_cap)
     t0 = ws.tick("stable step", t0)
     cb = ws.contact
-    resultants = contact_forces(model, state, cb, dt_new, ws.element_out.alive, ws.n_eroded)
+    resultants = contact_forces(model, state, cb, dt_new, ws.alive, ws.n_eroded)
     # work of the contact forces on the nodes over [x^{n−1}, x^n] (trapezoid), before
     # the velocities move on
     w_con_nodes = 0.0
@@ -208,15 +187,11 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     t0 = ws.tick("contact", t0)
     amplitude = smooth_step(state.t + 0.5 * dt_new, model.ramp_time)
     n_bad = gather_and_update(
-        model.node_arrays,
-        ws.element_out,
-        node_motion(state),
-        NodeForces(f_int=ws.f_int, f_ext=ws.f_ext, f_int_old=state.f_int,
-                   f_ext_old=state.f_ext, f_con=cb.f_con),
-        ws.node_energy,
-        amplitude=amplitude,
-        dt_old=state.dt,
-        dt_new=dt_new,
+        model.node_ptr, model.node_elem, model.node_corner, ws.blocks, ws.alive,
+        model.node_mass, model.node_inertia, model.bc_code, model.bc_velocity, model.body_accel,
+        cb.f_con, amplitude, state.dt, dt_new, ws.f_int, state.f_int, state.f_ext,
+        state.x, state.v, state.omega, state.node_active, ws.f_ext,
+        ws.w_int, ws.w_ext, ws.ke, ws.ke_eroded,
     )
     t0 = ws.tick("gather + integrate", t0)
     if n_bad:
@@ -231,16 +206,15 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     en[CONTACT_WORK] += w_con_nodes + w_con_bodies
     en[NODE_CONTACT_WORK] += w_con_nodes
     en[CONTACT_PENALTY] = cb.penalty_energy
-    node_en = ws.node_energy
-    en[W_INT] += float(np.sum(node_en.w_int))
-    en[W_EXT] += float(np.sum(node_en.w_ext))
-    en[KINETIC] = float(np.sum(node_en.ke))
-    en[ERODED_KINETIC] += float(np.sum(node_en.ke_eroded))
+    en[W_INT] += float(np.sum(ws.w_int))
+    en[W_EXT] += float(np.sum(ws.w_ext))
+    en[KINETIC] = float(np.sum(ws.ke))
+    en[ERODED_KINETIC] += float(np.sum(ws.ke_eroded))
     if ws.n_eroded:
         # booked once: the energies an element holds at its erosion (ws.elem, the state it
         # keeps frozen from now on), which energy_balance no longer counts as stored or
         # hourglass energy
-        gone = ws.element_out.eroded_now != 0
+        gone = ws.eroded_now != 0
         en[ERODED_INTERNAL] += float(np.sum(
             ws.elem[gone, SL.E_U_MEMB] + ws.elem[gone, SL.E_U_BEND] + ws.elem[gone, SL.E_U_HG]
         ))

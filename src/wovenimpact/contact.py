@@ -12,7 +12,7 @@ import math
 import numpy as np
 
 from wovenimpact.errors import InputError
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.kernels.contact_broad import (
     bucket_count,
     candidates_still_valid,
@@ -161,7 +161,7 @@ class ShellContact:
         self.node_mass = np.ascontiguousarray(model.node_mass, dtype=float)
         self.node_ptr = np.ascontiguousarray(model.node_ptr, dtype=np.int64)
         self.node_elem = np.ascontiguousarray(model.node_elem, dtype=np.int64)
-        self.h_seg = 0.5 * model.sections[model.elem_section, S.C_THICK].astype(float)
+        self.h_seg = 0.5 * model.sections[model.elem_section, SL.C_THICK].astype(float)
         self.h_node = np.zeros(nn)
         on = part != 0
         for c in range(4):

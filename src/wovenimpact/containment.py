@@ -13,7 +13,7 @@ import math
 
 import numpy as np
 
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.quantities import held_energy
 
 FRAGMENT = "blade.fragment"
@@ -62,7 +62,7 @@ def fragment_row(model, state) -> dict:
                      size / r_casing)
     half_z = max(WINDOW * float(np.max(np.abs(x[:, 2] - cm[2]))), size)
     live = np.zeros(model.n_nodes, dtype=bool)
-    live[model.quads[state.elem[:, S.E_ALIVE] != 0.0].ravel()] = True
+    live[model.quads[state.elem[:, SL.E_ALIVE] != 0.0].ravel()] = True
     casing = casing[live[casing]]
     xc = state.x[casing]
     near = (np.abs(np.angle(np.exp(1j * (np.arctan2(xc[:, 1], xc[:, 0]) - phi_cm))))
@@ -121,7 +121,7 @@ def layer_materials(model) -> list[str]:
     out = []
     for elems in layer_elements(model):
         sec = int(np.bincount(model.elem_section[elems]).argmax()) if elems.size else 0
-        name = model.material_names[int(model.sections[sec, S.C_MAT])]
+        name = model.material_names[int(model.sections[sec, SL.C_MAT])]
         out.append(name or model.section_names[sec])
     return out
 
@@ -171,7 +171,7 @@ def casing_summary(model, state, h: dict) -> dict:
     outcome = containment_outcome(h, inner)
     casing_elems = np.flatnonzero(np.isin(model.quads, np.concatenate(
         [model.node_sets[s] for s in layers])).all(axis=1))
-    mass = float(np.sum(model.sections[model.elem_section[casing_elems], S.C_AREAL_MASS]
+    mass = float(np.sum(model.sections[model.elem_section[casing_elems], SL.C_AREAL_MASS]
                         * model.area0[casing_elems]))
     area = float(model.area0[casing_elems].sum())
     bulge = np.asarray(h.get("outer_layer_bulge_m", ()), dtype=float)

@@ -24,12 +24,12 @@ from __future__ import annotations
 import numpy as np
 
 from wovenimpact.kernels import j2_layout as J
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 
 
 def has_metal(model) -> bool:
     """The model has a J2 (plastic metal) material."""
-    return bool(np.any(model.mat_kind == S.MAT_J2))
+    return bool(np.any(model.mat_kind == SL.MAT_J2))
 
 
 def simpson_weights(n_pts: int) -> np.ndarray:
@@ -47,12 +47,12 @@ def _j2_point_values(model, state, column: int):
     width = model.point_width
     for sec in range(model.sections.shape[0]):
         row = model.sections[sec]
-        if model.mat_kind[int(row[S.C_MAT])] != S.MAT_J2:
+        if model.mat_kind[int(row[SL.C_MAT])] != SL.MAT_J2:
             continue
         elems = np.flatnonzero(model.elem_section == sec)
         if elems.size == 0:
             continue
-        n_pts, n_in = int(row[S.C_POINTS]), int(row[S.C_INPLANE])
+        n_pts, n_in = int(row[SL.C_POINTS]), int(row[SL.C_INPLANE])
         blocks = state.mat[elems, : n_in * n_pts * width].reshape(len(elems), n_in, n_pts, width)
         if n_in == 4:
             w_in = model.gauss_weight[elems]

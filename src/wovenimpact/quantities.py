@@ -14,7 +14,7 @@ import numpy as np
 
 from wovenimpact.errors import InputError
 from wovenimpact.kernels import rigid_body as RB
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 
 QUIET_TIME = 10e-6  # contact must have been light this long to call a perforation
 LIGHT_CONTACT = 0.01  # "light": below this fraction of the peak contact force
@@ -77,7 +77,7 @@ def attached_nodes(model, state) -> np.ndarray:
 
     The components are recomputed only when the set of live elements changes (one
     entry is kept: the model, held by a weak reference, and its alive flags)."""
-    alive = state.elem[:, S.E_ALIVE] != 0.0
+    alive = state.elem[:, SL.E_ALIVE] != 0.0
     ref = _ATTACHED_CACHE.get("model")
     if (ref is not None and ref() is model
             and np.array_equal(_ATTACHED_CACHE["alive"], alive)):
@@ -214,8 +214,8 @@ def held_energy(model, state, elems) -> float:
     eroded element's as it held it at erosion)."""
     nodes = np.unique(model.quads[elems])
     ke = 0.5 * float(np.sum(model.node_mass[nodes] * np.sum(state.v[nodes] ** 2, axis=1)))
-    return ke + float(np.sum(state.elem[elems, S.E_U_MEMB] + state.elem[elems, S.E_U_BEND]
-                             + state.elem[elems, S.E_U_HG]))
+    return ke + float(np.sum(state.elem[elems, SL.E_U_MEMB] + state.elem[elems, SL.E_U_BEND]
+                             + state.elem[elems, SL.E_U_HG]))
 
 
 def ply_deflections(model, state) -> list[float]:

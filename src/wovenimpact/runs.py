@@ -45,7 +45,7 @@ from wovenimpact.io.checkpoint import (
 from wovenimpact.io.fields import FieldWriter
 from wovenimpact.io.history import History
 from wovenimpact.io.report import write_run_report
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.metal_state import has_metal, plastic_work
 from wovenimpact.model.compile import CompiledCase, compile_case
 from wovenimpact.quantities import (
@@ -141,7 +141,7 @@ def history_row(model, state: State, normaliser: float = 0.0) -> dict:
         "reaction_work_part_J": eb["reaction_work_J"], "energy_drift_part_J": eb["drift_J"],
         "energy_error_fraction": abs(eb["drift_J"]) / scale,
         "energy_normaliser_part_J": scale, "max_displacement_m": float(disp),
-        "eroded_elements": int(np.sum(state.elem[:, S.E_ALIVE] == 0.0)),
+        "eroded_elements": int(np.sum(state.elem[:, SL.E_ALIVE] == 0.0)),
     }
 
 
@@ -451,7 +451,7 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
         "body_force_work_J": factor * eb["body_force_work_J"],
         "reaction_work_J": factor * eb["reaction_work_J"],
         "contact_energy_J": factor * eb["contact_energy_J"],
-        "eroded_elements": int(np.sum(state.elem[:, S.E_ALIVE] == 0.0)),
+        "eroded_elements": int(np.sum(state.elem[:, SL.E_ALIVE] == 0.0)),
         "energy_error_fraction": error,
         "energy_tolerance": spec.run.energy_tolerance,
         "energy_check": "pass" if error <= spec.run.energy_tolerance else "fail",

@@ -14,7 +14,7 @@ from dataclasses import dataclass, field, fields
 import numpy as np
 
 from wovenimpact.kernels import rigid_body as RB
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 
 # indices of State.energy (J)
 W_INT = 0  # work of the internal forces (membrane, bending, shear, hourglass)
@@ -116,11 +116,11 @@ def initial_state(model, velocity=None, angular_velocity=None) -> State:
         np.asarray(velocity, dtype=float), (n, 3)).copy()
     w = np.zeros((n, 3)) if angular_velocity is None else np.broadcast_to(
         np.asarray(angular_velocity, dtype=float), (n, 3)).copy()
-    elem = np.zeros((ne, S.N_ELEM_STATE))
-    for col in (S.E_F, *range(S.E_FG, S.E_FG + 16, 4)):  # F = I at the centre and Gauss points
+    elem = np.zeros((ne, SL.N_ELEM_STATE))
+    for col in (SL.E_F, *range(SL.E_FG, SL.E_FG + 16, 4)):  # F = I at the centre and Gauss points
         elem[:, col] = 1.0
         elem[:, col + 3] = 1.0
-    elem[:, S.E_ALIVE] = 1.0
+    elem[:, SL.E_ALIVE] = 1.0
     mat = model.section_state0[model.elem_section].copy()
     energy = np.zeros(N_ENERGY)
     ke = 0.5 * (np.sum(model.node_mass[:, None] * v * v) + np.sum(model.node_inertia[:, None] * w * w))

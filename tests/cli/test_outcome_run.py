@@ -43,7 +43,7 @@ def test_a_plug_torn_free_is_not_intact_material(tmp_path):
     1 mm ahead of the nose. The plug is not intact material (nothing attaches it to the
     clamped edge); the ply outside the ring is, once moved ahead of the nose too."""
     from tests.cli.test_run_cli import CASE, IMPACTOR, write_case
-    from wovenimpact.kernels import shell_layout as S
+    from wovenimpact.kernels import shell_layout as SL
     from wovenimpact.model.compile import compile_case
     from wovenimpact.quantities import attached_nodes, intact_material_ahead
     from wovenimpact.spec.case import load_case
@@ -55,7 +55,7 @@ def test_a_plug_torn_free_is_not_intact_material(tmp_path):
     assert intact_material_ahead(model, state)["intact_material_ahead"] == 1  # before
     centre = model.x0[model.quads].mean(axis=1)
     r = np.hypot(centre[:, 0], centre[:, 1])
-    state.elem[(r > 1e-3) & (r < 2.2e-3), S.E_ALIVE] = 0.0
+    state.elem[(r > 1e-3) & (r < 2.2e-3), SL.E_ALIVE] = 0.0
     plug = np.unique(model.quads[r <= 1e-3])
     rest = np.setdiff1d(np.unique(model.quads[r >= 2.2e-3]), plug)
     state.x[:, 2] -= 1.5e-3  # the whole ply below the nose (0.4 mm above it at t = 0)

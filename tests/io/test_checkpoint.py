@@ -9,7 +9,7 @@ import pytest
 
 from wovenimpact.errors import InputError
 from wovenimpact.io.checkpoint import latest_checkpoint, load_checkpoint, save_checkpoint
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.state import N_ENERGY, State
 
 DIGEST = "a" * 64
@@ -20,7 +20,7 @@ def make_state(step: int = 7, seed: int = 0, n: int = 5, ne: int = 3) -> State:
     return State(
         t=1.25e-6 * step + 1e-17, step=step, dt=np.nextafter(1e-7, 1.0),
         x=rng.standard_normal((n, 3)), v=rng.standard_normal((n, 3)),
-        omega=rng.standard_normal((n, 3)), elem=rng.standard_normal((ne, S.N_ELEM_STATE)),
+        omega=rng.standard_normal((n, 3)), elem=rng.standard_normal((ne, SL.N_ELEM_STATE)),
         mat=np.array([[np.nan, -0.0, np.inf]] * ne), f_int=rng.standard_normal((n, 6)),
         f_ext=rng.standard_normal((n, 6)), node_active=np.array([1, 0, 1, 1, 1], np.int8),
         energy=rng.standard_normal(N_ENERGY),

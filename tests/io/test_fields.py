@@ -12,7 +12,7 @@ from wovenimpact.errors import InputError
 from wovenimpact.io.fields import PVD_NAME, FieldWriter, cell_blocks, read_pvd
 from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels import j2_layout as J
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.materials.metal import MetalParameters
 from wovenimpact.model import Section, build_model
 from wovenimpact.model.mesh import plate_mesh
@@ -34,8 +34,8 @@ def moved(model, k: int):
     s.t, s.step = k * 1e-6, 10 * k
     s.x = model.x0 + 1e-4 * rng.standard_normal(model.x0.shape)
     s.v = rng.standard_normal(model.x0.shape)
-    s.elem[:, S.E_N:S.E_N + 3] = rng.standard_normal((model.n_elems, 3))
-    s.elem[k % model.n_elems, S.E_ALIVE] = 0.0
+    s.elem[:, SL.E_N:SL.E_N + 3] = rng.standard_normal((model.n_elems, 3))
+    s.elem[k % model.n_elems, SL.E_ALIVE] = 0.0
     return s
 
 
@@ -58,8 +58,8 @@ def test_three_frames_read_back(tmp_path, model):
         assert np.array_equal(m.point_data["displacement"], s.x - model.x0)
         assert np.array_equal(m.point_data["velocity"], s.v)
         cd = {k: v[0] for k, v in m.cell_data.items()}
-        assert np.array_equal(cd["membrane_resultant"], s.elem[:, S.E_N:S.E_N + 3])
-        assert np.array_equal(cd["alive"], s.elem[:, S.E_ALIVE])
+        assert np.array_equal(cd["membrane_resultant"], s.elem[:, SL.E_N:SL.E_N + 3])
+        assert np.array_equal(cd["alive"], s.elem[:, SL.E_ALIVE])
         assert np.array_equal(cd["ply"], model.ply)
         for name in ("tension_warp", "tension_fill", "damage_warp", "damage_fill"):
             assert np.all(cd[name] == 0.0), name  # steel: not a fabric
@@ -169,7 +169,7 @@ def test_triangles_go_to_their_own_block(tmp_path):
         ("quad", [0], [[0, 1, 2, 3]]), ("triangle", [1], [[3, 2, 4]])]
     tm = build_model(nodes, quads, {"p": Section(material=STEEL, thickness=1e-3)}, [0, 0])
     s = initial_state(tm)
-    s.elem[1, S.E_N] = 9.0
+    s.elem[1, SL.E_N] = 9.0
     m = meshio.read(FieldWriter(tmp_path, tm).write(s))
     assert [b.type for b in m.cells] == ["quad", "triangle"]
     assert m.cell_data["element"][1].tolist() == [1]

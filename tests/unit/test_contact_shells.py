@@ -10,7 +10,7 @@ from hypothesis import strategies as st
 
 from wovenimpact.contact import ShellContact
 from wovenimpact.jit import set_threads
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.kernels.contact_broad import bucket_count, find_candidates
 from wovenimpact.materials.metal import MetalParameters
 from wovenimpact.model import Section, build_model
@@ -244,13 +244,13 @@ def test_eroded_segments_and_inactive_nodes_give_no_force():
     mesh, model = plies_model(spacing=t - delta, thickness=t)
     contact = ShellContact(model, remove_initial_overlap=False)
     state = initial_state(model)
-    f, _, n = contact_forces(contact, model, state.x, alive=state.elem[:, S.E_ALIVE],
+    f, _, n = contact_forces(contact, model, state.x, alive=state.elem[:, SL.E_ALIVE],
                              active=state.node_active)
     assert n > 0
     # erode ply 0: its elements leave the surface and its nodes become inactive
-    state.elem[mesh.elem_sets["ply0"], S.E_ALIVE] = 0.0
+    state.elem[mesh.elem_sets["ply0"], SL.E_ALIVE] = 0.0
     state.node_active[mesh.node_sets["ply0"]] = 0
-    f, energy, n = contact_forces(contact, model, state.x, alive=state.elem[:, S.E_ALIVE],
+    f, energy, n = contact_forces(contact, model, state.x, alive=state.elem[:, SL.E_ALIVE],
                                   active=state.node_active)
     assert n == 0 and energy == 0.0 and not f.any()
 

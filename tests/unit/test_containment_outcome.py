@@ -138,7 +138,7 @@ def test_layer_energies_are_the_generated_plies_energies():
     from pathlib import Path
 
     from wovenimpact.containment import layer_energies, layer_materials
-    from wovenimpact.kernels import shell_layout as S
+    from wovenimpact.kernels import shell_layout as SL
     from wovenimpact.model.compile import compile_case
     from wovenimpact.quantities import ply_energies
     from wovenimpact.spec.case import case_from_dict
@@ -152,7 +152,7 @@ def test_layer_energies_are_the_generated_plies_energies():
     model, state = compiled.model, compiled.state
     rng = np.random.default_rng(7)
     state.v[:] = rng.normal(0.0, 30.0, state.v.shape)
-    for col in (S.E_U_MEMB, S.E_U_BEND, S.E_U_HG):
+    for col in (SL.E_U_MEMB, SL.E_U_BEND, SL.E_U_HG):
         state.elem[:, col] = rng.uniform(0.0, 1e-3, model.n_elems)
     assert layer_energies(model, state) == pytest.approx(ply_energies(model, state)[:3],
                                                          rel=1e-12)

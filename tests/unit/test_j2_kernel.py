@@ -53,7 +53,7 @@ def rot(theta: float) -> np.ndarray:
 
 
 def tau_eq(state: np.ndarray) -> float:
-    t11, t22, t12 = state[L.S_TAU : L.S_TAU + 3]
+    t11, t22, t12 = state[L.S_KIRCHHOFF : L.S_KIRCHHOFF + 3]
     return math.sqrt(t11 * t11 - t11 * t22 + t22 * t22 + 3.0 * t12 * t12)
 
 
@@ -87,7 +87,8 @@ def kernel_work_oracle(path, states, thick=T0):
         uo, un = polar_oracle(path[k - 1]), polar_oracle(path[k])
         lm = (un - uo) @ np.linalg.inv(0.5 * (uo + un))
         d = 0.5 * (lm + lm.T)
-        to, tn = states[k - 1, L.S_TAU : L.S_TAU + 3], states[k, L.S_TAU : L.S_TAU + 3]
+        tau = slice(L.S_KIRCHHOFF, L.S_KIRCHHOFF + 3)
+        to, tn = states[k - 1, tau], states[k, tau]
         ts = to + tn
         w[k] = w[k - 1] + 0.5 * thick * (ts[0] * d[0, 0] + ts[1] * d[1, 1] + 2.0 * ts[2] * d[0, 1])
     return w
@@ -137,7 +138,7 @@ def test_fracture_within_the_step_that_crosses_the_fracture_strain():
         pytest.fail("no fracture")
     assert prev < params.fracture_strain <= st_new[L.S_EPS_P]
     assert np.all(upd.resultant == 0.0)
-    assert np.all(st_new[L.S_TAU : L.S_TAU + 3] == 0.0) and st_new[L.S_ENERGY] == 0.0
+    assert np.all(st_new[L.S_KIRCHHOFF : L.S_KIRCHHOFF + 3] == 0.0) and st_new[L.S_ENERGY] == 0.0
     # the elastic energy it held is booked as released, not lost
     assert st_new[L.S_FAIL_ENERGY] > 0.0
     # and it stays failed: no stress for any further deformation
@@ -155,15 +156,15 @@ def test_unload_slope_is_E(name):
         drv.accept(k / 40, *drv.trial(k / 40))
     eps_p = drv.state[L.S_EPS_P]
     assert eps_p > 0.05
-    t_before, f_before = drv.state[L.S_TAU], drv.f.copy()
+    t_before, f_before = drv.state[L.S_KIRCHHOFF], drv.f.copy()
     for s in (0.999, 0.998, 0.997):
         drv.accept(s, *drv.trial(s))
         # uniaxial plane-stress elastic unloading: Δτ_xx = E Δd_xx, Δd_xx = 2(b − a)/(a + b)
         a, b = f_before[0, 0], drv.f[0, 0]
-        slope = (drv.state[L.S_TAU] - t_before) / (2.0 * (b - a) / (a + b))
+        slope = (drv.state[L.S_KIRCHHOFF] - t_before) / (2.0 * (b - a) / (a + b))
         assert slope == pytest.approx(params.modulus, rel=1e-9)
         assert drv.state[L.S_EPS_P] == eps_p  # no plastic flow on unloading
-        t_before, f_before = drv.state[L.S_TAU], drv.f.copy()
+        t_before, f_before = drv.state[L.S_KIRCHHOFF], drv.f.copy()
 
 
 # --- energy ----------------------------------------------------------------------------
@@ -201,7 +202,8 @@ def test_retraced_elastic_cycle_returns_stress_and_energy_to_zero(name):
     scale = np.max(states[:, L.S_ENERGY])
     assert scale > 0.0 and np.all(states[:, L.S_EPS_P] == 0.0)
     assert abs(states[-1, L.S_ENERGY]) <= ROUND_OFF * scale
-    assert np.all(np.abs(states[-1, L.S_TAU : L.S_TAU + 3]) <= 1e-9 * params.hardening[0][1])
+    tau = states[-1, L.S_KIRCHHOFF : L.S_KIRCHHOFF + 3]
+    assert np.all(np.abs(tau) <= 1e-9 * params.hardening[0][1])
     assert np.all(states[:, L.S_PLASTIC_WORK] == 0.0)
     w = piola_work(path, res)
     assert abs(w[-1]) <= 1e-9 * np.max(np.abs(w))
@@ -276,7 +278,7 @@ def test_simple_shear_to_large_strain():
 # --- objectivity -------------------------------------------------------------------------
 
 
-INVARIANTS = (L.S_EPS_P, L.S_PLASTIC_WORK, L.S_ENERGY, L.S_THICK, L.S_DAMAGE, L.S_YIELD)
+INVARIANTS = (L.S_EPS_P, L.S_PLASTIC_WORK, L.S_ENERGY, L.S_THICK, L.S_JC_DAMAGE, L.S_YIELD)
 
 
 @pytest.mark.parametrize("name", ["aluminium", "ti6al4v_johnson_cook"])
@@ -327,7 +329,7 @@ def test_rate_factor_against_the_hand_written_pure_shear_equation(dt):
     a0, a1, a2 = 1.0, 1.004, 1.008
     path = np.array([np.diag([a, 1.0 / a]) for a in (a0, a1, a2)])
     states, _ = drive(params, path, dt=dt)
-    tau_old = states[1, L.S_TAU]
+    tau_old = states[1, L.S_KIRCHHOFF]
     dd = 2.0 * (a2 - a1) / (a2 + a1)
 
     def eq(x):
@@ -413,7 +415,7 @@ def test_random_increments_never_exceed_the_yield_surface(name, increments):
         if params.rate is None:  # rate-independent: σ_y never falls, so ΔW_p ≥ 0 (theory)
             assert new[L.S_PLASTIC_WORK] >= state[L.S_PLASTIC_WORK]
         assert new[L.S_EPS_P] >= state[L.S_EPS_P]
-        assert new[L.S_DAMAGE] >= state[L.S_DAMAGE]
+        assert new[L.S_JC_DAMAGE] >= state[L.S_JC_DAMAGE]
         state, f = new, f_new
 
 
@@ -474,10 +476,11 @@ def test_layout_shares_columns_with_the_elastic_row_and_the_fabric_state():
     from wovenimpact.kernels import fabric_layout as FL
     from wovenimpact.kernels import shell_layout as SL
 
-    assert (L.P_E, L.P_NU, L.P_RHO) == (SL.E_MOD, SL.E_NU, SL.E_RHO)
+    elastic = [SL.ELASTIC_MODULUS, SL.ELASTIC_POISSON, SL.ELASTIC_DENSITY]
+    assert [L.P_YOUNG, L.P_NU, L.P_RHO] == elastic
     assert (L.S_ALIVE, L.S_ENERGY) == (FL.S_ALIVE, FL.S_ENERGY)
     p = j2_parameter_row(material("aluminium"))
-    assert (p[SL.E_MOD], p[SL.E_NU], p[SL.E_RHO]) == (72e9, 0.32, 2780.0)
+    assert tuple(p[elastic]) == (72e9, 0.32, 2780.0)
 
 
 def test_j2_point_called_like_fabric_point_from_a_section_loop():
@@ -572,7 +575,7 @@ def test_kernel_matches_a_3d_radial_return_with_sigma33_solved_to_zero(name, see
         tau, eps_p, lam3 = oracle_step(params, tau, eps_p, lam3, path[k - 1], path[k], dt)
         st_k = states[k]
         sy = flow_stress_oracle(params, st_k)
-        assert np.max(np.abs(st_k[L.S_TAU : L.S_TAU + 3] - tau)) <= 1e-9 * sy, k
+        assert np.max(np.abs(st_k[L.S_KIRCHHOFF : L.S_KIRCHHOFF + 3] - tau)) <= 1e-9 * sy, k
         assert st_k[L.S_EPS_P] == pytest.approx(eps_p, rel=1e-9, abs=1e-15)
         assert st_k[L.S_THICK] == pytest.approx(lam3, rel=1e-12)
     assert states[-1, L.S_EPS_P] > 0.02  # the path is well into the plastic range

@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from wovenimpact.errors import InputError
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.model.compile import compile_case
 from wovenimpact.spec.case import case_from_dict
 
@@ -28,7 +28,7 @@ def test_touching_plies_are_stacked_by_their_own_thicknesses():
     elements have its section, and a node's contact offset is half its own ply's
     thickness (each ply has its own nodes)."""
     model = compile_case(case_from_dict(hybrid_doc()), HYBRID.parent).model
-    thick = model.sections[model.elem_section, S.C_THICK]
+    thick = model.sections[model.elem_section, SL.C_THICK]
     t_f = float(thick[0])
     assert t_f == pytest.approx(0.4992e-3, rel=1e-3)
     assert np.all(thick[model.ply < 4] == t_f) and np.all(thick[model.ply == 4] == 1e-3)

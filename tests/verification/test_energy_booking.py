@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from tests.verification.meshes import elastic, rect_grid
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.state import initial_state
@@ -30,14 +30,14 @@ def test_an_eroded_element_is_booked_once():
                         np.zeros(len(quads), int), bcs=bc, erode_dt_fraction=0.6)
     st = initial_state(model)
     ws = Workspace.for_model(model, st)
-    while np.all(st.elem[:, S.E_ALIVE] == 1.0) and st.step < 20000:
+    while np.all(st.elem[:, SL.E_ALIVE] == 1.0) and st.step < 20000:
         step(model, st, ws)
-    dead = st.elem[:, S.E_ALIVE] == 0.0
+    dead = st.elem[:, SL.E_ALIVE] == 0.0
     assert dead.any() and not dead.all(), "no element (or every one) eroded"
     for _ in range(20):
         step(model, st, ws)
     eb = energy_balance(model, st)
-    frozen = st.elem[dead][:, [S.E_U_MEMB, S.E_U_BEND, S.E_U_HG]]
+    frozen = st.elem[dead][:, [SL.E_U_MEMB, SL.E_U_BEND, SL.E_U_HG]]
     live = ~dead
     print(f"\neroded {int(dead.sum())} element(s) at step {st.step}: energies at erosion "
           f"{frozen.sum(axis=0)} J; W_int {eb['internal_work_J']:.4e} J, stored "
@@ -48,8 +48,8 @@ def test_an_eroded_element_is_booked_once():
     assert eb["eroded_internal_J"] == pytest.approx(frozen.sum(), rel=1e-12)
     assert eb["eroded_hourglass_J"] == pytest.approx(frozen[:, 2].sum(), rel=1e-12)
     assert eb["stored_J"] == pytest.approx(
-        float(np.sum(st.elem[live, S.E_U_MEMB] + st.elem[live, S.E_U_BEND])), rel=1e-12)
-    assert eb["hourglass_J"] == pytest.approx(float(np.sum(st.elem[live, S.E_U_HG])), rel=1e-12)
+        float(np.sum(st.elem[live, SL.E_U_MEMB] + st.elem[live, SL.E_U_BEND])), rel=1e-12)
+    assert eb["hourglass_J"] == pytest.approx(float(np.sum(st.elem[live, SL.E_U_HG])), rel=1e-12)
     # an elastic strip dissipates nothing: its parts add up to the internal work (to the
     # half step of work the trapezoid gives the eroding element's last force)
     parts = eb["stored_J"] + eb["hourglass_J"] + eb["eroded_internal_J"]

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from wovenimpact.kernels import j2_layout as J
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.metal_state import plastic_work, thickness_ratio
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.solver import Workspace, energy_balance, step
@@ -50,13 +50,13 @@ def test_aluminium_strip_pulled_follows_the_hardening_table_and_books_its_plasti
     energy plus the plastic work of the points (1 %; metal_state.plastic_work sums the
     same to 1e-12), the energy balance holding."""
     al, t, n, model, st = pulled_strip(membrane)
-    assert model.sections[0, S.C_POINTS] == 5
+    assert model.sections[0, SL.C_POINTS] == 5
     width = model.point_width
     pts = st.mat.reshape(n, -1, 5, width)  # (element, in-plane point, level, column)
     eps_p = pts[..., J.S_EPS_P]
     assert eps_p.min() > 0.04
     assert np.allclose(eps_p, eps_p[..., :1], rtol=1e-9)
-    sigma = st.elem[:, S.E_N] / (t * pts[..., J.S_THICK].mean(axis=(1, 2)))
+    sigma = st.elem[:, SL.E_N] / (t * pts[..., J.S_THICK].mean(axis=(1, 2)))
     table = np.interp(eps_p.mean(axis=(1, 2)), *np.array(al.hardening).T)
     print(f"\n{membrane}: ε_p {eps_p.mean():.4f}, σ {sigma.mean() / 1e6:.2f} MPa vs table "
           f"{table.mean() / 1e6:.2f} MPa")

@@ -17,7 +17,7 @@ import pytest
 
 from wovenimpact.impactor import Impactor
 from wovenimpact.kernels import rigid_body as RB
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.metal_state import plastic_work
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.model.compile import stack_plies
@@ -85,7 +85,7 @@ def test_projectile_perforates_metal_then_meets_fabric_momentum_and_energy_booke
         body_on_metal = max(body_on_metal, float(np.abs(cb.f_body[metal_nodes, 2]).max()))
         body_on_fabric = max(body_on_fabric, float(np.abs(cb.f_body[fabric_nodes, 2]).max()))
         worst = max(worst, energy_balance(model, st)["error_fraction"])
-    eroded_metal = int(np.sum((st.elem[:, S.E_ALIVE] == 0.0) & (mesh.ply == 2)))
+    eroded_metal = int(np.sum((st.elem[:, SL.E_ALIVE] == 0.0) & (mesh.ply == 2)))
     eb = energy_balance(model, st)
     w_p = plastic_work(model, st)
     v_body = -st.bodies[0, RB.B_V + 2]

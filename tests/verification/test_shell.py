@@ -9,7 +9,7 @@ import pytest
 
 from tests.verification.meshes import elastic, rect_grid
 from wovenimpact.kernels import fabric_layout as FL
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.solver.explicit import element_forces
@@ -46,10 +46,10 @@ def test_membrane_patch_test_on_a_distorted_mesh_is_exact():
     _, ws = forces_at(model, x)
     f = np.eye(2) + grad
     # the corotational frame turns with side 1-2: compare invariants of N and F
-    F_el = ws.elem[:, S.E_F:S.E_F + 4].reshape(-1, 2, 2)
+    F_el = ws.elem[:, SL.E_F:SL.E_F + 4].reshape(-1, 2, 2)
     C_el = np.einsum("nki,nkj->nij", F_el, F_el)
     c_err = np.max(np.abs(C_el - f.T @ f))
-    n_el = ws.elem[:, S.E_N:S.E_N + 3]
+    n_el = ws.elem[:, SL.E_N:SL.E_N + 3]
     tr = n_el[:, 0] + n_el[:, 1]
     det = n_el[:, 0] * n_el[:, 1] - n_el[:, 2] ** 2
     scale = mat.modulus * t * 1e-3
@@ -94,10 +94,10 @@ def test_rigid_rotation_by_90_degrees_leaves_no_stress(axis):
         element_forces(model, st, ws)
         st.elem, ws.elem = ws.elem, st.elem
         st.mat, ws.mat = ws.mat, st.mat
-    stress = max(np.max(np.abs(st.elem[:, S.E_N:S.E_N + 3])) / t,
-                 np.max(np.abs(st.elem[:, S.E_M:S.E_M + 3])) * 6 / t**2,
-                 np.max(np.abs(st.elem[:, S.E_Q:S.E_Q + 2])) / t,
-                 np.max(np.abs(st.elem[:, S.E_HG:S.E_HG + 5])) / (t * 1e-3))
+    stress = max(np.max(np.abs(st.elem[:, SL.E_N:SL.E_N + 3])) / t,
+                 np.max(np.abs(st.elem[:, SL.E_M:SL.E_M + 3])) * 6 / t**2,
+                 np.max(np.abs(st.elem[:, SL.E_Q:SL.E_Q + 2])) / t,
+                 np.max(np.abs(st.elem[:, SL.E_HG:SL.E_HG + 5])) / (t * 1e-3))
     print(f"\n90° rigid rotation about {axis}: max stress {stress / mat.modulus:.1e} E")
     assert stress < 1e-10 * mat.modulus
 
@@ -245,7 +245,7 @@ def test_fabric_strip_pulled_along_the_warp_reproduces_the_single_element_curve(
     st = initial_state(model)
     ws = Workspace.for_model(model, st)
     u_hist, t_hist = [], []
-    while st.elem[:, S.E_ALIVE].all() and st.mat[:, FL.S_DAMAGE].max() == 0.0:
+    while st.elem[:, SL.E_ALIVE].all() and st.mat[:, FL.S_DAMAGE].max() == 0.0:
         step(model, st, ws)
         u_hist.append((st.x[right, 0].mean() - n * cell) / n)
         t_hist.append(st.mat[:, FL.S_TENSION].mean())
@@ -342,7 +342,7 @@ def test_body_force_accelerates_a_free_plate_uniformly_and_its_work_is_booked():
           f"W_ext − KE = {eb['external_work_J'] - eb['kinetic_J']:.1e} J")
     # exact up to the round-off stresses of x = x0 + u (strains ~1e-15, forces ~1e-9 N)
     assert np.max(np.abs(st.v - g * t_half)) < 1e-6 * np.linalg.norm(g) * t_half
-    assert np.max(np.abs(st.elem[:, S.E_N:S.E_N + 3])) < 1e-12 * 210e9 * 1e-3
+    assert np.max(np.abs(st.elem[:, SL.E_N:SL.E_N + 3])) < 1e-12 * 210e9 * 1e-3
     assert eb["external_work_J"] == pytest.approx(eb["kinetic_J"], rel=1e-9)
 
 
@@ -367,10 +367,10 @@ def test_eroded_element_gives_no_force_and_its_energy_is_booked():
     st = initial_state(model)
     ws = Workspace.for_model(model, st)
     peak = 0.0
-    while st.elem[0, S.E_ALIVE] == 1.0 and st.step < 20000:
+    while st.elem[0, SL.E_ALIVE] == 1.0 and st.step < 20000:
         step(model, st, ws)
         peak = max(peak, float(np.max(st.mat[0, FL.S_TENSION:FL.S_TENSION + 2])))
-    assert st.elem[0, S.E_ALIVE] == 0.0, "the element never eroded"
+    assert st.elem[0, SL.E_ALIVE] == 0.0, "the element never eroded"
     for _ in range(5):
         step(model, st, ws)
     eb = energy_balance(model, st)
@@ -381,7 +381,7 @@ def test_eroded_element_gives_no_force_and_its_energy_is_booked():
     assert 0.9 * fab.warp.ultimate_tension < peak < fab.warp.ultimate_tension
     assert np.all(st.node_active[:4] == 0) and np.all(st.v[:4] == 0.0)
     assert np.all(st.f_int[:4] == 0.0)
-    assert np.all(st.node_active[4:] == 1) and st.elem[1, S.E_ALIVE] == 1.0
+    assert np.all(st.node_active[4:] == 1) and st.elem[1, SL.E_ALIVE] == 1.0
     assert eb["eroded_kinetic_J"] > 0.0
     assert eb["error_fraction"] < 1e-3
 

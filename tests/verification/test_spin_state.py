@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.model.casing import blade_mesh, casing_mesh, circumferential_directions
 from wovenimpact.solver.relaxation import centrifugal_acceleration, spin_state
@@ -160,7 +160,7 @@ def test_released_fragment_flies_straight_at_omega_r_cm():
         step(model, st, ws)
     p_end = (m[:, None] * st.v[frag]).sum(axis=0)
     assert np.linalg.norm(p_end - p_release) < 1e-9 * m.sum() * speed0
-    assert np.all(st.elem[mesh.elem_sets["release"], S.E_ALIVE] == 0.0)
+    assert np.all(st.elem[mesh.elem_sets["release"], SL.E_ALIVE] == 0.0)
     assert np.allclose(np.hypot(st.x[root, 0], st.x[root, 1]), 0.05, rtol=1e-3)
 
 

@@ -212,15 +212,15 @@ class MetalPointDriver:
         t = self.t0 * st[L.S_THICK]
         sxx, syy, sxy = n[0] / t, n[1] / t, n[2] / t
         seq = math.sqrt(max(sxx * sxx - sxx * syy + syy * syy + 3.0 * sxy * sxy, 0.0))
-        txx, tyy, txy = st[L.S_TAU : L.S_TAU + 3]
+        txx, tyy, txy = st[L.S_KIRCHHOFF : L.S_KIRCHHOFF + 3]
         teq = math.sqrt(max(txx * txx - txx * tyy + tyy * tyy + 3.0 * txy * txy, 0.0))
         strain = s * self.strain_max
         self.rows.append([
             s, strain, f[0, 0], f[1, 1], f[0, 1], sxx, syy, sxy, seq, teq,
             st[L.S_EPS_P], st[L.S_YIELD], float(self.params.flow_stress(st[L.S_EPS_P])),
             st[L.S_RATE], st[L.S_THICK], (sxx + syy) / (3.0 * seq) if seq > 0.0 else 0.0,
-            st[L.S_DAMAGE], st[L.S_ALIVE], st[L.S_ENERGY], st[L.S_PLASTIC_WORK],
-            st[L.S_FAIL_ENERGY], self.work, st[L.S_ITER],
+            st[L.S_JC_DAMAGE], st[L.S_ALIVE], st[L.S_ENERGY], st[L.S_PLASTIC_WORK],
+            st[L.S_FAIL_ENERGY], self.work, st[L.S_RETURN_ITER],
         ])
 
     def accept(self, s: float, f: np.ndarray, upd: PointUpdate) -> None:

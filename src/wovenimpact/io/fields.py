@@ -35,7 +35,7 @@ import numpy as np
 from wovenimpact.errors import InputError
 from wovenimpact.io.atomic import atomic_path, atomic_write_text
 from wovenimpact.kernels import fabric_layout as FL
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.metal_state import max_plastic_strain, thickness_ratio
 from wovenimpact.state import State
 
@@ -63,8 +63,8 @@ def model_parts(model) -> list[tuple[str, np.ndarray]]:
 
 def fabric_elements(model) -> np.ndarray:
     """(n_elems,) True where the element's section material is a fabric."""
-    mat = model.sections[model.elem_section, S.C_MAT].astype(np.int64)
-    return model.mat_kind[mat] == S.MAT_FABRIC
+    mat = model.sections[model.elem_section, SL.C_MAT].astype(np.int64)
+    return model.mat_kind[mat] == SL.MAT_FABRIC
 
 
 def cell_blocks(quads: np.ndarray) -> list[tuple[str, np.ndarray, np.ndarray]]:
@@ -83,14 +83,15 @@ def cell_blocks(quads: np.ndarray) -> list[tuple[str, np.ndarray, np.ndarray]]:
 def element_fields(model, state: State, fabric: np.ndarray) -> dict[str, np.ndarray]:
     """Per-element output arrays (index = Model element)."""
     out = {
-        "membrane_resultant": state.elem[:, S.E_N:S.E_N + 3],
-        "alive": state.elem[:, S.E_ALIVE],
+        "membrane_resultant": state.elem[:, SL.E_N:SL.E_N + 3],
+        "alive": state.elem[:, SL.E_ALIVE],
         "ply": np.asarray(model.ply, dtype=np.int64),
         "element": np.arange(model.n_elems, dtype=np.int64),
     }
     # integrated sections: the mid-surface point (block points // 2 of the state row)
     # (a point's block is model.point_width wide: 16 beside a metal section, not FL.N_STATE)
-    mid = (model.sections[model.elem_section, S.C_POINTS].astype(np.int64) // 2) * model.point_width
+    n_points = model.sections[model.elem_section, SL.C_POINTS].astype(np.int64)
+    mid = (n_points // 2) * model.point_width
     rows = np.flatnonzero(fabric)
     for name, col in (("tension_warp", FL.S_TENSION), ("tension_fill", FL.S_TENSION + 1),
                       ("damage_warp", FL.S_DAMAGE), ("damage_fill", FL.S_DAMAGE + 1)):

@@ -77,23 +77,23 @@ from wovenimpact.kernels.j2_layout import (
     P_D,
     P_DAMAGE,
     P_DAMAGE_REF,
-    P_E,
     P_FRACTURE,
     P_HARD,
     P_N_HARD,
     P_NU,
     P_RATE_C,
     P_RATE_REF,
+    P_YOUNG,
     S_ALIVE,
-    S_DAMAGE,
     S_ENERGY,
     S_EPS_P,
     S_FAIL_ENERGY,
-    S_ITER,
+    S_JC_DAMAGE,
+    S_KIRCHHOFF,
     S_PLASTIC_WORK,
     S_RATE,
+    S_RETURN_ITER,
     S_SIG,
-    S_TAU,
     S_THICK,
     S_YIELD,
     STATUS_BAD_KINEMATICS,
@@ -304,7 +304,7 @@ def clear_failed_point(s_out, i):
     s_out[i, S_ALIVE] = 0.0
     for j in range(3):
         s_out[i, S_SIG + j] = 0.0
-        s_out[i, S_TAU + j] = 0.0
+        s_out[i, S_KIRCHHOFF + j] = 0.0
     s_out[i, S_ENERGY] = 0.0
 
 
@@ -331,7 +331,7 @@ def j2_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, dt, thick, s_in, 
     """
     for j in range(N_STATE):
         s_out[i, j] = s_in[i, j]
-    e_mod = p[m, P_E]
+    e_mod = p[m, P_YOUNG]
     nu = p[m, P_NU]
     det_o = fo11 * fo22 - fo12 * fo21
     det_n = f11 * f22 - f12 * f21
@@ -341,7 +341,7 @@ def j2_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, dt, thick, s_in, 
     if s_in[i, S_ALIVE] == 0.0:
         clear_failed_point(s_out, i)
         s_out[i, S_RATE] = 0.0
-        s_out[i, S_ITER] = 0.0
+        s_out[i, S_RETURN_ITER] = 0.0
         return STATUS_OK, 0.0, 0.0, 0.0, 0.0
 
     # 1. kinematics (J1–J2)
@@ -354,9 +354,9 @@ def j2_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, dt, thick, s_in, 
         return STATUS_BAD_KINEMATICS, 0.0, 0.0, 0.0, 0.0
 
     # 2. elastic predictor (J3)
-    to11 = s_in[i, S_TAU]
-    to22 = s_in[i, S_TAU + 1]
-    to12 = s_in[i, S_TAU + 2]
+    to11 = s_in[i, S_KIRCHHOFF]
+    to22 = s_in[i, S_KIRCHHOFF + 1]
+    to12 = s_in[i, S_KIRCHHOFF + 2]
     c = e_mod / (1.0 - nu * nu)
     g_mod = 0.5 * e_mod / (1.0 + nu)
     tt11 = to11 + c * (dd11 + nu * dd22)
@@ -374,12 +374,12 @@ def j2_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, dt, thick, s_in, 
         t11, t22, t12, dgam, deps, sig_y, iters, res = plane_stress_return(
             p, m, e_mod, nu, tt11, tt22, tt12, eps_p, dt
         )
-        s_out[i, S_ITER] = iters
+        s_out[i, S_RETURN_ITER] = iters
         if not (res <= RETURN_TOL_FAIL):
             return STATUS_NOT_CONVERGED, 0.0, 0.0, 0.0, 0.0
     else:
         t11, t22, t12 = tt11, tt22, tt12
-        s_out[i, S_ITER] = 0.0
+        s_out[i, S_RETURN_ITER] = 0.0
 
     # 4. plastic strain increment (J7), thickness (J10), energies (J11)
     dep11 = dgam * (2.0 * t11 - t22) / 3.0
@@ -399,9 +399,9 @@ def j2_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, dt, thick, s_in, 
     s_out[i, S_RATE] = rate
     s_out[i, S_YIELD] = sig_y if deps > 0.0 else hardening(p, m, eps_p_new)[0]
     jac = det_n * lam3  # volume ratio J (J10)
-    s_out[i, S_TAU] = t11
-    s_out[i, S_TAU + 1] = t22
-    s_out[i, S_TAU + 2] = t12
+    s_out[i, S_KIRCHHOFF] = t11
+    s_out[i, S_KIRCHHOFF + 1] = t22
+    s_out[i, S_KIRCHHOFF + 2] = t12
     s_out[i, S_SIG] = t11 / jac
     s_out[i, S_SIG + 1] = t22 / jac
     s_out[i, S_SIG + 2] = t12 / jac
@@ -413,8 +413,8 @@ def j2_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, dt, thick, s_in, 
             seq = math.sqrt(t11 * t11 - t11 * t22 + t22 * t22 + 3.0 * t12 * t12)
             eta = (t11 + t22) / (3.0 * seq) if seq > 0.0 else 0.0
             ef = fracture_strain_jc(p, m, eta, rate)
-            dmg = s_in[i, S_DAMAGE] + deps / ef if ef > 0.0 else 1.0
-            s_out[i, S_DAMAGE] = dmg
+            dmg = s_in[i, S_JC_DAMAGE] + deps / ef if ef > 0.0 else 1.0
+            s_out[i, S_JC_DAMAGE] = dmg
             failed = dmg >= 1.0
         ef_const = p[m, P_FRACTURE]
         if ef_const > 0.0 and eps_p_new >= ef_const:

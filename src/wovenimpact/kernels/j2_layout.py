@@ -6,12 +6,20 @@ constants: Numba treats module-level ints as compile-time constants.
 
 Parameter vector ``p`` (float64, length ``N_PARAM``), SI units. Columns 0–2 are
 E, ν, ρ as in the elastic row of :mod:`wovenimpact.kernels.shell_layout`
-(``E_MOD``, ``E_NU``, ``E_RHO``), so code that only needs the elastic constants
-(bending of a resultant section, wave speeds) reads a metal row unchanged.
+(``ELASTIC_MODULUS``, ``ELASTIC_POISSON``, ``ELASTIC_DENSITY``), so code that only needs
+the elastic constants (bending of a resultant section, wave speeds) reads a metal row
+unchanged.
+
+Names that fabric_layout also defines mean the same there (``S_ALIVE``, ``S_ENERGY`` and
+the ``STATUS_*`` codes, same values), or are each layout's own length or text table
+(``N_PARAM``, ``N_STATE``, ``STATUS_TEXT``); a column that differs from the fabric's has a
+name of its own (``P_YOUNG``, not the fabric's yarn modulus ``P_E``; ``S_KIRCHHOFF``, not
+the trellis shear stress ``S_TAU``; ``S_JC_DAMAGE``, ``S_RETURN_ITER``).
+tests/unit/test_layouts.py checks it.
 """
 
 # --- parameters -------------------------------------------------------------
-P_E = 0  # E, Young's modulus (Pa)
+P_YOUNG = 0  # E, Young's modulus (Pa)
 P_NU = 1  # ν, Poisson's ratio (—)
 P_RHO = 2  # ρ, density (kg/m³)
 P_FRACTURE = 3  # ε_f, equivalent plastic strain at failure (—); 0: no such criterion
@@ -30,17 +38,17 @@ N_PARAM = P_HARD + 2 * N_HARD_MAX
 # kernel reads a point's alive flag and stored energy the same way for both kinds
 # (tests/unit/test_j2_kernel.py checks it).
 S_SIG = 0  # rotated Cauchy stress σ_xx, σ_yy, σ_xy (Pa), Green–Naghdi frame: S_SIG + 0..2
-S_TAU = 3  # rotated Kirchhoff stress τ = J σ (Pa), the variable of the return: S_TAU + 0..2
+S_KIRCHHOFF = 3  # rotated Kirchhoff stress τ = J σ (Pa), the return's variable: +0..2
 S_EPS_P = 6  # ε̄p, equivalent plastic strain (—)
 S_PLASTIC_WORK = 7  # plastic work per unit reference area, cumulative (J/m²)
 S_THICK = 8  # λ3 = t / t0, thickness stretch (—)
-S_DAMAGE = 9  # D, Johnson–Cook damage (—), 0 … ≥ 1
+S_JC_DAMAGE = 9  # D, Johnson–Cook damage (—), 0 … ≥ 1
 S_ALIVE = 10  # 1.0 until the point fails, then 0.0 for good (as fabric_layout.S_ALIVE)
 S_ENERGY = 11  # elastic stored energy per unit reference area (J/m²) (as fabric_layout.S_ENERGY)
 S_RATE = 12  # ε̇p, equivalent plastic strain rate of the last step (1/s)
 S_YIELD = 13  # σ_y, current flow stress (Pa), rate factor included
 S_FAIL_ENERGY = 14  # elastic energy per reference area released when the point failed (J/m²)
-S_ITER = 15  # iterations of the last return
+S_RETURN_ITER = 15  # iterations of the last return
 N_STATE = 16
 
 # --- status codes returned per point -----------------------------------------

@@ -62,9 +62,7 @@ from wovenimpact.kernels.shell_layout import (
     E_HG,
     E_KAPPA,
     E_M,
-    E_MOD,
     E_N,
-    E_NU,
     E_Q,
     E_U_BEND,
     E_U_HG,
@@ -73,6 +71,8 @@ from wovenimpact.kernels.shell_layout import (
     EL_MATERIAL,
     EL_NAN,
     EL_OK,
+    ELASTIC_MODULUS,
+    ELASTIC_POISSON,
     MAT_FABRIC,
     MAT_J2,
     MEMBRANE_FULL,
@@ -250,7 +250,8 @@ def point_response(kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, 
             return st, False, 0.0, 0.0, 0.0, 0.0, 0.0
         return 0, rows_out[row, FL.S_ALIVE] != 0.0, c, rows_out[row, FL.S_ENERGY], a, b, c12
     energy, c, a, b, c12 = elastic_membrane(
-        g11, g12, g21, g22, mat_params[m, E_MOD], mat_params[m, E_NU], thick
+        g11, g12, g21, g22, mat_params[m, ELASTIC_MODULUS], mat_params[m, ELASTIC_POISSON],
+        thick
     )
     return 0, True, c, energy, a, b, c12
 

@@ -19,9 +19,11 @@ Sections (``Model.sections``, one row per section, SI):
   4 = 2×2 Gauss points, no in-plane hourglass modes (``MEMBRANE_FULL``; theory §4.5).
 
 Material kinds (``Model.mat_kind``): ``MAT_ELASTIC`` (params E, ν, ρ in columns
-``E_MOD``, ``E_NU``, ``E_RHO``), ``MAT_FABRIC`` (the crossover parameter vector of
-:mod:`wovenimpact.kernels.fabric_layout`) and ``MAT_J2`` (plane-stress J2 plasticity,
-:mod:`wovenimpact.kernels.j2_layout`; E, ν, ρ in the same first columns).
+``ELASTIC_MODULUS``, ``ELASTIC_POISSON``, ``ELASTIC_DENSITY`` of ``Model.mat_params``;
+a prefix of their own, apart from the ``E_*`` element-state columns), ``MAT_FABRIC``
+(the crossover parameter vector of :mod:`wovenimpact.kernels.fabric_layout`) and
+``MAT_J2`` (plane-stress J2 plasticity, :mod:`wovenimpact.kernels.j2_layout`; E, ν, ρ
+in the same first columns).
 
 Per-element state (``State.elem``, one row per element):
 
@@ -64,13 +66,13 @@ N_SECTION = 10
 MEMBRANE_REDUCED = 1
 MEMBRANE_FULL = 4
 
-# material kinds and the elastic parameter vector
+# material kinds and the elastic parameter vector (a row of Model.mat_params)
 MAT_ELASTIC = 0
 MAT_FABRIC = 1
 MAT_J2 = 2
-E_MOD = 0
-E_NU = 1
-E_RHO = 2
+ELASTIC_MODULUS = 0  # E (Pa)
+ELASTIC_POISSON = 1  # ν (—)
+ELASTIC_DENSITY = 2  # ρ (kg/m³)
 
 # element state
 E_F = 0

@@ -120,7 +120,7 @@ def j2_parameter_row(params: MetalParameters) -> np.ndarray:
             f"material {params.name!r}: hardening table has {n} rows, at most {L.N_HARD_MAX}"
         )
     p = np.zeros(L.N_PARAM)
-    p[L.P_E] = params.modulus
+    p[L.P_YOUNG] = params.modulus
     p[L.P_NU] = params.poisson
     p[L.P_RHO] = params.density
     p[L.P_FRACTURE] = params.fracture_strain or 0.0

@@ -179,7 +179,7 @@ def erode_at_start(model: Model, state: State, er, key: str) -> None:
     """Erode the elements whose centroid lies within er.radius of the line through
     er.centre along er.cylinder_axis (a hole through the plies); nodes left without a
     live element leave the model."""
-    from wovenimpact.kernels import shell_layout as S
+    from wovenimpact.kernels import shell_layout as SL
 
     centroid = model.x0[model.quads].mean(axis=1)
     axis = np.asarray(er.cylinder_axis, dtype=float)
@@ -195,9 +195,9 @@ def erode_at_start(model: Model, state: State, er, key: str) -> None:
     if hit.all():
         raise InputError(f"{key}: radius {er.radius:g} m erodes every element at t = 0 "
                          "(valid: a hole smaller than the plies)")
-    state.elem[hit, S.E_ALIVE] = 0.0
+    state.elem[hit, SL.E_ALIVE] = 0.0
     live = np.zeros(model.n_nodes, dtype=bool)
-    live[model.quads[state.elem[:, S.E_ALIVE] != 0.0].ravel()] = True
+    live[model.quads[state.elem[:, SL.E_ALIVE] != 0.0].ravel()] = True
     state.node_active[~live] = 0
     state.v[~live] = 0.0
     state.omega[~live] = 0.0

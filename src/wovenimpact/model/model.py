@@ -20,7 +20,7 @@ from wovenimpact.errors import InputError
 from wovenimpact.impactor import BODY_PENALTY_SCALE, Impactor
 from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels import rigid_body as RB
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.materials.fabric import FabricParameters
 from wovenimpact.materials.fabric import initial_state as fabric_initial_state
 from wovenimpact.materials.metal import MetalParameters, j2_parameter_row
@@ -33,7 +33,7 @@ DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 def is_plastic(material) -> bool:
     """A J2 plastic metal (kernels.j2)."""
     return isinstance(material, MetalParameters) and material.kind == "j2_plastic"
-MEMBRANE_POINTS = {"full": S.MEMBRANE_FULL, "reduced": S.MEMBRANE_REDUCED}
+MEMBRANE_POINTS = {"full": SL.MEMBRANE_FULL, "reduced": SL.MEMBRANE_REDUCED}
 GAUSS = 1.0 / np.sqrt(3.0)  # 2×2 Gauss points at (±1/√3, ±1/√3), weights 1
 GAUSS_XI = np.array([-GAUSS, GAUSS, GAUSS, -GAUSS])  # point g next to corner g
 GAUSS_ETA = np.array([-GAUSS, -GAUSS, GAUSS, GAUSS])
@@ -87,7 +87,7 @@ class Section:
     def row(self, mat_index: int, name: str) -> np.ndarray:
         """The section's row of ``Model.sections`` (layout in shell_layout)."""
         m = self.material
-        r = np.zeros(S.N_SECTION)
+        r = np.zeros(SL.N_SECTION)
         if isinstance(m, FabricParameters):
             t = m.shell_thickness if self.thickness is None else self.thickness
             mu = m.areal_mass if self.areal_mass is None else self.areal_mass
@@ -131,16 +131,16 @@ class Section:
         if membrane not in MEMBRANE_POINTS:
             raise InputError(f"section {name!r}: membrane = {membrane!r}; valid: "
                              f"{' or '.join(repr(k) for k in MEMBRANE_POINTS)}")
-        r[S.C_THICK] = t
-        r[S.C_MAT] = mat_index
-        r[S.C_AREAL_MASS] = mu
-        r[S.C_BEND_E] = e_b
-        r[S.C_BEND_NU] = nu_b
-        r[S.C_SHEAR_G] = g
-        r[S.C_SHEAR_K] = self.shear_factor
-        r[S.C_HOURGLASS] = self.hourglass
-        r[S.C_POINTS] = points
-        r[S.C_INPLANE] = MEMBRANE_POINTS[membrane]
+        r[SL.C_THICK] = t
+        r[SL.C_MAT] = mat_index
+        r[SL.C_AREAL_MASS] = mu
+        r[SL.C_BEND_E] = e_b
+        r[SL.C_BEND_NU] = nu_b
+        r[SL.C_SHEAR_G] = g
+        r[SL.C_SHEAR_K] = self.shear_factor
+        r[SL.C_HOURGLASS] = self.hourglass
+        r[SL.C_POINTS] = points
+        r[SL.C_INPLANE] = MEMBRANE_POINTS[membrane]
         return r
 
 
@@ -574,15 +574,15 @@ def build_model(
     kinds, params, states = [], [], []
     for m in mats:
         if isinstance(m, FabricParameters):
-            kinds.append(S.MAT_FABRIC)
+            kinds.append(SL.MAT_FABRIC)
             params.append(m.to_array())
             states.append(fabric_initial_state(m)[0])
         elif is_plastic(m):
-            kinds.append(S.MAT_J2)
+            kinds.append(SL.MAT_J2)
             params.append(j2_parameter_row(m))
             states.append(j2_initial_state(m)[0])
         else:
-            kinds.append(S.MAT_ELASTIC)
+            kinds.append(SL.MAT_ELASTIC)
             params.append(np.array([m.modulus, m.poisson, m.density]))
             states.append(np.zeros(0))
     n_par = max(len(p) for p in params)
@@ -593,7 +593,7 @@ def build_model(
     # state vector of the model's kinds (width of the table: the widest section)
     point_width = max(len(st) for st in states)
     padded = [np.pad(st, (0, point_width - len(st))) for st in states]
-    blocks = [np.tile(padded[int(r[S.C_MAT])], int(r[S.C_POINTS]) * int(r[S.C_INPLANE]))
+    blocks = [np.tile(padded[int(r[SL.C_MAT])], int(r[SL.C_POINTS]) * int(r[SL.C_INPLANE]))
               if point_width else np.zeros(0) for r in sec_table]
     section_state0 = np.zeros((len(blocks), max(1, max(len(b) for b in blocks))))
     for i, b in enumerate(blocks):
@@ -601,8 +601,8 @@ def build_model(
     ref_grad, area0, gauss_grad, gauss_weight = material_frame_gradients(x0, q, warp_direction)
     # lumped masses: a quarter of each element's mass to each corner; rotary inertia
     # m · max(t²/12, A/8) so that rotations never govern the stable step (theory §3)
-    thick = sec_table[es, S.C_THICK]
-    m_el = sec_table[es, S.C_AREAL_MASS] * area0
+    thick = sec_table[es, SL.C_THICK]
+    m_el = sec_table[es, SL.C_AREAL_MASS] * area0
     node_mass = np.zeros(len(x0))
     node_inertia = np.zeros(len(x0))
     for c in range(4):

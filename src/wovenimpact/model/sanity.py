@@ -31,7 +31,7 @@ import numpy as np
 
 from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.kernels import rigid_body as RB
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 
 MAX_WAVE_SPEED = 2.0e4  # m/s: above any engineering material's (diamond ~18 km/s)
 MAX_CROSSING = 0.5  # of the smallest element length moved in one step
@@ -56,7 +56,7 @@ def first_step(model, state) -> tuple[float, int]:
 
     ws = Workspace.for_model(model, state)
     shell_forces(model, state, ws)
-    dt_el = ws.elem[:, S.E_DT]
+    dt_el = ws.elem[:, SL.E_DT]
     e = int(np.argmin(dt_el))
     return model.alpha * float(dt_el[e]), e
 
@@ -74,9 +74,9 @@ def _section_text(model, e: int, spec) -> str:
     row = model.sections[sec]
     name = model.section_names[sec] if sec < len(model.section_names) else str(sec)
     material = spec.sections[name].material if name in spec.sections else "?"
-    return (f"section {name!r} (material {material!r}): thickness {row[S.C_THICK]:.3g} m, "
-            f"areal mass {row[S.C_AREAL_MASS]:.3g} kg/m^2, bending modulus "
-            f"{row[S.C_BEND_E]:.3g} Pa, transverse shear modulus {row[S.C_SHEAR_G]:.3g} Pa")
+    return (f"section {name!r} (material {material!r}): thickness {row[SL.C_THICK]:.3g} m, "
+            f"areal mass {row[SL.C_AREAL_MASS]:.3g} kg/m^2, bending modulus "
+            f"{row[SL.C_BEND_E]:.3g} Pa, transverse shear modulus {row[SL.C_SHEAR_G]:.3g} Pa")
 
 
 def check_step_count(model, state, spec) -> float:
@@ -162,7 +162,7 @@ def check_plies(spec, model) -> None:
     if not (isinstance(m, PlateMeshSpec) and m.plies > 1 and m.spacing is not None):
         return  # without spacing (ply_sections) the plies are stacked by their thicknesses
     first = [int(np.flatnonzero(model.ply == k)[0]) for k in range(m.plies)]
-    t = [float(model.sections[model.elem_section[e], S.C_THICK]) for e in first]
+    t = [float(model.sections[model.elem_section[e], SL.C_THICK]) for e in first]
     need = max(0.5 * (a + b) for a, b in zip(t[:-1], t[1:]))
     if m.spacing < need * (1.0 - 1e-9):
         raise InputError(
@@ -180,7 +180,7 @@ def check_thickness(model, spec) -> None:
             f"mesh: the structure is {extent:.3g} m across, more than {MAX_EXTENT:g} m (valid: "
             "an impact model; check the units of the mesh, coordinates are in metres)")
     for sec in np.unique(model.elem_section):
-        t = float(model.sections[sec, S.C_THICK])
+        t = float(model.sections[sec, SL.C_THICK])
         if t < MIN_THICKNESS:
             e = int(np.flatnonzero(model.elem_section == sec)[0])
             raise InputError(

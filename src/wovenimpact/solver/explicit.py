@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from wovenimpact.errors import SimulationError
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.kernels.gather import gather_nodal_forces
 from wovenimpact.kernels.integrate import force_pair_power, gather_and_update, smooth_step
 from wovenimpact.kernels.mass_scaling import node_masses, scale_element_masses, scaled_node_masses
@@ -51,9 +51,9 @@ from wovenimpact.state import (
 
 DT_COLLAPSE = 1e-3  # a step below this fraction of the first one stops the run
 STATUS_TEXT = {
-    S.EL_INVERTED: "inverted or degenerate (non-positive area or Jacobian)",
-    S.EL_MATERIAL: "material point failed (no converged crimp heights or inadmissible stretch)",
-    S.EL_NAN: "non-finite force or time step (NaN/inf)",
+    SL.EL_INVERTED: "inverted or degenerate (non-positive area or Jacobian)",
+    SL.EL_MATERIAL: "material point failed (no converged crimp heights or inadmissible stretch)",
+    SL.EL_NAN: "non-finite force or time step (NaN/inf)",
 }
 
 
@@ -177,14 +177,14 @@ def stable_step(model, state: State, ws: Workspace, dt_cap: float) -> float:
     scale_masses(model, state, ws)
     dt = min(model.alpha * ws.dt_min, dt_cap)
     if not math.isfinite(dt) or dt <= 0.0:
-        dt_el = ws.elem[:, S.E_DT]
+        dt_el = ws.elem[:, SL.E_DT]
         e = int(np.argmin(dt_el))
         raise SimulationError(
             f"no stable time step at t = {state.t:.6e} s (element {e}: {dt_el[e]!r}); "
             "every element eroded, or a non-finite state"
         )
     if state.dt_first > 0.0 and dt < DT_COLLAPSE * state.dt_first:
-        e = int(np.argmin(ws.elem[:, S.E_DT]))
+        e = int(np.argmin(ws.elem[:, SL.E_DT]))
         raise SimulationError(
             f"time step collapsed at t = {state.t:.6e} s: Δt = {dt:.3e} s is below "
             f"{DT_COLLAPSE:g} of the first step ({state.dt_first:.3e} s), governed by element "
@@ -199,12 +199,13 @@ def release(model, state: State) -> None:
     internal energy, once. Their nodes left without a live element leave the model in
     the node update that follows."""
     idx = model.release_elems
-    live = idx[state.elem[idx, S.E_ALIVE] != 0.0]
+    live = idx[state.elem[idx, SL.E_ALIVE] != 0.0]
     if not live.size:
         return
     state.energy[ERODED_INTERNAL] += float(np.sum(
-        state.elem[live, S.E_U_MEMB] + state.elem[live, S.E_U_BEND] + state.elem[live, S.E_U_HG]))
-    state.elem[live, S.E_ALIVE] = 0.0
+        state.elem[live, SL.E_U_MEMB] + state.elem[live, SL.E_U_BEND]
+        + state.elem[live, SL.E_U_HG]))
+    state.elem[live, SL.E_ALIVE] = 0.0
 
 
 def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
@@ -255,7 +256,7 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
         # hourglass energy
         gone = ws.eroded_now != 0
         en[ERODED_INTERNAL] += float(np.sum(
-            ws.elem[gone, S.E_U_MEMB] + ws.elem[gone, S.E_U_BEND] + ws.elem[gone, S.E_U_HG]
+            ws.elem[gone, SL.E_U_MEMB] + ws.elem[gone, SL.E_U_BEND] + ws.elem[gone, SL.E_U_HG]
         ))
     state.elem, ws.elem = ws.elem, state.elem
     state.mat, ws.mat = ws.mat, state.mat
@@ -346,9 +347,9 @@ def energy_balance(model, state: State) -> dict[str, float]:
     (broken yarns, damping of the contact's or the material's).
     """
     en = state.energy
-    live = state.elem[:, S.E_ALIVE] != 0.0
-    u_memb, u_bend, u_hg = (state.elem[:, S.E_U_MEMB], state.elem[:, S.E_U_BEND],
-                            state.elem[:, S.E_U_HG])
+    live = state.elem[:, SL.E_ALIVE] != 0.0
+    u_memb, u_bend, u_hg = (state.elem[:, SL.E_U_MEMB], state.elem[:, SL.E_U_BEND],
+                            state.elem[:, SL.E_U_HG])
     stored = float(np.sum(np.where(live, u_memb + u_bend, 0.0)))
     hourglass = float(np.sum(np.where(live, u_hg, 0.0)))
     eroded_hg = float(np.sum(np.where(live, 0.0, u_hg)))

@@ -12,7 +12,7 @@ import pytest
 
 from tests.verification.meshes import elastic, rect_grid
 from wovenimpact.errors import InputError, SimulationError
-from wovenimpact.kernels import shell_layout as S
+from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.state import MASS_SCALING, initial_state
@@ -40,7 +40,7 @@ def run_to(model, t_end):
     while st.t < t_end:
         step(model, st, ws)
         dts.append(st.dt)
-        dt_crushed = min(dt_crushed, st.elem[3, S.E_DT])
+        dt_crushed = min(dt_crushed, st.elem[3, SL.E_DT])
     run_to.dt_crushed = dt_crushed  # smallest unscaled L_e/c_e of the crushed element
     return st, ws, np.array(dts)
 

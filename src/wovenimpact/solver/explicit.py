@@ -148,7 +148,7 @@ def scale_masses(model, state: State, ws: Workspace) -> None:
     if model.mass_scaling_fraction <= 0.0 or state.dt_first <= 0.0:
         return
     target = model.mass_scaling_fraction * state.dt_first / model.alpha
-    raised, ws.dt_min = scale_element_masses(ws.elem, S.E_DT, ws.alive, state.mass_ratio, target)
+    raised, ws.dt_min = scale_element_masses(ws.elem, SL.E_DT, ws.alive, state.mass_ratio, target)
     if not raised:
         return
     scaled_node_masses(model.node_ptr, model.node_elem, state.mass_ratio, model.elem_mass,

@@ -104,9 +104,12 @@ def _kernel_source_digest() -> str:
     return h.hexdigest()[:16]
 
 
+PARALLEL = os.environ.get("WOVENIMPACT_SERIAL", "0") not in ("1", "true", "yes")
+# Numba's cache key ignores the ``parallel`` flag: serial builds get their own directory,
+# or WOVENIMPACT_SERIAL=1 would load the parallel object code cached before it
 _CACHE_DIR = None if "NUMBA_CACHE_DIR" in os.environ else str(
     Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
-    / "wovenimpact" / "numba" / _kernel_source_digest()
+    / "wovenimpact" / "numba" / (_kernel_source_digest() + ("" if PARALLEL else "-serial"))
 )
 
 
@@ -126,7 +129,6 @@ def _cache_dir():
 
 
 JIT_FLAGS = dict(cache=True, fastmath=False, error_model="numpy", nogil=True)
-PARALLEL = os.environ.get("WOVENIMPACT_SERIAL", "0") not in ("1", "true", "yes")
 
 
 def kernel(fn):

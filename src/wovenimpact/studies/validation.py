@@ -317,7 +317,8 @@ def design_lines(name: str, work: Path, workers: int, log=_quiet) -> list[str]:
     except InputError as err:  # a failed pack stops the search: the report says so
         log(f"design search {name} failed: {err}")
         return head + [f"**No answer: the search stopped.** {err}", ""]
-    runs = ", ".join(f"{n} plies {outcome}" for n, outcome in result["runs"].items())
+    runs = ", ".join(f"{n} {'ply' if int(n) == 1 else 'plies'} {outcome}"
+                     for n, outcome in result["runs"].items())
     lines = head + [
              f"Answer: **{result['plies_to_stop']} plies** "
              f"({result['areal_mass_kg_per_m2']:.3f} kg/m² of fabric). Runs: {runs}."]

@@ -107,14 +107,3 @@ def test_shell_layout_is_not_imported_as_S():
     found = [str(p) for root in (SRC, TESTS) for p in root.rglob("*.py")
              if pattern.search(p.read_text(encoding="utf-8"))]
     assert not found, found
-
-
-def test_the_models_boundary_codes_are_the_node_updates():
-    """model.model writes the codes (FREE, FIXED, PRESCRIBED, ROTATING) that
-    kernels.integrate reads; both modules define them, so they are checked to agree."""
-    from wovenimpact.kernels import integrate
-    from wovenimpact.model import model
-
-    assert model.FREE == 0
-    assert (model.FIXED, model.PRESCRIBED, model.ROTATING) == (
-        integrate.FIXED, integrate.PRESCRIBED, integrate.ROTATING)

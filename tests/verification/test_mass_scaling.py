@@ -65,8 +65,8 @@ def test_a_crushed_element_gets_the_mass_that_restores_its_step_and_the_balance_
     quarter = 0.25 * st.mass_ratio[3] * model.elem_mass[3]
     np.testing.assert_allclose(st.added_mass[model.quads[3]], quarter, rtol=1e-14)
     assert np.count_nonzero(st.added_mass) == 4
-    # the nodes of the crushed element are held or driven, so they are never at rest:
-    # the driven pair moves at 40 m/s and takes ½ Δm v² of kinetic energy with it
+    # two of the crushed element's nodes are held (at rest), the driven pair moves at
+    # 40 m/s and takes ½ Δm v² of kinetic energy with each mass increase
     assert st.energy[MASS_SCALING] > 0.0
     eb = energy_balance(model, st)
     print(f"\nadded {st.added_mass.sum():.3e} kg (×{1 + st.mass_ratio[3]:.3f} on element 3), "
@@ -103,7 +103,7 @@ def test_scaling_at_or_below_the_erosion_fraction_or_out_of_range_is_refused(fra
         crushed_strip(fraction)
 
 
-def test_the_case_key_is_checked_against_erode_dt_fraction(tmp_path):
+def test_the_case_key_is_checked_against_erode_dt_fraction():
     from pathlib import Path
 
     from wovenimpact.spec.case import load_case

@@ -30,6 +30,8 @@ from numba import prange
 from wovenimpact.jit import inline_kernel, kernel, loop_kernel
 from wovenimpact.kernels.gather import node_force_sum
 
+# boundary-condition codes per degree of freedom (Model.bc_code; model.model uses these)
+FREE = 0
 FIXED = 1
 PRESCRIBED = 2
 ROTATING = 3  # the node turns rigidly: bc_velocity holds ω (0–2, rad/s) and the centre (3–5)

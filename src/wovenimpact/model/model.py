@@ -19,6 +19,7 @@ import numpy as np
 from wovenimpact.errors import InputError
 from wovenimpact.impactor import BODY_PENALTY_SCALE, Impactor
 from wovenimpact.kernels import fabric_layout as FL
+from wovenimpact.kernels.integrate import FIXED, PRESCRIBED, ROTATING
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.materials.fabric import FabricParameters
@@ -26,7 +27,6 @@ from wovenimpact.materials.fabric import initial_state as fabric_initial_state
 from wovenimpact.materials.metal import MetalParameters, j2_parameter_row
 from wovenimpact.materials.metal import initial_state as j2_initial_state
 
-FREE, FIXED, PRESCRIBED, ROTATING = 0, 1, 2, 3  # boundary-condition codes per degree of freedom
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 
 

@@ -32,6 +32,7 @@ import numpy as np
 from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as SL
+from wovenimpact.model.model import DOF_NAMES
 
 MAX_WAVE_SPEED = 2.0e4  # m/s: above any engineering material's (diamond ~18 km/s)
 MAX_CROSSING = 0.5  # of the smallest element length moved in one step
@@ -42,7 +43,6 @@ MAX_RADIUS_EXTENTS = 10.0  # impactor radius / largest extent of the mesh
 MIN_RADIUS_ELEMENTS = 0.1  # impactor radius / largest element edge (thesis study: 2.78/6 mm)
 MAX_QUIET_OUTPUTS = 1000  # outputs at every step beyond this many are warned of
 AREAL_MASS_FACTOR = 10.0  # a section's areal mass this far from its material's is warned of
-DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 
 
 def _text(seconds: float) -> str:

@@ -73,7 +73,7 @@ def run_case(n_plies: int, threads: int, calls: int) -> dict:
     searched = best_time(lambda: every_call.forces(x, v, dt, alive, active, out), calls)
     reused = best_time(lambda: contact.forces(x, v, dt, alive, active, out), calls)
     pairs = contact.n_pairs
-    broad = best_time(lambda: contact._search(x, contact.margin + contact.skin), calls)
+    broad = best_time(lambda: contact._search(x, contact.sigma), calls)
     n = model.n_nodes
     return {
         "plies": n_plies, "threads": threads, "nodes": n, "segments": model.n_elems,

@@ -14,10 +14,18 @@ import numpy as np
 from wovenimpact.errors import InputError
 from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.kernels.contact_broad import (
+    N_SEG_BOX,
+    N_SEG_PLANE,
+    REUSE_STEPS,
+    SKIN_FLOOR,
+    bin_segments,
     bucket_count,
     candidates_still_valid,
+    cell_edge,
     contact_masks,
-    find_candidates,
+    node_skins,
+    query_candidates,
+    segment_boxes,
 )
 from wovenimpact.kernels.contact_narrow import (
     N_GEO,
@@ -27,6 +35,23 @@ from wovenimpact.kernels.contact_narrow import (
     penalty_forces,
     segment_geometry,
 )
+
+
+CANDIDATE_SLOTS = 16  # candidates per node kept from the search's counting pass
+
+
+def node_plies(node_ptr, node_elem, ply) -> np.ndarray:
+    """(n_nodes,) the ply of all of a node's elements, −1 where they are of several plies
+    or there are none (the broad phase's quick exclusion test)."""
+    n = node_ptr.shape[0] - 1
+    counts = np.diff(node_ptr)
+    owner = np.repeat(np.arange(n), counts)
+    plies = ply[node_elem]
+    low = np.full(n, np.iinfo(np.int64).max)
+    high = np.full(n, np.iinfo(np.int64).min)
+    np.minimum.at(low, owner, plies)
+    np.maximum.at(high, owner, plies)
+    return np.where((counts > 0) & (low == high), low, -1).astype(np.int64)
 
 
 class ShellContact:
@@ -65,18 +90,21 @@ class ShellContact:
     the search is redone inside the same call, so the caller never redoes a step;
     ``grow_count`` counts these events.
 
-    Candidate reuse (Verlet lists): ``forces`` searches with the boxes inflated by a
-    ``skin`` on top of the margin and keeps those candidates while no node has moved
-    more than skin/2 along any axis since that search and no segment or node has left
-    the surfaces (:func:`~wovenimpact.kernels.contact_broad.candidates_still_valid`);
-    they are then a superset of a fresh search's, and the narrow phase first repeats
-    the fresh search's box test, so the same pairs give the same forces (bitwise but
-    for the order in which a node's or a segment's pair forces are summed, which
-    follows the search's bucket order; the 4-ply 120 m/s history is identical). ``searches``
-    counts the searches. The persistent state is ``overlap``, computed once from the
-    initial configuration (deterministic, so a restart rebuilding this object from
-    the same Model gets the same one), and the reused candidates, which do not change
-    the forces.
+    Candidate reuse (Verlet lists): ``forces`` searches with every node given a skin
+    σ_p and keeps those candidates while no node has moved farther than its skin since
+    that search and no segment or node has left the surfaces
+    (:func:`~wovenimpact.kernels.contact_broad.candidates_still_valid`); they then hold
+    every pair that could act (the narrow phase repeats the box test of a fresh search
+    and keeps the closest segment per ply and side, so the same pairs give the same
+    forces, bitwise: each node's candidates are listed in segment order whatever the
+    search). The default skin follows each node's speed at the search, σ_p =
+    max(σ_min,p, REUSE_STEPS |v_p| Δt), σ_min,p = SKIN_FLOOR · h_p: a node at rest gets
+    a quarter of its shell's thickness, a moving one what it would cover in
+    REUSE_STEPS steps, so a fast blade and a casing at rest are both searched rarely
+    and the lists hold the next ply, not the whole stack. ``searches`` counts the
+    searches. The persistent state is ``overlap``, computed once from the initial
+    configuration (deterministic, so a restart rebuilding this object from the same
+    Model gets the same one), and the reused candidates, which do not change the forces.
 
     Model (positional): uses ``quads``, ``ply``, ``node_mass``, ``node_ptr``,
     ``node_elem``, ``sections[:, C_THICK]``, ``elem_section`` and ``x0``.
@@ -92,11 +120,9 @@ class ShellContact:
         self_contact: also pair a ply's nodes with its own non-adjacent segments
             (default False: only different plies meet).
         margin: extra inflation of the search boxes (m, default 0).
-        skin: the Verlet skin of candidate reuse (m, ≥ 0; 0 searches at every call).
-            Default: the largest offset h_s, half a shell thickness. Measured on 4
-            plies at 120 m/s (plies one thickness apart, ms per step, 2 threads):
-            skin 0: 14.9; t/5: 11.0; t/2: 9.5; t: 14.2 (the boxes then reach the
-            next ply but one and the candidates grow fivefold).
+        skin: a uniform Verlet skin of candidate reuse: every node may move skin/2
+            (m, ≥ 0; 0 searches at every call). Default (None): the per-node skins
+            that follow the speed (above).
         remove_initial_overlap: measure the initial penetration of each node
             (``overlap``, m) and subtract it from its offset, so that the initial gaps
             are ≥ 0 and no force acts at t = 0 (default True). Kept constant.
@@ -166,13 +192,16 @@ class ShellContact:
         on = part != 0
         for c in range(4):
             np.maximum.at(self.h_node, quads[on, c], self.h_seg[on])
+        self.node_ply = node_plies(self.node_ptr, self.node_elem, self.ply)
+        self.slots = np.zeros((nn, CANDIDATE_SLOTS), dtype=np.int64)
         self.node_part = np.zeros(nn, dtype=np.int8)
         self.node_part[quads[on].ravel()] = 1
-        if skin is None:
-            skin = float(self.h_seg[on].max()) if on.any() else 0.0
-        if not (math.isfinite(skin) and skin >= 0.0):
-            raise InputError(f"contact skin = {skin!r} m; valid: ≥ 0")
-        self.skin = float(skin)
+        if skin is not None and not (math.isfinite(skin) and skin >= 0.0):
+            raise InputError(f"contact skin = {skin!r} m; valid: ≥ 0, or unset for the "
+                             "per-node skins that follow the speed")
+        self.skin = None if skin is None else float(skin)
+        self.sigma = np.zeros(nn)  # node skins of the last search (m)
+        self.no_skin = np.zeros(nn)  # zero skins: a search that is not reused
         # the configuration and masks of the last search of forces(); no search yet
         self.x_search = np.zeros((nn, 3))
         self.seg_on_search = np.zeros(ne, dtype=np.int8)
@@ -182,12 +211,10 @@ class ShellContact:
         # fixed-size scratch
         self.seg_on = np.zeros(ne, dtype=np.int8)
         self.node_on = np.zeros(nn, dtype=np.int8)
-        self.box = np.zeros((ne, 6))
+        self.seg_box = np.zeros((ne, N_SEG_BOX))
+        self.seg_plane = np.zeros((ne, N_SEG_PLANE))
         self.seg_geo = np.zeros((ne, N_SEG_GEO))  # the narrow phase's segment table at x
-        self.bucket_ptr = np.zeros(bucket_count(ne) + 1, dtype=np.int64)
-        self.bucket_seg = np.zeros(ne, dtype=np.int64)
-        self.bucket_cell = np.zeros((ne, 3), dtype=np.int64)
-        self.bucket_box = np.zeros((ne, 6))
+        self._alloc_entries(8 * ne)
         self.pair_ptr = np.zeros(nn + 1, dtype=np.int64)
         self.seg_ptr = np.zeros(nn + 1, dtype=np.int64)
         self.cursor = np.zeros(nn, dtype=np.int64)
@@ -195,7 +222,7 @@ class ShellContact:
         self.overlap = np.zeros(nn)
         self.grow_count = 0
         self.n_pairs = 0
-        self.cell = (0.0, 0.0, 0.0)
+        self.cell = 0.0
         if capacity is None:
             capacity = max(64, 8 * int(self.node_part.sum()))
         self._alloc_pairs(capacity)
@@ -203,7 +230,7 @@ class ShellContact:
             x = model.x0 if x_initial is None else np.ascontiguousarray(x_initial, dtype=float)
             contact_masks(np.ones(ne, dtype=np.int8), part, np.ones(nn, dtype=np.int8),
                           self.node_part, self.seg_on, self.node_on)
-            self._search(x, self.margin)
+            self._search(x, self.no_skin)
             segment_geometry(x, self.quads, self.seg_on, self.seg_geo)
             initial_overlap(x, self.quads, self.ply, self.h_node, self.h_seg, self.margin,
                             self.seg_geo, self.pair_ptr, self.pair_seg, self.geo,
@@ -224,23 +251,50 @@ class ShellContact:
         self.pair_e = np.zeros(cap)
         self.seg_entry = np.zeros(4 * cap, dtype=np.int64)
 
-    def _search(self, x, margin: float) -> int:
-        """Candidates at x with boxes inflated by ``margin`` on top of the offsets into
-        pair_ptr/pair_seg (seg_on/node_on set); grows on overflow."""
+    def _alloc_entries(self, capacity: int) -> None:
+        cap = max(64, int(capacity))
+        self.entry_seg = np.zeros(cap, dtype=np.int64)
+        self.entry_cell = np.zeros((cap, 3), dtype=np.int64)
+        self.entry_box = np.zeros((cap, N_SEG_BOX))
+        self.entry_ply = np.zeros(cap, dtype=np.int64)
+        self.bucket_ptr = np.zeros(bucket_count(cap) + 1, dtype=np.int64)
+
+    def _search(self, x, sigma) -> int:
+        """Candidates at x with node skins ``sigma`` into pair_ptr/pair_seg (seg_on and
+        node_on set); the bins and the pair buffers grow on overflow."""
+        segment_boxes(x, self.quads, self.seg_on, self.h_seg, sigma, self.margin,
+                      self.seg_box, self.seg_plane)
+        edge = cell_edge(self.seg_on, self.seg_box)
         while True:
-            n, l0, l1, l2 = find_candidates(
-                x, self.quads, self.ply, self.seg_on, self.node_on, self.h_node, self.h_seg,
-                margin, 0.0, self.self_contact, self.node_ptr, self.node_elem, self.box,
-                self.bucket_ptr, self.bucket_seg, self.bucket_cell, self.bucket_box,
-                self.pair_ptr, self.pair_seg,
+            n = bin_segments(self.seg_on, self.seg_box, self.ply, 1.0 / edge,
+                             self.bucket_ptr, self.entry_seg, self.entry_cell,
+                             self.entry_box, self.entry_ply)
+            if n <= self.entry_seg.shape[0]:
+                break
+            self._alloc_entries(int(1.5 * n))
+            self.grow_count += 1
+        while True:
+            n = query_candidates(
+                x, self.quads, self.ply, self.node_ply, self.node_on, self.h_node, sigma,
+                self.self_contact, self.node_ptr, self.node_elem, self.seg_plane, edge,
+                self.bucket_ptr, self.entry_seg, self.entry_cell, self.entry_box,
+                self.entry_ply, self.slots, self.pair_ptr, self.pair_seg,
             )
             if n <= self.capacity:
                 break
             self._alloc_pairs(int(1.5 * n) + 64)
             self.grow_count += 1
         self.n_pairs = int(n)
-        self.cell = (l0, l1, l2)
+        self.cell = edge
         return self.n_pairs
+
+    def node_skins(self, v, dt: float) -> np.ndarray:
+        """The skins σ_p of a search (class docstring) into ``self.sigma``."""
+        if self.skin is not None:
+            self.sigma[:] = 0.5 * self.skin
+        else:
+            node_skins(v, dt, REUSE_STEPS, self.h_node, SKIN_FLOOR, self.sigma)
+        return self.sigma
 
     def candidates(self, x, elem_alive=None, node_active=None) -> tuple[np.ndarray, np.ndarray]:
         """Candidate pairs (node, segment) at x, node-major (copies; for tests/diagnostics)."""
@@ -248,7 +302,7 @@ class ShellContact:
         alive = np.ones(ne, dtype=np.int8) if elem_alive is None else elem_alive
         active = np.ones(nn, dtype=np.int8) if node_active is None else node_active
         contact_masks(alive, self.elem_part, active, self.node_part, self.seg_on, self.node_on)
-        n = self._search(np.ascontiguousarray(x, dtype=float), self.margin)
+        n = self._search(np.ascontiguousarray(x, dtype=float), self.no_skin)
         self.searched = False  # the lists of forces() are gone
         nodes = np.repeat(np.arange(nn, dtype=np.int64), np.diff(self.pair_ptr))
         return nodes, self.pair_seg[:n].copy()
@@ -261,13 +315,13 @@ class ShellContact:
         contact_masks(elem_alive, self.elem_part, node_active, self.node_part,
                       self.seg_on, self.node_on)
         if not (self.searched and candidates_still_valid(
-                x, self.x_search, self.node_on, self.node_on_search, self.seg_on,
-                self.seg_on_search, self.skin)):
-            self._search(x, self.margin + self.skin)
+                x, self.x_search, self.sigma, self.node_on, self.node_on_search,
+                self.seg_on, self.seg_on_search)):
+            self._search(x, self.node_skins(v, dt))
             self.x_search[:] = x
             self.seg_on_search[:] = self.seg_on
             self.node_on_search[:] = self.node_on
-            self.searched = self.skin > 0.0
+            self.searched = self.skin is None or self.skin > 0.0
             self.searches += 1
         segment_geometry(x, self.quads, self.seg_on, self.seg_geo)
         penalty_forces(

@@ -2,16 +2,26 @@
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from wovenimpact.contact import ShellContact
+from wovenimpact.contact import ShellContact, node_plies
 from wovenimpact.jit import set_threads
 from wovenimpact.kernels import shell_layout as SL
-from wovenimpact.kernels.contact_broad import bucket_count, find_candidates
+from wovenimpact.kernels.contact_broad import (
+    N_SEG_BOX,
+    N_SEG_PLANE,
+    bin_segments,
+    bucket_count,
+    cell_edge,
+    query_candidates,
+    segment_boxes,
+)
 from wovenimpact.materials.metal import MetalParameters
 from wovenimpact.model import Section, build_model
 from wovenimpact.model.mesh import plate_mesh
@@ -144,15 +154,27 @@ def test_node_sliding_across_segment_boundaries_feels_a_continuous_force():
 # --- broad phase against brute force ------------------------------------------------------
 
 
-def brute_force_candidates(x, quads, ply, seg_on, node_on, h_node, h_seg, margin, self_contact,
-                           node_ptr, node_elem):
+def brute_force_candidates(x, quads, ply, seg_on, node_on, h_node, h_seg, sigma, margin,
+                           self_contact, node_ptr, node_elem, tol=0.0, plane=True):
+    """The pairs of the broad phase's criterion (contact_broad docstring) by testing every
+    node against every segment: box inflated by r + σ_p + σ_s (+ tol), and with
+    ``plane`` the plane test |n·p − d| ≤ r + σ_p + σ_s + w (+ tol)."""
     pairs = set()
-    lo = x[quads].min(axis=1)
-    hi = x[quads].max(axis=1)
+    xq = x[quads]
+    lo, hi = xq.min(axis=1), xq.max(axis=1)
+    n = np.cross(xq[:, 2] - xq[:, 0], xq[:, 3] - xq[:, 1])
+    length = np.linalg.norm(n, axis=1)
+    n = np.where(length[:, None] > 0, n / np.where(length > 0, length, 1.0)[:, None], 0.0)
+    heights = np.einsum("sd,sid->si", n, xq)
+    d = heights.mean(axis=1)
+    w = np.where(length > 0, np.abs(heights - d[:, None]).max(axis=1), np.inf)
+    sig_s = sigma[quads].max(axis=1)
     for p in np.flatnonzero(node_on):
         for s in np.flatnonzero(seg_on):
-            r = h_seg[s] + h_node[p] + margin
+            r = h_seg[s] + h_node[p] + margin + sigma[p] + sig_s[s] + tol
             if not (np.all(lo[s] - r <= x[p]) and np.all(x[p] <= hi[s] + r)):
+                continue
+            if plane and abs(n[s] @ x[p] - d[s]) > r + w[s]:
                 continue
             excluded = False
             for e in node_elem[node_ptr[p]:node_ptr[p + 1]]:
@@ -165,19 +187,63 @@ def brute_force_candidates(x, quads, ply, seg_on, node_on, h_node, h_seg, margin
     return pairs
 
 
+class RawSearch:
+    """The broad-phase kernels driven on raw arrays, the way ShellContact drives them."""
+
+    def __init__(self, mesh, h_node, h_seg, margin, self_contact, capacity=0):
+        from wovenimpact.model.model import node_element_map
+
+        ne, nn = mesh.n_elems, mesh.n_nodes
+        self.mesh, self.h_node, self.h_seg = mesh, h_node, h_seg
+        self.margin, self.self_contact = margin, self_contact
+        self.ptr, self.elem, _ = node_element_map(mesh.quads, nn)
+        self.node_ply = node_plies(self.ptr, self.elem, mesh.ply)
+        self.seg_box, self.seg_plane = np.zeros((ne, N_SEG_BOX)), np.zeros((ne, N_SEG_PLANE))
+        self.slots = np.zeros((nn, 4), np.int64)  # few: nodes overflow them too
+        self.pair_ptr = np.zeros(nn + 1, np.int64)
+        self.pair_seg = np.zeros(capacity, np.int64)
+
+    def __call__(self, x, seg_on, node_on, sigma):
+        m = self.mesh
+        segment_boxes(x, m.quads, seg_on, self.h_seg, sigma, self.margin, self.seg_box,
+                      self.seg_plane)
+        edge = cell_edge(seg_on, self.seg_box)
+        n_entries = bin_segments(seg_on, self.seg_box, m.ply, 1.0 / edge,
+                                 np.zeros(65, np.int64), np.zeros(0, np.int64),
+                                 np.zeros((0, 3), np.int64), np.zeros((0, 6)),
+                                 np.zeros(0, np.int64))  # too small: counts only
+        bins = (np.zeros(bucket_count(n_entries) + 1, np.int64), np.zeros(n_entries, np.int64),
+                np.zeros((n_entries, 3), np.int64), np.zeros((n_entries, 6)),
+                np.zeros(n_entries, np.int64))
+        assert bin_segments(seg_on, self.seg_box, m.ply, 1.0 / edge, *bins) == n_entries
+        args = (x, m.quads, m.ply, self.node_ply, node_on, self.h_node, sigma,
+                self.self_contact, self.ptr, self.elem, self.seg_plane, edge, *bins,
+                self.slots, self.pair_ptr)
+        n = query_candidates(*args, self.pair_seg)
+        if n > self.pair_seg.shape[0]:  # overflow: nothing written but the count
+            self.pair_seg = np.full(n, -1, np.int64)
+            assert query_candidates(*args, self.pair_seg) == n
+        nodes = np.repeat(np.arange(m.n_nodes), np.diff(self.pair_ptr))
+        return list(zip(nodes.tolist(), self.pair_seg[:n].tolist()))
+
+
 @settings(max_examples=60, deadline=None)
 @given(
     seed=st.integers(0, 2**32 - 1),
     n_plies=st.integers(1, 3),
     amp=st.floats(0.0, 1.5),
     h=st.floats(0.0, 0.6),
+    skin=st.floats(0.0, 0.5),
     margin=st.floats(0.0, 0.3),
     self_contact=st.booleans(),
     dead=st.floats(0.0, 0.5),
 )
-def test_bucket_search_equals_brute_force(seed, n_plies, amp, h, margin, self_contact, dead):
-    """Random (possibly tangled) plies, offsets, margins, eroded elements and inactive
-    nodes: the hashed-grid search finds exactly the brute-force O(N·M) pairs."""
+def test_bucket_search_equals_brute_force(seed, n_plies, amp, h, skin, margin, self_contact,
+                                          dead):
+    """Random (possibly tangled) plies, offsets, skins, margins, eroded elements and
+    inactive nodes: the hashed-grid search finds the brute-force O(N·M) pairs of its
+    criterion (box and plane tests), each once, a node's segments in increasing order:
+    all of them, and none beyond the rounding allowance of its tests."""
     rng = np.random.default_rng(seed)
     size = 1e-3
     mesh = plate_mesh(4e-3, size, plies=n_plies, spacing=0.5e-3, quarter=True)
@@ -185,24 +251,51 @@ def test_bucket_search_equals_brute_force(seed, n_plies, amp, h, margin, self_co
     ne, nn = mesh.n_elems, mesh.n_nodes
     h_seg = rng.uniform(0.0, h * size, ne)
     h_node = rng.uniform(0.0, h * size, nn)
+    sigma = rng.uniform(0.0, skin * size, nn)
     seg_on = (rng.uniform(size=ne) >= dead).astype(np.int8)
     node_on = (rng.uniform(size=nn) >= dead / 2).astype(np.int8)
-    ptr, elem, _ = node_element_map(mesh.quads, nn)
-    args = (x, mesh.quads, mesh.ply, seg_on, node_on, h_node, h_seg, margin * size, 0.0,
-            self_contact, ptr, elem, np.zeros((ne, 6)), np.zeros(bucket_count(ne) + 1, np.int64),
-            np.zeros(ne, np.int64), np.zeros((ne, 3), np.int64), np.zeros((ne, 6)),
-            np.zeros(nn + 1, np.int64))
-    n, *_ = find_candidates(*args, np.zeros(0, np.int64))  # no capacity: counts only
-    pair_seg = np.full(n, -1, np.int64)
-    pair_ptr = args[-1]
-    n2, *_ = find_candidates(*args, pair_seg)
-    assert n2 == n and pair_ptr[-1] == n
-    nodes = np.repeat(np.arange(nn), np.diff(pair_ptr))
-    found = list(zip(nodes.tolist(), pair_seg.tolist()))
+    search = RawSearch(mesh, h_node, h_seg, margin * size, self_contact)
+    found = search(x, seg_on, node_on, sigma)
     assert len(found) == len(set(found))  # no duplicates
-    expect = brute_force_candidates(x, mesh.quads, mesh.ply, seg_on, node_on, h_node, h_seg,
-                                    margin * size, self_contact, ptr, elem)
-    assert set(found) == expect
+    assert found == sorted(found)  # node-major, each node's segments in increasing order
+    brute = (x, mesh.quads, mesh.ply, seg_on, node_on, h_node, h_seg, sigma, margin * size,
+             self_contact, search.ptr, search.elem)
+    assert brute_force_candidates(*brute) <= set(found)
+    assert set(found) <= brute_force_candidates(*brute, tol=1e-6 * size)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2, 3])
+def test_the_plane_test_drops_no_pair_that_acts(seed):
+    """Tangled plies at random velocities: the forces of the search's candidates (box and
+    plane tests) are bitwise those of every pair in the narrow phase's box, the
+    candidate list of the plain box test (a superset): the plane test only drops pairs
+    that cannot act, while it drops many on curved or tilted plies."""
+    mesh, model, x, rng = random_overlapping_plies(seed, n_plies=4)
+    c, s = math.cos(0.7), math.sin(0.7)  # plies tilted 40° about y: loose boxes
+    x = x @ np.array([[c, 0.0, -s], [0.0, 1.0, 0.0], [s, 0.0, c]])
+    v = rng.normal(0.0, 10.0, x.shape)
+    contact = ShellContact(model, friction=0.2, remove_initial_overlap=False, skin=0.0)
+    f, energy, n = contact_forces(contact, model, x, v=v)
+    listed = contact.n_pairs
+    ne, nn = model.n_elems, model.n_nodes
+    box_only = sorted(brute_force_candidates(
+        x, contact.quads, contact.ply, np.ones(ne, np.int8), np.ones(nn, np.int8),
+        contact.h_node, contact.h_seg, np.zeros(nn), 0.0, False, contact.node_ptr,
+        contact.node_elem, plane=False))
+    assert len(box_only) > listed
+    nodes, segs = np.array(box_only, dtype=np.int64).T
+    ptr = np.zeros(nn + 1, np.int64)
+    ptr[1:] = np.cumsum(np.bincount(nodes, minlength=nn))
+    contact._alloc_pairs(len(segs))
+    contact.pair_ptr[:], contact.pair_seg[:len(segs)] = ptr, segs
+    contact.n_pairs = len(segs)
+    contact.searched = True  # keep the planted lists: every node within its skin
+    contact.sigma[:] = math.inf
+    contact.x_search[:] = x
+    contact.seg_on_search[:] = 1
+    contact.node_on_search[:] = 1
+    f2, energy2, n2 = contact_forces(contact, model, x, v=v)
+    assert n > 0 and (n2, energy2) == (n, energy) and f2.tobytes() == f.tobytes()
 
 
 def test_buffers_grow_on_overflow():
@@ -401,17 +494,18 @@ def test_damped_plies_collide_plastically():
     assert abs(restitution[-1]) < 0.01
 
 
-def test_reused_candidates_give_the_forces_of_a_search_at_every_step():
+@pytest.mark.parametrize("skin", [None, 0.25e-3])
+def test_reused_candidates_give_the_forces_of_a_search_at_every_step(skin):
     """Verlet-list reuse changes nothing: two plies closing at 40 m/s while sliding
     (friction 0.2, a shear velocity field) are stepped with the forces of a contact that
-    reuses its candidates (default skin) and, side by side, one that searches at every
-    call (skin 0); at every step both see the same (x, v) and give bitwise the same
-    forces, energy and active pairs, while the reusing one searched far less often."""
+    reuses its candidates (default per-node skins, or a uniform one) and, side by side,
+    one that searches at every call (skin 0); at every step both see the same (x, v)
+    and give bitwise the same forces, energy and active pairs, while the reusing one
+    searched far less often."""
     t, V = 0.5e-3, 20.0
     mesh, model = plies_model(spacing=t + 0.05e-3, thickness=t)
-    reuse = ShellContact(model, friction=0.2, remove_initial_overlap=False)
+    reuse = ShellContact(model, friction=0.2, remove_initial_overlap=False, skin=skin)
     fresh = ShellContact(model, friction=0.2, remove_initial_overlap=False, skin=0.0)
-    assert reuse.skin > 0.0
     x = model.x0.copy()
     v = np.zeros_like(x)
     top = x[:, 2] > x[:, 2].mean()  # the upper ply's nodes

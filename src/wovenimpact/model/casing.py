@@ -146,7 +146,7 @@ def blade_mesh(
             raise InputError(f"blade {label} = {c!r} m must be > 0")
     n_in = _divisions(crack_radius - root_radius, element_size, "blade hub length")
     n_out = _divisions(tip_radius - crack_radius, element_size, "blade fragment length")
-    n_c = _divisions(max(root_chord, tip_chord), element_size, "blade chord")
+    n_c = _divisions(min(root_chord, tip_chord), element_size, "blade chord")
     r = np.concatenate([np.linspace(root_radius, crack_radius, n_in + 1),
                         np.linspace(crack_radius, tip_radius, n_out + 1)[1:]])
     u = np.linspace(-0.5, 0.5, n_c + 1)

@@ -161,3 +161,26 @@ def rigid_contact_forces(
         force[i, 1] = fy
         force[i, 2] = fz
         energy[i] = 0.5 * k * gap * gap
+
+
+@kernel
+def add_body_forces(x, centre, f_body, f_con):
+    """f_con += f_body (the body's forces on the nodes), and the resultant force and
+    torque about ``centre`` of the nodes' forces on the body, −Σ f_i and −Σ (x_i − c) × f_i:
+    one serial pass in node order (deterministic), no temporary arrays."""
+    fx = fy = fz = tx = ty = tz = 0.0
+    for i in range(x.shape[0]):
+        gx, gy, gz = f_body[i, 0], f_body[i, 1], f_body[i, 2]
+        if gx == 0.0 and gy == 0.0 and gz == 0.0:
+            continue
+        f_con[i, 0] += gx
+        f_con[i, 1] += gy
+        f_con[i, 2] += gz
+        ax, ay, az = x[i, 0] - centre[0], x[i, 1] - centre[1], x[i, 2] - centre[2]
+        fx -= gx
+        fy -= gy
+        fz -= gz
+        tx -= ay * gz - az * gy
+        ty -= az * gx - ax * gz
+        tz -= ax * gy - ay * gx
+    return fx, fy, fz, tx, ty, tz

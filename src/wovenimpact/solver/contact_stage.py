@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from wovenimpact.kernels import rigid_body as RB
-from wovenimpact.kernels.contact_rigid import rigid_contact_forces
+from wovenimpact.kernels.contact_rigid import add_body_forces, rigid_contact_forces
 from wovenimpact.kernels.gather import nodes_with_live_elements, node_sum
 from wovenimpact.kernels.rigid_body import advance_body
 
@@ -99,14 +99,14 @@ def contact_forces(model, state, cb: ContactBuffers, dt: float, elem_alive,
             p[RB.BP_REACH] + float(model.node_offset.max()), cb.f_body, cb.e_body,
         )
         cb.penalty_energy += node_sum(cb.e_body)
-        cb.f_con += cb.f_body
-        force = -cb.f_body.sum(axis=0)
+        fx, fy, fz, tx, ty, tz = add_body_forces(state.x, row[RB.B_X:RB.B_X + 3], cb.f_body,
+                                                 cb.f_con)
+        force = np.array([fx, fy, fz])
         if p[RB.BP_AXIAL_ONLY]:  # symmetry planes through the axis: no torque, no drift
             force = (force @ axis) * axis
             torque = np.zeros(3)
         else:
-            arm = state.x - row[RB.B_X:RB.B_X + 3]
-            torque = -np.cross(arm, cb.f_body).sum(axis=0)
+            torque = np.array([tx, ty, tz])
         resultants.append((force, torque))
     if cb.shells is not None:
         cb.shell_energy, cb.shell_pairs = cb.shells.forces(

@@ -85,7 +85,8 @@ def main(argv: list[str]) -> None:
         line = (f"element {e} ({names[e]}, ply {model.ply[e]}): W {a['work'][e]:.3f} J, "
                 f"ΔU {a['delta_u'][e]:.3f} J, gap {gap[e]:.3f} J")
         kind = model.mat_kind[int(model.sections[model.elem_section[e], SL.C_MAT])]
-        n_in = 4 if int(model.sections[model.elem_section[e], SL.C_INPLANE]) == SL.MEMBRANE_FULL else 1
+        section = model.sections[model.elem_section[e]]
+        n_in = 4 if int(section[SL.C_INPLANE]) == SL.MEMBRANE_FULL else 1
         if kind == SL.MAT_FABRIC:
             pts = state.mat[e, :n_in * width].reshape(n_in, width)
             line += (f"; λ_w,f {np.round(pts[:, FL.S_LAMBDA:FL.S_LAMBDA + 2], 2).tolist()}, "

@@ -151,46 +151,45 @@ def bin_segments(seg_on, seg_box, ply, inv_edge, bucket_ptr, entry_seg, entry_ce
                  entry_ply):
     """Every live segment into every cell its padded box overlaps, bucketed by the
     cell hash: entries of bucket b are entry_seg/entry_cell/entry_box/entry_ply[
-    bucket_ptr[b]:bucket_ptr[b + 1]] (segment, cell, padded box, ply: a bucket is
-    scanned as one stream), in segment order. Returns the number of entries; when it exceeds the capacity
-    of entry_seg nothing but the count is written (the caller grows and calls again)."""
+    bucket_ptr[b]:bucket_ptr[b + 1]] (segment, cell, padded box, ply: a bucket is scanned
+    as one stream), in segment order. Returns the number of entries; when it exceeds the
+    capacity of entry_seg nothing but the count is written (the caller grows and calls
+    again)."""
     n_buckets = bucket_ptr.shape[0] - 1
     mask = n_buckets - 1
     for b in range(n_buckets + 1):
         bucket_ptr[b] = 0
     n = 0
-    for s in range(seg_on.shape[0]):
-        if seg_on[s] == 0:
-            continue
-        for cx in range(cell_of(seg_box[s, 0], inv_edge), cell_of(seg_box[s, 3], inv_edge) + 1):
-            for cy in range(cell_of(seg_box[s, 1], inv_edge), cell_of(seg_box[s, 4], inv_edge) + 1):
-                for cz in range(cell_of(seg_box[s, 2], inv_edge),
-                                cell_of(seg_box[s, 5], inv_edge) + 1):
-                    bucket_ptr[cell_bucket(cx, cy, cz, mask) + 1] += 1
-                    n += 1
-    if n > entry_seg.shape[0]:
-        return n
-    for b in range(n_buckets):
-        bucket_ptr[b + 1] += bucket_ptr[b]
-    # fill in segment order, bucket_ptr[b] serving as the cursor of bucket b (it ends
-    # at the end of b, i.e. the start of b + 1), then shift back by one
-    for s in range(seg_on.shape[0]):
-        if seg_on[s] == 0:
-            continue
-        for cx in range(cell_of(seg_box[s, 0], inv_edge), cell_of(seg_box[s, 3], inv_edge) + 1):
-            for cy in range(cell_of(seg_box[s, 1], inv_edge), cell_of(seg_box[s, 4], inv_edge) + 1):
-                for cz in range(cell_of(seg_box[s, 2], inv_edge),
-                                cell_of(seg_box[s, 5], inv_edge) + 1):
-                    b = cell_bucket(cx, cy, cz, mask)
-                    k = bucket_ptr[b]
-                    entry_seg[k] = s
-                    entry_cell[k, 0] = cx
-                    entry_cell[k, 1] = cy
-                    entry_cell[k, 2] = cz
-                    for c in range(N_SEG_BOX):
-                        entry_box[k, c] = seg_box[s, c]
-                    entry_ply[k] = ply[s]
-                    bucket_ptr[b] = k + 1
+    # pass 0 counts per bucket; pass 1 fills in segment order, bucket_ptr[b] serving as
+    # the cursor of bucket b (it ends at the end of b, i.e. the start of b + 1)
+    for fill in range(2):
+        for s in range(seg_on.shape[0]):
+            if seg_on[s] == 0:
+                continue
+            for cx in range(cell_of(seg_box[s, 0], inv_edge), cell_of(seg_box[s, 3], inv_edge) + 1):
+                for cy in range(cell_of(seg_box[s, 1], inv_edge),
+                                cell_of(seg_box[s, 4], inv_edge) + 1):
+                    for cz in range(cell_of(seg_box[s, 2], inv_edge),
+                                    cell_of(seg_box[s, 5], inv_edge) + 1):
+                        b = cell_bucket(cx, cy, cz, mask)
+                        if fill == 0:
+                            bucket_ptr[b + 1] += 1
+                            n += 1
+                            continue
+                        k = bucket_ptr[b]
+                        entry_seg[k] = s
+                        entry_cell[k, 0] = cx
+                        entry_cell[k, 1] = cy
+                        entry_cell[k, 2] = cz
+                        for c in range(N_SEG_BOX):
+                            entry_box[k, c] = seg_box[s, c]
+                        entry_ply[k] = ply[s]
+                        bucket_ptr[b] = k + 1
+        if fill == 0:
+            if n > entry_seg.shape[0]:
+                return n
+            for b in range(n_buckets):
+                bucket_ptr[b + 1] += bucket_ptr[b]
     for b in range(n_buckets, 0, -1):  # shift back: bucket_ptr[b] = start of b
         bucket_ptr[b] = bucket_ptr[b - 1]
     bucket_ptr[0] = 0

@@ -166,8 +166,8 @@ def rigid_contact_forces(
 @kernel
 def add_body_forces(x, centre, f_body, f_con):
     """f_con += f_body (the body's forces on the nodes), and the resultant force and
-    torque about ``centre`` of the nodes' forces on the body, −Σ f_i and −Σ (x_i − c) × f_i:
-    one serial pass in node order (deterministic), no temporary arrays."""
+    torque about ``centre`` of the nodes' forces on the body, −Σ f_i and
+    −Σ (x_i − c) × f_i: one serial pass in node order (deterministic), no temporaries."""
     fx = fy = fz = tx = ty = tz = 0.0
     for i in range(x.shape[0]):
         gx, gy, gz = f_body[i, 0], f_body[i, 1], f_body[i, 2]

@@ -406,6 +406,34 @@ def full_membrane(
             m_xy * inv, fx, fy)
 
 
+@inline_kernel
+def warp_forces(fx, fy, lx, ly, lz, area):
+    """Normal corner forces that make the membrane corner forces (fx, fy) of a warped
+    element the gradient of its membrane energy (theory §4, "Warped elements").
+
+    The membrane energy U depends on the corners' coordinates in the element's frame
+    (x̂_I, ŷ_I), and the frame turns with the nodes: its normal e3 ∥ d13 × d24. So
+    δU = Σ_I f_I · δx_I − δθ · M, with f_I = f_x,I e1 + f_y,I e2 the in-plane forces,
+    M = Σ_I d_I × f_I their moment about the centroid (d_I = (x̂_I, ŷ_I, z_I), z_I the
+    warp) and δθ the frame's rotation. The diagonals lie in the element's plane, so the
+    tilt δθ_1 = −e2·δe3, δθ_2 = e1·δe3 with δe3 = (1 − e3 e3ᵀ)(δd13 × d24 + d13 ×
+    δd24)/|n| depends on the corners' normal motions alone:
+        ∂θ_1/∂z = (a_1, −b_1, −a_1, b_1)/2A,   ∂θ_2/∂z = (a_2, −b_2, −a_2, b_2)/2A
+    at corners 1…4, a = d24, b = d13 in the frame, |n| = 2A. The corner forces of U are
+    then f_I − (M_1 ∂θ_1/∂z_I + M_2 ∂θ_2/∂z_I) e3, with M_1 = −Σ z_I f_y,I and
+    M_2 = Σ z_I f_x,I (the in-plane turn's M_3 = Σ x̂ f_y − ŷ f_x is zero: the membrane
+    stress is symmetric). A flat element (z = 0) gets none. The rate-form hourglass
+    forces, booked in the frame, are left as they are. Returns the four normal forces."""
+    m1 = m2 = 0.0
+    for i in range(4):
+        m1 -= lz[i] * fy[i]
+        m2 += lz[i] * fx[i]
+    inv = 0.5 / area
+    a1, a2 = (lx[3] - lx[1]) * inv, (ly[3] - ly[1]) * inv
+    b1, b2 = (lx[2] - lx[0]) * inv, (ly[2] - ly[0]) * inv
+    return (-(m1 * a1 + m2 * a2), m1 * b1 + m2 * b2, m1 * a1 + m2 * a2, -(m1 * b1 + m2 * b2))
+
+
 @kernel
 def shell_force(
     e, x, v, omega, dt, quads, area0, ref_grad, gauss_grad, gauss_weight, sec, sections,
@@ -632,11 +660,19 @@ def shell_force(
 
     # 6. corner forces (membrane, shear, hourglass) and moments in the local frame,
     # turned to global axes
+    cx = 0.25 * (px[0] + px[1] + px[2] + px[3])
+    cy = 0.25 * (py[0] + py[1] + py[2] + py[3])
+    cz = 0.25 * (pz[0] + pz[1] + pz[2] + pz[3])
+    lz = ((px[0] - cx) * e3x + (py[0] - cy) * e3y + (pz[0] - cz) * e3z,
+          (px[1] - cx) * e3x + (py[1] - cy) * e3y + (pz[1] - cz) * e3z,
+          (px[2] - cx) * e3x + (py[2] - cy) * e3y + (pz[2] - cz) * e3z,
+          (px[3] - cx) * e3x + (py[3] - cy) * e3y + (pz[3] - cz) * e3z)
+    fzs = warp_forces(mf_x, mf_y, lx, ly, lz, area)
     fsum = 0.0
     for i in range(4):
         fx = mf_x[i] + gam[i] * hg0
         fy = mf_y[i] + gam[i] * hg1
-        fz = area * (b1[i] * qx + b2[i] * qy) + gam[i] * hg2
+        fz = area * (b1[i] * qx + b2[i] * qy) + gam[i] * hg2 + fzs[i]
         mx = area * (-b2[i] * myy - b1[i] * mxy - 0.25 * qy) + gam[i] * hg3
         my = area * (b1[i] * mxx + b2[i] * mxy + 0.25 * qx) + gam[i] * hg4
         gx = fx * e1x + fy * e2x + fz * e3x

@@ -10,7 +10,9 @@ positions x^n and the half-step velocities v^{n−1/2}, ω^{n−1/2}:
    kernel, or an elastic St Venant–Kirchhoff membrane) and the nodal forces are
    f̂_I = Σ_g w_g P_g ∂N_I/∂X|_g with P = J N F⁻ᵀ — a total-Lagrangian membrane,
    work-conjugate to the material's stored energy — at the 2×2 Gauss points
-   (``full_membrane``, theory §4.5) or at the centre alone (w = A0; reduced);
+   (``full_membrane``, theory §4.5) or at the centre alone (w = A0; reduced); on a
+   warped element, normal corner forces for the frame's tilt make them the exact
+   gradient of the membrane energy (``warp_forces``, theory §4 "Warped elements");
 3. bending and transverse shear in rate form (Belytschko–Lin–Tsay 1984):
    κ̇_x = b1·θ̇_y, κ̇_y = −b2·θ̇_x, 2κ̇_xy = b2·θ̇_y − b1·θ̇_x,
    γ̇_xz = b1·v_z + ¼Σθ̇_y, γ̇_yz = b2·v_z − ¼Σθ̇_x (zero for any rigid

@@ -275,7 +275,7 @@ def penalty_forces(
             coefficient μ (0: frictionless).
         dt: the time step the forces are for (s), > 0.
         seg: (n_elems, N_SEG_GEO) the segments' table at x (:func:`segment_geometry`).
-        pair_ptr, pair_seg: candidates (contact_broad.find_candidates).
+        pair_ptr, pair_seg: candidates (contact_broad.query_candidates).
         geo: (capacity, N_GEO), pair_on: (capacity,) int8: scratch / written.
         pair_f: (capacity, 3) written for the active pairs (pair_on ≠ 0): force on the
             node of each pair (N); rows of the other pairs are left as they were (no

@@ -132,7 +132,8 @@ def corotational_frame(px, py, pz):
     local coordinates about the centroid; area A = ½ (x̂31 ŷ42 − x̂42 ŷ31);
     b1 = ∂N/∂x̂ = (ŷ24, ŷ31, ŷ42, ŷ13)/2A, b2 = ∂N/∂ŷ = (x̂42, x̂13, x̂24, x̂31)/2A.
 
-    Returns ((e1), (e2), (e3), (x̂, ŷ), A, (b1, b2)); A is 0 or NaN if degenerate.
+    Returns ((e1), (e2), (e3), (x̂, ŷ), A, (b1, b2), ẑ), ẑ the corners' warp off the
+    plane; A is 0 or NaN if degenerate.
     """
     d13x, d13y, d13z = px[2] - px[0], py[2] - py[0], pz[2] - pz[0]
     d24x, d24y, d24z = px[3] - px[1], py[3] - py[1], pz[3] - pz[1]
@@ -164,9 +165,13 @@ def corotational_frame(px, py, pz):
     inv2a = 0.5 / area
     b1 = ((y1 - y3) * inv2a, (y2 - y0) * inv2a, (y3 - y1) * inv2a, (y0 - y2) * inv2a)
     b2 = ((x3 - x1) * inv2a, (x0 - x2) * inv2a, (x1 - x3) * inv2a, (x2 - x0) * inv2a)
+    z = ((px[0] - cx) * e3x + (py[0] - cy) * e3y + (pz[0] - cz) * e3z,
+         (px[1] - cx) * e3x + (py[1] - cy) * e3y + (pz[1] - cz) * e3z,
+         (px[2] - cx) * e3x + (py[2] - cy) * e3y + (pz[2] - cz) * e3z,
+         (px[3] - cx) * e3x + (py[3] - cy) * e3y + (pz[3] - cz) * e3z)
     return (
         (e1x, e1y, e1z), (e2x, e2y, e2z), (e3x, e3y, e3z),
-        ((x0, x1, x2, x3), (y0, y1, y2, y3)), area, (b1, b2),
+        ((x0, x1, x2, x3), (y0, y1, y2, y3)), area, (b1, b2), z,
     )
 
 
@@ -662,14 +667,7 @@ def shell_force(
 
     # 6. corner forces (membrane, shear, hourglass) and moments in the local frame,
     # turned to global axes
-    cx = 0.25 * (px[0] + px[1] + px[2] + px[3])
-    cy = 0.25 * (py[0] + py[1] + py[2] + py[3])
-    cz = 0.25 * (pz[0] + pz[1] + pz[2] + pz[3])
-    lz = ((px[0] - cx) * e3x + (py[0] - cy) * e3y + (pz[0] - cz) * e3z,
-          (px[1] - cx) * e3x + (py[1] - cy) * e3y + (pz[1] - cz) * e3z,
-          (px[2] - cx) * e3x + (py[2] - cy) * e3y + (pz[2] - cz) * e3z,
-          (px[3] - cx) * e3x + (py[3] - cy) * e3y + (pz[3] - cz) * e3z)
-    fzs = warp_forces(mf_x, mf_y, lx, ly, lz, area)
+    fzs = warp_forces(mf_x, mf_y, lx, ly, frame[6], area)
     fsum = 0.0
     for i in range(4):
         fx = mf_x[i] + gam[i] * hg0

@@ -676,15 +676,13 @@ def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
 
     A thin wrapper of :func:`fabric_point` (which loop kernels call directly).
     """
-    p_table = p.reshape((1, p.shape[0]))  # a view: the row may carry a 1.6 MB table
-    row_in = np.empty((1, N_STATE))
-    row_in[0, :] = s_in
-    row_out = np.empty((1, N_STATE))
+    p_table = p.reshape((1, p.shape[0]))  # views (a kernel allocates nothing, jit.kernel):
+    row_in = s_in.reshape((1, s_in.shape[0]))  # the row may carry a 1.6 MB table
+    row_out = s_out.reshape((1, s_out.shape[0]))
     status, stiff, n_xx, n_yy, n_xy = fabric_point(
         p_table, 0, f_old[0, 0], f_old[0, 1], f_old[1, 0], f_old[1, 1],
         f_new[0, 0], f_new[0, 1], f_new[1, 0], f_new[1, 1], row_in, row_out, 0,
     )
-    s_out[:] = row_out[0, :]
     n_out[0] = n_xx
     n_out[1] = n_yy
     n_out[2] = n_xy

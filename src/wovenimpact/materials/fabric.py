@@ -67,7 +67,7 @@ class FabricOptions:
     # crossover evaluation (theory §1.9): "table" interpolates the tabulated stored
     # energy while both families are intact and inside the table (fibre frame only),
     # "exact" always runs the height solve (the reference)
-    crossover: Literal["table", "exact"] = "exact"
+    crossover: Literal["table", "exact"] = "table"
 
 
 @dataclass(frozen=True)

@@ -110,8 +110,19 @@ def layer_energies(model, state) -> list[float]:
     """Energy each casing layer holds (J, innermost first): the kinetic energy of its
     nodes plus the energy of its elements (stored, hourglass, plastic; for eroded
     elements the energy they held at erosion), as ``quantities.ply_energies`` counts a
-    ply's."""
+    ply's. Not what it absorbed: energy its broken yarns dissipated and the kinetic
+    energy of its eroded pieces are gone from it (:func:`layer_absorbed_energies`)."""
     return [held_energy(model, state, elems) for elems in layer_elements(model)]
+
+
+def layer_absorbed_energies(model, state) -> list[float]:
+    """Energy each casing layer absorbed (J, innermost first): the work the contact
+    forces did on its nodes, ``State.contact_work`` summed over them (theory §8.3). Energy
+    reaches a layer only through contact (its clamped nodes do not move), so this is what
+    it holds, what it dissipated and what its eroded pieces carried away; a layer that
+    passes energy on to the next one through contact counts only what it kept."""
+    return [float(np.sum(state.contact_work[np.unique(model.quads[elems])]))
+            for elems in layer_elements(model)]
 
 
 def layer_materials(model) -> list[str]:
@@ -127,10 +138,10 @@ def layer_materials(model) -> list[str]:
 
 
 def energy_per_material(model, state) -> dict[str, float]:
-    """:func:`layer_energies` summed over the layers of each material (J): what the
-    aluminium and what the Kevlar of a hybrid casing absorbed."""
+    """:func:`layer_absorbed_energies` summed over the layers of each material (J): what
+    the aluminium and what the Kevlar of a hybrid casing absorbed."""
     out: dict[str, float] = {}
-    for name, e in zip(layer_materials(model), layer_energies(model, state)):
+    for name, e in zip(layer_materials(model), layer_absorbed_energies(model, state)):
         out[name] = out.get(name, 0.0) + e
     return out
 
@@ -182,7 +193,8 @@ def casing_summary(model, state, h: dict) -> dict:
         # the largest over the history rows and the end state (a bulge that springs back
         # is still the casing's largest deflection)
         "max_bulge_m": max([outer_layer_bulge(model, state), *bulge.tolist()]),
-        "absorbed_energy_per_layer_J": layer_energies(model, state),
+        "absorbed_energy_per_layer_J": layer_absorbed_energies(model, state),
+        "held_energy_per_layer_J": layer_energies(model, state),
         "absorbed_energy_per_material_J": energy_per_material(model, state),
         "casing_mass_kg": mass,
         "casing_mass_per_area_kg_per_m2": mass / area * len(layers) if area else None,

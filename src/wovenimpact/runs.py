@@ -80,8 +80,10 @@ IMPACT_COLUMNS = ("impactor_velocity_m_per_s", "impactor_displacement_m", "conta
                   "impactor_kinetic_energy_part_J")
 METAL_COLUMNS = ("plastic_work_part_J",)  # models with a J2 (metal) section
 MASS_SCALING_COLUMNS = ("added_mass_part_kg", "mass_scaling_energy_part_J", "mass_scaled_elements")
-SUMMARY_VERSION = 3  # 2: issue 9's outcome rule and energy keys; 3: issue 12's energy
-#                     normalisation and provenance; older summaries are re-run
+SUMMARY_VERSION = 4  # 2: issue 9's outcome rule and energy keys; 3: issue 12's energy
+#                     normalisation and provenance; 4: a casing layer's absorbed energy is
+#                     the contact work it received (held_energy_per_layer_J the old
+#                     figure); older summaries are re-run
 DEFAULT_OUTPUTS = {"history": 1000, "field": 20, "checkpoint": 10}  # per run, if not given
 
 
@@ -477,7 +479,8 @@ IMPACT_SUMMARY_KEYS = ("outcome", "perforated", "residual_velocity_m_per_s",
 CONTAINMENT_SUMMARY_KEYS = ("outcome", "contained", "fragment_exit_speed_m_per_s",
                             "fragment_mass_kg", "fragment_initial_speed_m_per_s", "max_bulge_m",
                             "casing_mass_kg", "casing_mass_per_area_kg_per_m2", "casing_layers",
-                            "absorbed_energy_per_layer_J", "absorbed_energy_per_material_J")
+                            "absorbed_energy_per_layer_J", "held_energy_per_layer_J",
+                            "absorbed_energy_per_material_J")
 COMMON_SUMMARY_KEYS = (
     "summary_version", "case", "end_time_s", "steps", "elements", "nodes", "first_time_step_s",
     "last_time_step_s", "wall_time_s", "element_cycles", "ns_per_element_cycle",

@@ -9,7 +9,7 @@ steps: after ``n`` steps ``x`` is x^n and ``v``/``omega`` are v^{n−1/2}/ω^{n�
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field, fields
+from dataclasses import MISSING, dataclass, field, fields
 
 import numpy as np
 
@@ -57,6 +57,9 @@ class State:
         f_contact: (n_nodes, 3) contact forces on the nodes at x^n (for their work).
         mass_ratio: (n_elems,) added-mass ratio r_e of mass scaling (kernels.mass_scaling).
         added_mass: (n_nodes,) mass added to each node by mass scaling (kg).
+        contact_work: (n_nodes,) work the contact forces did on each node so far (J,
+            the trapezoid rule of ``force_pair_power``): the energy a node's part took
+            from contact, which it holds, dissipated or carried away when it eroded.
     """
 
     t: float
@@ -76,6 +79,7 @@ class State:
     f_contact: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
     mass_ratio: np.ndarray = field(default_factory=lambda: np.zeros(0))
     added_mass: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    contact_work: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     def copy(self) -> State:
         return State(**{f.name: (getattr(self, f.name).copy() if isinstance(
@@ -89,6 +93,8 @@ class State:
     def from_arrays(cls, data) -> State:
         kw = {}
         for f in fields(cls):
+            if f.name not in data and f.default_factory is not MISSING:
+                continue  # an array added since the file was written: its default
             a = np.asarray(data[f.name])
             kw[f.name] = a.item() if a.ndim == 0 else a.copy()
         kw["step"] = int(kw["step"])
@@ -137,7 +143,8 @@ def initial_state(model, velocity=None, angular_velocity=None) -> State:
     return State(t=0.0, step=0, dt=0.0, x=model.x0.copy(), v=v, omega=w, elem=elem, mat=mat,
                  f_int=np.zeros((n, 6)), f_ext=np.zeros((n, 6)),
                  node_active=np.ones(n, dtype=np.int8), energy=energy, bodies=bodies,
-                 f_contact=np.zeros((n, 3)), mass_ratio=np.zeros(ne), added_mass=np.zeros(n))
+                 f_contact=np.zeros((n, 3)), mass_ratio=np.zeros(ne), added_mass=np.zeros(n),
+                 contact_work=np.zeros(n))
 
 
 def rigid_rotation_velocity(x: np.ndarray, omega, centre=(0.0, 0.0, 0.0)) -> np.ndarray:

@@ -109,6 +109,26 @@ def test_containment_outputs_bulge_layer_and_material_energies_and_fragment_plot
     assert per_material[names[0]] == pytest.approx(per_layer[0], rel=1e-12)  # aluminium
     assert per_material[names[1]] == pytest.approx(per_layer[1] + per_layer[2], rel=1e-12)
     assert sum(per_layer) > 0.0
+    # absorbed = the contact work the layer's nodes received: the run's per-node sums
+    # (final checkpoint) add up to the whole contact work, the blade gave what the layers
+    # took plus what the contact dashpots dissipated and the penalty springs hold
+    from wovenimpact.containment import layer_absorbed_energies
+    from wovenimpact.io.checkpoint import latest_checkpoint, load_checkpoint
+    from wovenimpact.spec.case import load_case
+
+    spec, base = load_case(case, [
+        'run.end_time="300 us"', 'mesh.element_size="10 mm"', "mesh.casing.layers=2",
+        'run.field_interval="150 us"', 'run.checkpoint_interval="300 us"'])
+    model = compile_case(spec, base).model
+    state = load_checkpoint(latest_checkpoint(out / "checkpoints"), model.digest())
+    assert state.t == pytest.approx(summary["end_time_s"], rel=1e-12)
+    assert layer_absorbed_energies(model, state) == pytest.approx(per_layer, rel=1e-12)
+    total = float(np.sum(state.contact_work))
+    assert total == pytest.approx(-summary["contact_energy_J"], rel=1e-9)
+    assert int(model.ply.max()) == 3  # layers 0–2, then the blade
+    blade = float(np.sum(state.contact_work[np.unique(model.quads[model.ply == 3])]))
+    assert blade < -sum(per_layer) < 0.0  # the fragment lost more than the casing took
+    assert sum(per_layer) + blade == pytest.approx(total, rel=1e-9)
     assert (out / "plots" / "fragment.png").exists()
     assert not (out / "plots" / "ply_deflection.png").exists()
     # the VTU series: casing and blade as the blocks (parts 0, 1) of each frame, each file
@@ -159,3 +179,56 @@ def test_layer_energies_are_the_generated_plies_energies():
     names = layer_materials(model)
     assert len(names) == 3 and names[1] == names[2] != names[0]
     assert names[0] == "aluminium" and names[1] == "fabric"  # material name, else section
+
+
+def test_layer_absorbed_energies_sum_the_contact_work_of_each_layers_nodes():
+    """The absorbed energy of a layer is the contact work of its own nodes (layers share
+    no node; the blade's nodes count for none), and the per-material figures are the
+    sums of their layers'; the held energies stay ``quantities.ply_energies``."""
+    from pathlib import Path
+
+    from wovenimpact.containment import (
+        energy_per_material,
+        layer_absorbed_energies,
+        layer_elements,
+    )
+    from wovenimpact.model.compile import compile_case
+    from wovenimpact.spec.case import case_from_dict
+    from wovenimpact.spec.fields import read_toml, set_dotted
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "containment" / "hybrid_4.toml"
+    doc = read_toml(path, "case")
+    set_dotted(doc, "mesh.element_size", "10 mm")
+    set_dotted(doc, "mesh.casing.layers", 2)
+    compiled = compile_case(case_from_dict(doc, str(path)), path.parent)
+    model, state = compiled.model, compiled.state
+    state.contact_work = np.random.default_rng(3).normal(0.0, 1.0, model.n_nodes)
+    nodes = [np.unique(model.quads[e]) for e in layer_elements(model)]
+    assert sum(n.size for n in nodes) == np.unique(np.concatenate(nodes)).size  # disjoint
+    expected = [float(np.sum(state.contact_work[n])) for n in nodes]
+    assert layer_absorbed_energies(model, state) == pytest.approx(expected, rel=1e-12)
+    per_material = energy_per_material(model, state)
+    assert list(per_material.values()) == pytest.approx(
+        [expected[0], expected[1] + expected[2]], rel=1e-12)
+
+
+def test_force_pair_power_books_each_nodes_share_and_keeps_the_sum():
+    """The trapezoid power Σ_a ½ (f_old + f_new)_a · v_a is summed in node order (the same
+    bits as a plain loop), and each node's ½ (f_old + f_new)_a · v_a Δt is added to its
+    accumulator."""
+    from wovenimpact.kernels.integrate import force_pair_power
+
+    rng = np.random.default_rng(11)
+    f_old, f_new, v = (rng.normal(size=(50, 3)) for _ in range(3))
+    acc = np.zeros(50)
+    dt = 3e-7
+    power = force_pair_power(f_old, f_new, v, dt, acc)
+    s = 0.0
+    for a in range(50):
+        for j in range(3):
+            s += (f_old[a, j] + f_new[a, j]) * v[a, j]
+    assert power == 0.5 * s
+    per_node = 0.5 * np.sum((f_old + f_new) * v, axis=1) * dt
+    assert acc == pytest.approx(per_node, rel=1e-12)
+    force_pair_power(f_old, f_new, v, dt, acc)  # it accumulates
+    assert acc == pytest.approx(2.0 * per_node, rel=1e-12)

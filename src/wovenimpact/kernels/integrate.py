@@ -70,16 +70,22 @@ def smooth_step(t, ramp_time):
 
 
 @kernel
-def force_pair_power(f_old, f_new, v):
+def force_pair_power(f_old, f_new, v, dt, node_work):
     """Σ_a ½ (f_a^{n−1} + f_a^n) · v_a: the trapezoid-rule power of a nodal force over a
-    step, times Δt its work (serial sum, deterministic). A kernel rather than
-    ``np.vdot``: on arrays of more than 10 000 entries OpenBLAS hands vdot to its
-    threads, which then spin between steps and take a core from the element loops
-    (measured: 4 plies at 120 m/s, 56.6 s → 32.9 s wall on 2 cores)."""
+    step, times Δt its work (serial sum, deterministic); each node's share of the work,
+    ½ (f_a^{n−1} + f_a^n) · v_a Δt, is added to ``node_work[a]`` (the contact work a
+    node's part has received: theory §8.3). A kernel rather than ``np.vdot``: on arrays
+    of more than 10 000 entries OpenBLAS hands vdot to its threads, which then spin
+    between steps and take a core from the element loops (measured: 4 plies at 120 m/s,
+    56.6 s → 32.9 s wall on 2 cores)."""
     s = 0.0
     for a in range(v.shape[0]):
+        p = 0.0
         for j in range(3):
-            s += (f_old[a, j] + f_new[a, j]) * v[a, j]
+            t = (f_old[a, j] + f_new[a, j]) * v[a, j]
+            s += t
+            p += t
+        node_work[a] += 0.5 * p * dt
     return 0.5 * s
 
 

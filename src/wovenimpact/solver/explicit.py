@@ -97,6 +97,8 @@ class Workspace:
             state.added_mass = np.zeros(n)
         if state.mass_ratio.shape != (ne,):
             state.mass_ratio = np.zeros(ne)
+        if state.contact_work.shape != (n,):
+            state.contact_work = np.zeros(n)
         mass, inertia = node_masses(model.node_mass, model.node_inertia, state.added_mass)
         return cls(
             elem=np.empty_like(state.elem), mat=np.empty_like(state.mat),
@@ -223,7 +225,8 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     # the velocities move on
     w_con_nodes = 0.0
     if resultants or cb.shells is not None:
-        w_con_nodes = force_pair_power(state.f_contact, cb.f_con, state.v) * state.dt
+        w_con_nodes = force_pair_power(state.f_contact, cb.f_con, state.v, state.dt,
+                                       state.contact_work) * state.dt
     t0 = ws.tick("contact", t0)
     amplitude = smooth_step(state.t + 0.5 * dt_new, model.ramp_time)
     n_bad = gather_and_update(

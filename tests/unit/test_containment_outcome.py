@@ -155,21 +155,11 @@ def test_layer_energies_are_the_generated_plies_energies():
     energies equal quantities.ply_energies of those plies for any velocities and element
     energies, and each layer is named by its material (inner shell aluminium, then the
     fabric)."""
-    from pathlib import Path
-
     from wovenimpact.containment import layer_energies, layer_materials
     from wovenimpact.kernels import shell_layout as SL
-    from wovenimpact.model.compile import compile_case
     from wovenimpact.quantities import ply_energies
-    from wovenimpact.spec.case import case_from_dict
-    from wovenimpact.spec.fields import read_toml, set_dotted
 
-    path = Path(__file__).resolve().parents[2] / "examples" / "containment" / "hybrid_4.toml"
-    doc = read_toml(path, "case")
-    set_dotted(doc, "mesh.element_size", "10 mm")
-    set_dotted(doc, "mesh.casing.layers", 2)
-    compiled = compile_case(case_from_dict(doc, str(path)), path.parent)
-    model, state = compiled.model, compiled.state
+    model, state = coarse_two_ply_casing()
     rng = np.random.default_rng(7)
     state.v[:] = rng.normal(0.0, 30.0, state.v.shape)
     for col in (SL.E_U_MEMB, SL.E_U_BEND, SL.E_U_HG):
@@ -185,23 +175,13 @@ def test_layer_absorbed_energies_sum_the_contact_work_of_each_layers_nodes():
     """The absorbed energy of a layer is the contact work of its own nodes (layers share
     no node; the blade's nodes count for none), and the per-material figures are the
     sums of their layers'; the held energies stay ``quantities.ply_energies``."""
-    from pathlib import Path
-
     from wovenimpact.containment import (
         energy_per_material,
         layer_absorbed_energies,
         layer_elements,
     )
-    from wovenimpact.model.compile import compile_case
-    from wovenimpact.spec.case import case_from_dict
-    from wovenimpact.spec.fields import read_toml, set_dotted
 
-    path = Path(__file__).resolve().parents[2] / "examples" / "containment" / "hybrid_4.toml"
-    doc = read_toml(path, "case")
-    set_dotted(doc, "mesh.element_size", "10 mm")
-    set_dotted(doc, "mesh.casing.layers", 2)
-    compiled = compile_case(case_from_dict(doc, str(path)), path.parent)
-    model, state = compiled.model, compiled.state
+    model, state = coarse_two_ply_casing()
     state.contact_work = np.random.default_rng(3).normal(0.0, 1.0, model.n_nodes)
     nodes = [np.unique(model.quads[e]) for e in layer_elements(model)]
     assert sum(n.size for n in nodes) == np.unique(np.concatenate(nodes)).size  # disjoint
@@ -232,3 +212,19 @@ def test_force_pair_power_books_each_nodes_share_and_keeps_the_sum():
     assert acc == pytest.approx(per_node, rel=1e-12)
     force_pair_power(f_old, f_new, v, dt, acc)  # it accumulates
     assert acc == pytest.approx(2.0 * per_node, rel=1e-12)
+
+
+def coarse_two_ply_casing():
+    """Model and initial state of the 4-ply example reduced to 2 plies at 10 mm."""
+    from pathlib import Path
+
+    from wovenimpact.model.compile import compile_case
+    from wovenimpact.spec.case import case_from_dict
+    from wovenimpact.spec.fields import read_toml, set_dotted
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "containment" / "hybrid_4.toml"
+    doc = read_toml(path, "case")
+    set_dotted(doc, "mesh.element_size", "10 mm")
+    set_dotted(doc, "mesh.casing.layers", 2)
+    compiled = compile_case(case_from_dict(doc, str(path)), path.parent)
+    return compiled.model, compiled.state

@@ -580,3 +580,38 @@ def test_a_folded_surface_meets_itself_only_with_self_contact(self_contact):
     else:
         assert contacts == 0 and not f.any()
         assert np.all(v[top, 2] == -V) and worst < -0.1 * t  # sinking into each other
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.integers(0, 2**31 - 1), st.floats(0.0, 0.6))
+def test_the_plane_bound_passes_over_only_segments_farther_than_it(seed, warp):
+    """The narrow phase's plane bound |n̄ · (p − x̄)| − |n̄ · c| is a lower bound of the
+    distance from p to the bilinear segment (its closest point, found by the projection):
+    on random warped quads (corner heights up to ``warp`` of the size, tilted) and points
+    around them, no point is closer than the bound says."""
+    from wovenimpact.kernels.contact_narrow import (
+        N_SEG_GEO,
+        SG_MID,
+        SG_NORMAL,
+        SG_WARP,
+        closest_point_on_quad,
+        segment_geometry,
+    )
+
+    rng = np.random.default_rng(seed)
+    corners = np.array([[-1.0, -1.0, 0.0], [1.0, -1.0, 0.0], [1.0, 1.0, 0.0], [-1.0, 1.0, 0.0]])
+    corners[:, :2] += rng.uniform(-0.3, 0.3, (4, 2))
+    corners[:, 2] = warp * rng.uniform(-1.0, 1.0, 4)
+    q, _ = np.linalg.qr(rng.normal(size=(3, 3)))
+    pts = rng.uniform(-3.0, 3.0, (200, 3))
+    x = np.vstack([corners @ q.T, pts])
+    quads = np.array([[0, 1, 2, 3]], dtype=np.int64)
+    seg = np.zeros((1, N_SEG_GEO))
+    segment_geometry(x, quads, np.ones(1, dtype=np.int8), seg)
+    n, mid, w = seg[0, SG_NORMAL:SG_NORMAL + 3], seg[0, SG_MID:SG_MID + 3], seg[0, SG_WARP]
+    assert math.isclose(float(n @ n), 1.0, rel_tol=1e-12)
+    for p in pts:
+        out = closest_point_on_quad(p[0], p[1], p[2], x, quads, seg, 0)
+        d = math.dist(p, out[2:5])
+        bound = abs(float(n @ (p - mid))) - w
+        assert bound <= d * (1.0 + 1e-12) + 1e-12

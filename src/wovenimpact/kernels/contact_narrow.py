@@ -75,17 +75,20 @@ INSIDE_TOL = 1e-10  # |ξ|, |η| ≤ 1 + tol counts as inside the segment
 GN_ITERATIONS = 12
 
 
-# columns of the per-segment table of ``segment_geometry``: the raw box (b_min, b_max)
-# and the bilinear form x(ξ, η) = x̄ + ξ a + η b + ξη c (module docstring)
-SG_BOX, SG_MID, SG_A, SG_B, SG_C = 0, 6, 9, 12, 15
-N_SEG_GEO = 18
+# columns of the per-segment table of ``segment_geometry``: the raw box (b_min, b_max),
+# the bilinear form x(ξ, η) = x̄ + ξ a + η b + ξη c (module docstring), the centre normal
+# n̄ = a × b / |a × b| and the warp |n̄ · c| (the plane bound of ``evaluate_node_pairs``)
+SG_BOX, SG_MID, SG_A, SG_B, SG_C, SG_NORMAL, SG_WARP = 0, 6, 9, 12, 15, 18, 21
+N_SEG_GEO = 22
 
 
 @loop_kernel
 def segment_geometry(x, quads, seg_on, seg):
     """Per live segment s (seg_on[s] ≠ 0; other rows untouched), at x: its raw box
-    b_min, b_max (the narrow phase's box test) and x̄, a, b, c of its bilinear form —
-    computed once per segment and step instead of once per candidate pair."""
+    b_min, b_max (the narrow phase's box test), x̄, a, b, c of its bilinear form, and
+    the centre normal n̄ with the warp |n̄ · c| (its plane bound; n̄ = 0 for a degenerate
+    segment, which turns the bound off) — computed once per segment and step instead of
+    once per candidate pair."""
     for s in prange(quads.shape[0]):
         if seg_on[s] == 0:
             continue
@@ -98,6 +101,16 @@ def segment_geometry(x, quads, seg_on, seg):
             seg[s, SG_A + d] = 0.25 * (x2 + x3 - x1 - x4)
             seg[s, SG_B + d] = 0.25 * (x3 + x4 - x1 - x2)
             seg[s, SG_C + d] = 0.25 * (x1 + x3 - x2 - x4)
+        ax, ay, az = seg[s, SG_A], seg[s, SG_A + 1], seg[s, SG_A + 2]
+        bx, by, bz = seg[s, SG_B], seg[s, SG_B + 1], seg[s, SG_B + 2]
+        nx, ny, nz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+        nn = math.sqrt(nx * nx + ny * ny + nz * nz)
+        inv = 1.0 / nn if nn > 0.0 else 0.0
+        nx, ny, nz = nx * inv, ny * inv, nz * inv
+        seg[s, SG_NORMAL] = nx
+        seg[s, SG_NORMAL + 1] = ny
+        seg[s, SG_NORMAL + 2] = nz
+        seg[s, SG_WARP] = abs(nx * seg[s, SG_C] + ny * seg[s, SG_C + 1] + nz * seg[s, SG_C + 2])
 
 
 @kernel
@@ -202,10 +215,16 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, pair_ptr, 
     for the closest candidate of each (ply, side) group, else 0.
 
     A candidate whose node is outside the segment's box (``seg``, by
-    :func:`segment_geometry` at x) inflated by h_p + h_s + margin (the broad phase's test,
-    contact_broad) is passed over (keep 0, side
-    0, d = ∞): a fresh search at x would not have listed it, so candidates kept from
-    an earlier search with a skin (ShellContact) give the same result.
+    :func:`segment_geometry` at x) inflated by r = h_p + h_s + margin (the broad phase's
+    test, contact_broad) is passed over (keep 0, side 0, d = ∞): a fresh search at x
+    would not have listed it, so candidates kept from an earlier search with a skin
+    (ShellContact) give the same result. So is one farther than r from the segment by
+    its plane bound: every point of the bilinear segment lies within the warp |n̄ · c|
+    of the plane through x̄ normal to n̄ (n̄ · (x(ξ, η) − x̄) = ξη n̄ · c), so
+    d ≥ |n̄ · (p − x̄)| − |n̄ · c|; such a pair could not act (g > margin + o_p ≥ 0), and
+    on plies of one thickness the closest pair of its group, if it was that one, could
+    not either, so the forces are unchanged — the projection is spared (on the flagship
+    case, 6 % of the candidates at 20 µs, 22 % at 100 µs, beside the box test's 73–76 %).
     """
     px, py, pz = x[p, 0], x[p, 1], x[p, 2]
     k0, k1 = pair_ptr[p], pair_ptr[p + 1]
@@ -215,7 +234,11 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, pair_ptr, 
         lo, hi = SG_BOX, SG_BOX + 3
         if not (seg[s, lo] - r <= px <= seg[s, hi] + r
                 and seg[s, lo + 1] - r <= py <= seg[s, hi + 1] + r
-                and seg[s, lo + 2] - r <= pz <= seg[s, hi + 2] + r):
+                and seg[s, lo + 2] - r <= pz <= seg[s, hi + 2] + r
+                and abs(seg[s, SG_NORMAL] * (px - seg[s, SG_MID])
+                        + seg[s, SG_NORMAL + 1] * (py - seg[s, SG_MID + 1])
+                        + seg[s, SG_NORMAL + 2] * (pz - seg[s, SG_MID + 2]))
+                - seg[s, SG_WARP] <= r):
             geo[k, GEO_DIST] = math.inf
             geo[k, GEO_SIDE] = 0.0
             keep[k] = 0

@@ -32,7 +32,10 @@ Per-element functions take the whole tables and the element's row index (no
 per-element array views: each view costs reference counting at every call) and
 the small geometric helpers work on scalars and tuples. Row indices are passed
 as unsigned integers (``np.uint64``): a signed index makes Numba check every
-access for a negative index to wrap around, ~20 % of the element's time.
+access for a negative index to wrap around, ~20 % of the element's time. The helpers
+of ``shell_force`` are inlined into it at Numba IR level (``inline_kernel``): one
+function for LLVM to allocate registers in, 2 764 → 2 471 instructions per elastic
+element and 10 324 → 9 064 per fabric 2×2 element (callgrind; results bitwise the same).
 """
 
 from __future__ import annotations
@@ -82,7 +85,7 @@ from wovenimpact.kernels.shell_layout import (
 )
 
 
-@kernel
+@inline_kernel
 def elastic_membrane(f11, f12, f21, f22, modulus, poisson, thick):
     """St Venant–Kirchhoff plane-stress membrane from the in-plane F.
 
@@ -112,7 +115,7 @@ def elastic_membrane(f11, f12, f21, f22, modulus, poisson, thick):
     return 0.5 * (s11 * e11 + s22 * e22 + 2.0 * s12 * e12), c, n_xx, n_yy, n_xy
 
 
-@kernel
+@inline_kernel
 def local_components(ax, ay, az, ex, ey, ez):
     """(a_I · e) for the four corners: a nodal vector field (components ax, ay, az,
     4-tuples) seen along axis e."""
@@ -175,7 +178,7 @@ def corotational_frame(px, py, pz):
     )
 
 
-@kernel
+@inline_kernel
 def hourglass_vectors(lx, ly, b1, b2):
     """Flanagan–Belytschko γ_I = ¼ (h_I − (h·x̂) b1_I − (h·ŷ) b2_I), h = (1, −1, 1, −1),
     orthogonal to every linear field; and Σ_I (b1_I² + b2_I²)."""
@@ -193,7 +196,7 @@ def hourglass_vectors(lx, ly, b1, b2):
     return gam, bb
 
 
-@kernel
+@inline_kernel
 def hourglass_mode(q_old, k, gam_mid, rates, dt):
     """One hourglass mode (stiffness form): Q_new = Q_old + k (γ_mid · rates) Δt.
 
@@ -207,7 +210,7 @@ def hourglass_mode(q_old, k, gam_mid, rates, dt):
     return new, 0.5 * (q_old + new) * rate * dt
 
 
-@kernel
+@inline_kernel
 def clear_block(blocks, e):
     """No force or moment at any corner of element e."""
     for i in range(4):
@@ -215,7 +218,7 @@ def clear_block(blocks, e):
             blocks[e, i, j] = 0.0
 
 
-@kernel
+@inline_kernel
 def through_thickness_f(z, kx, ky, kxy2, f11, f12, f21, f22):
     """In-plane F at height z: (I + z κ̂) F, κ̂ = [[κ_x, κ_xy], [κ_xy, κ_y]]; the strain
     at z is then the mid-surface strain plus z κ (BLT curvature convention)."""
@@ -226,7 +229,7 @@ def through_thickness_f(z, kx, ky, kxy2, f11, f12, f21, f22):
     )
 
 
-@kernel
+@inline_kernel
 def point_response(kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, dt, thick,
                    rows_in, rows_out, row):
     """The material at one point: F_old → F_new (o.., g..) over Δt, dispatched on its kind.
@@ -263,7 +266,7 @@ def point_response(kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, 
     return 0, True, c, energy, a, b, c12
 
 
-@kernel
+@inline_kernel
 def section_response(
     n_pts, thick, kind, mat_params, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22,
     ko_x, ko_y, ko_xy2, k_x, k_y, k_xy2, dt, rows_in, rows_out, row0,
@@ -318,7 +321,7 @@ def section_response(
     return 0, alive, c_max, w_sum, n_xx, n_yy, n_xy, mxx, myy, mxy
 
 
-@kernel
+@inline_kernel
 def first_piola(n11, n22, n12, f11, f12, f21, f22):
     """P = J N F⁻ᵀ (force per reference length) from the Cauchy resultant N and F;
     F⁻ᵀ = [[f22, −f21], [−f12, f11]] / J. Returns (P11, P12, P21, P22)."""
@@ -326,7 +329,7 @@ def first_piola(n11, n22, n12, f11, f12, f21, f22):
             n12 * f22 - n22 * f12, -n12 * f21 + n22 * f11)
 
 
-@kernel
+@inline_kernel
 def sync_yarn_damage(rows_out, row0, n_pts):
     """Yarn failure is an element's, not a Gauss point's (theory §4.5): the element is
     about one crossover cell, so a family broken at one of its 2×2 points is broken
@@ -340,7 +343,7 @@ def sync_yarn_damage(rows_out, row0, n_pts):
                 rows_out[row0 + np.uint64(g * n_pts + k), FL.S_DAMAGE + fam] = d
 
 
-@kernel
+@inline_kernel
 def full_membrane(
     e, lx, ly, gauss_grad, gauss_weight, a0, n_pts, thick, kind, mat_params, m, el_in, el_out,
     ko_x, ko_y, ko_xy2, k_x, k_y, k_xy2, dt, rows_in, rows_out, row0,

@@ -174,7 +174,7 @@ def test_layer_energies_are_the_generated_plies_energies():
 def test_layer_absorbed_energies_sum_the_contact_work_of_each_layers_nodes():
     """The absorbed energy of a layer is the contact work of its own nodes (layers share
     no node; the blade's nodes count for none), and the per-material figures are the
-    sums of their layers'; the held energies stay ``quantities.ply_energies``."""
+    sums of their layers'."""
     from wovenimpact.containment import (
         energy_per_material,
         layer_absorbed_energies,

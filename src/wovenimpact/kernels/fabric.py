@@ -676,8 +676,10 @@ def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
 
     A thin wrapper of :func:`fabric_point` (which loop kernels call directly).
     """
-    p_table = p.reshape((1, p.shape[0]))  # views (a kernel allocates nothing, jit.kernel):
-    row_in = s_in.reshape((1, s_in.shape[0]))  # the row may carry a 1.6 MB table
+    # views, not copies: a kernel allocates nothing (jit.kernel), and the parameter row
+    # may carry a 1.6 MB table
+    p_table = p.reshape((1, p.shape[0]))
+    row_in = s_in.reshape((1, s_in.shape[0]))
     row_out = s_out.reshape((1, s_out.shape[0]))
     status, stiff, n_xx, n_yy, n_xy = fabric_point(
         p_table, 0, f_old[0, 0], f_old[0, 1], f_old[1, 0], f_old[1, 1],

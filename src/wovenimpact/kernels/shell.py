@@ -444,6 +444,18 @@ def warp_forces(fx, fy, lx, ly, lz, area):
     return (-(m1 * a1 + m2 * a2), m1 * b1 + m2 * b2, m1 * a1 + m2 * a2, -(m1 * b1 + m2 * b2))
 
 
+@inline_kernel
+def carry_state(e, el_in, el_out, rows_in, rows_out, row0, n_rows):
+    """Copy element e's state and its section's n_rows material point rows (from row0)
+    from the start-of-step tables to the end-of-step ones; the step then updates the
+    copy. Rows past n_rows belong to no point of this section and are never written."""
+    for j in range(N_ELEM_STATE):
+        el_out[e, j] = el_in[e, j]
+    for r in range(row0, row0 + n_rows):
+        for j in range(rows_in.shape[1]):
+            rows_out[r, j] = rows_in[r, j]
+
+
 @kernel
 def shell_force(
     e, x, v, omega, dt, quads, area0, ref_grad, gauss_grad, gauss_weight, sec, sections,
@@ -462,22 +474,30 @@ def shell_force(
             parameter table (row int(sections[sec, C_MAT])).
         el_in, el_out: element state tables (shell_layout), start / end of step.
         rows_in, rows_out: material point states, start / end of step, one row per
-            point: element e owns rows e·point_blocks … + point_blocks − 1.
+            point: element e owns rows e·point_blocks … + point_blocks − 1, of which
+            its section uses the first C_POINTS·C_INPLANE (only those are carried).
+            An eroded element's rows are carried only while the out tables still
+            hold it alive (the first step after its erosion): both tables then hold
+            the same rows for good, provided they did when the run started.
         blocks: (n_elems, 4, 6), row e written: forces (global, N) and moments
             (global, N·m) per corner, the internal (resisting) forces.
 
     Returns:
         (status, eroded_now): an EL_* code, and 1 if the element eroded this step.
     """
-    for j in range(N_ELEM_STATE):
-        el_out[e, j] = el_in[e, j]
-    for r in range(e * np.uint64(point_blocks), (e + np.uint64(1)) * np.uint64(point_blocks)):
-        for j in range(rows_in.shape[1]):
-            rows_out[r, j] = rows_in[r, j]
+    # the rows the element's section uses (a fabric section of a model that also holds
+    # 2×2×5-point metal uses 4 of the 20 point rows each element owns)
+    n_rows = min(np.uint64(sections[sec, C_POINTS] * sections[sec, C_INPLANE]),
+                 np.uint64(point_blocks))
+    row0 = e * np.uint64(point_blocks)
     if el_in[e, E_ALIVE] == 0.0:
+        # eroded: its state no longer changes; the other buffer needs it once more
+        if el_out[e, E_ALIVE] != 0.0:
+            carry_state(e, el_in, el_out, rows_in, rows_out, row0, n_rows)
         el_out[e, E_DT] = math.inf
         clear_block(blocks, e)
         return EL_OK, 0
+    carry_state(e, el_in, el_out, rows_in, rows_out, row0, n_rows)
 
     # 1. corotational frame at x^n (forces) and at x^{n−1/2} = x^n − ½Δt v (rates:
     # the velocities of the step belong to the midpoint configuration)
@@ -565,7 +585,6 @@ def shell_force(
     a0 = area0[e]
     n_pts = int(sections[sec, C_POINTS])
     integrated = n_pts > 1
-    row0 = e * np.uint64(point_blocks)
     if int(sections[sec, C_INPLANE]) == MEMBRANE_FULL:
         status, eroded, c_memb, w_memb, n11, n22, n12, mi_xx, mi_yy, mi_xy, mf_x, mf_y = (
             full_membrane(

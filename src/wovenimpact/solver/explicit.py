@@ -101,7 +101,7 @@ class Workspace:
             state.contact_work = np.zeros(n)
         mass, inertia = node_masses(model.node_mass, model.node_inertia, state.added_mass)
         return cls(
-            elem=np.empty_like(state.elem), mat=np.empty_like(state.mat),
+            elem=state.elem.copy(), mat=state.mat.copy(),  # dead rows stay equal (shell_force)
             blocks=np.zeros((ne, 4, 6)), status=np.zeros(ne, dtype=np.int32),
             eroded_now=np.zeros(ne, dtype=np.int32), alive=np.zeros(ne, dtype=np.uint8),
             f_int=np.zeros((n, 6)),

@@ -445,6 +445,205 @@ def warp_forces(fx, fy, lx, ly, lz, area):
 
 
 @inline_kernel
+def corner_values(a, c0, c1, c2, c3):
+    """The x, y and z components of rows c0…c3 of a (n, ≥3) table, as three 4-tuples."""
+    return (
+        (a[c0, 0], a[c1, 0], a[c2, 0], a[c3, 0]),
+        (a[c0, 1], a[c1, 1], a[c2, 1], a[c3, 1]),
+        (a[c0, 2], a[c1, 2], a[c2, 2], a[c3, 2]),
+    )
+
+
+@inline_kernel
+def element_failed(e, el_out, blocks, measure):
+    """Element e has a degenerate geometry (``measure``: an area or a Jacobian ≤ 0 or
+    not finite): no force, no stable step; returns (EL_NAN or EL_INVERTED, 0)."""
+    el_out[e, E_DT] = 0.0
+    clear_block(blocks, e)
+    return (EL_NAN if not math.isfinite(measure) else EL_INVERTED), 0
+
+
+@inline_kernel
+def midpoint_frame(px, py, pz, vx, vy, vz, dt):
+    """The corotational frame (``corotational_frame``) at x^{n−1/2} = x^n − ½Δt v^{n−1/2}:
+    the configuration the step's velocities belong to."""
+    h = 0.5 * dt
+    return corotational_frame(
+        (px[0] - h * vx[0], px[1] - h * vx[1], px[2] - h * vx[2], px[3] - h * vx[3]),
+        (py[0] - h * vy[0], py[1] - h * vy[1], py[2] - h * vy[2], py[3] - h * vy[3]),
+        (pz[0] - h * vz[0], pz[1] - h * vz[1], pz[2] - h * vz[2], pz[3] - h * vz[3]),
+    )
+
+
+@inline_kernel
+def midpoint_rates(mid, vx_, vy_, vz_, wx_, wy_, wz_, dt):
+    """Corner velocities and spins in the midpoint frame ``mid`` and the step's
+    increments of curvature and transverse shear (BLT, module docstring item 3):
+    Δκ_x = Σ b1·θ̇_y Δt, Δκ_y = −Σ b2·θ̇_x Δt, 2Δκ_xy = Σ (b2·θ̇_y − b1·θ̇_x) Δt,
+    Δγ_xz = Σ (b1·v_z + ¼θ̇_y) Δt, Δγ_yz = Σ (b2·v_z − ¼θ̇_x) Δt — zero for any rigid motion.
+
+    Returns (v̂_x, v̂_y, v̂_z, θ̇_x, θ̇_y) as 4-tuples, then Δκ_x, Δκ_y, 2Δκ_xy, Δγ_xz, Δγ_yz.
+    """
+    (m1x, m1y, m1z), (m2x, m2y, m2z), (m3x, m3y, m3z) = mid[0], mid[1], mid[2]
+    mb1, mb2 = mid[5]
+    vx = local_components(vx_, vy_, vz_, m1x, m1y, m1z)
+    vy = local_components(vx_, vy_, vz_, m2x, m2y, m2z)
+    vz = local_components(vx_, vy_, vz_, m3x, m3y, m3z)
+    tx = local_components(wx_, wy_, wz_, m1x, m1y, m1z)
+    ty = local_components(wx_, wy_, wz_, m2x, m2y, m2z)
+    kx = ky = kxy2 = gxz = gyz = 0.0
+    for i in range(4):
+        kx += mb1[i] * ty[i]
+        ky -= mb2[i] * tx[i]
+        kxy2 += mb2[i] * ty[i] - mb1[i] * tx[i]
+        gxz += mb1[i] * vz[i] + 0.25 * ty[i]
+        gyz += mb2[i] * vz[i] - 0.25 * tx[i]
+    return vx, vy, vz, tx, ty, kx * dt, ky * dt, kxy2 * dt, gxz * dt, gyz * dt
+
+
+@inline_kernel
+def centre_gradient(lx, ly, g1, g2):
+    """In-plane deformation gradient at the centre, F = Σ_I x̂_I ⊗ ∂N_I/∂X:
+    (F11, F12, F21, F22) from the local corner coordinates and the reference gradients."""
+    f11 = f12 = f21 = f22 = 0.0
+    for i in range(4):
+        f11 += lx[i] * g1[i]
+        f12 += lx[i] * g2[i]
+        f21 += ly[i] * g1[i]
+        f22 += ly[i] * g2[i]
+    return f11, f12, f21, f22
+
+
+@inline_kernel
+def centre_membrane_forces(a0, n11, n22, n12, f11, f12, f21, f22, g1, g2):
+    """One-point membrane corner forces f̂_I = A0 P ∂N_I/∂X, P = J N F⁻ᵀ (first Piola):
+    (x components, y components) as 4-tuples in the local frame."""
+    p11, p12, p21, p22 = first_piola(n11, n22, n12, f11, f12, f21, f22)
+    mf_x = (a0 * (p11 * g1[0] + p12 * g2[0]), a0 * (p11 * g1[1] + p12 * g2[1]),
+            a0 * (p11 * g1[2] + p12 * g2[2]), a0 * (p11 * g1[3] + p12 * g2[3]))
+    mf_y = (a0 * (p21 * g1[0] + p22 * g2[0]), a0 * (p21 * g1[1] + p22 * g2[1]),
+            a0 * (p21 * g1[2] + p22 * g2[2]), a0 * (p21 * g1[3] + p22 * g2[3]))
+    return mf_x, mf_y
+
+
+@inline_kernel
+def bending_and_shear(e, el_in, el_out, area, integrated, c_memb, thick, e_b, nu_b, kgt,
+                      mi_xx, mi_yy, mi_xy, dkx, dky, dkxy2, dgxz, dgyz):
+    """Bending moments and transverse shear forces of element e at the end of the step,
+    written to el_out with the bending energy (trapezoid rule on the increments).
+
+    Resultant section: M += D Δκ, D = E_b t³/12(1 − ν_b²) (plate law); integrated
+    section: M from its points (mi_*; their energy is in the membrane term, and the
+    plate stiffness C_m t²/12 serves the hourglass only). Always Q += k G t Δγ.
+
+    Returns (D, M_xx, M_yy, M_xy, Q_x, Q_y, w) with w = 1 when M is the plate law's.
+    """
+    m_old0, m_old1, m_old2 = el_in[e, E_M], el_in[e, E_M + 1], el_in[e, E_M + 2]
+    q_old0, q_old1 = el_in[e, E_Q], el_in[e, E_Q + 1]
+    if integrated:
+        d_b = c_memb * thick * thick / 12.0  # for the hourglass stiffness only
+        mxx, myy, mxy = mi_xx, mi_yy, mi_xy
+        w_bend = 0.0
+    else:
+        d_b = e_b * thick * thick * thick / (12.0 * (1.0 - nu_b * nu_b))
+        mxx = m_old0 + d_b * (dkx + nu_b * dky)
+        myy = m_old1 + d_b * (dky + nu_b * dkx)
+        mxy = m_old2 + d_b * 0.5 * (1.0 - nu_b) * dkxy2
+        w_bend = 1.0
+    qx = q_old0 + kgt * dgxz
+    qy = q_old1 + kgt * dgyz
+    el_out[e, E_M] = mxx
+    el_out[e, E_M + 1] = myy
+    el_out[e, E_M + 2] = mxy
+    el_out[e, E_Q] = qx
+    el_out[e, E_Q + 1] = qy
+    el_out[e, E_U_BEND] = el_in[e, E_U_BEND] + area * (
+        w_bend * (0.5 * (m_old0 + mxx) * dkx + 0.5 * (m_old1 + myy) * dky
+                  + 0.5 * (m_old2 + mxy) * dkxy2)
+        + 0.5 * (q_old0 + qx) * dgxz + 0.5 * (q_old1 + qy) * dgyz
+    )
+    return d_b, mxx, myy, mxy, qx, qy, w_bend
+
+
+@inline_kernel
+def hourglass_resultants(e, el_in, el_out, k_m, k_w, k_t, gam_mid, vx, vy, vz, tx, ty, dt):
+    """The five hourglass resultants of element e (in-plane x, y; w; θ_x, θ_y), each
+    Q += k (γ_mid · rates) Δt (``hourglass_mode``), written to el_out with their
+    energy; returns them."""
+    hg0, e_hg = hourglass_mode(el_in[e, E_HG], k_m, gam_mid, vx, dt)
+    hg1, de = hourglass_mode(el_in[e, E_HG + 1], k_m, gam_mid, vy, dt)
+    e_hg += de
+    hg2, de = hourglass_mode(el_in[e, E_HG + 2], k_w, gam_mid, vz, dt)
+    e_hg += de
+    hg3, de = hourglass_mode(el_in[e, E_HG + 3], k_t, gam_mid, tx, dt)
+    e_hg += de
+    hg4, de = hourglass_mode(el_in[e, E_HG + 4], k_t, gam_mid, ty, dt)
+    e_hg += de
+    el_out[e, E_HG] = hg0
+    el_out[e, E_HG + 1] = hg1
+    el_out[e, E_HG + 2] = hg2
+    el_out[e, E_HG + 3] = hg3
+    el_out[e, E_HG + 4] = hg4
+    el_out[e, E_U_HG] = el_in[e, E_U_HG] + e_hg
+    return hg0, hg1, hg2, hg3, hg4
+
+
+@inline_kernel
+def corner_forces(e, blocks, frame, mf_x, mf_y, fzs, gam, hg0, hg1, hg2, hg3, hg4,
+                  mxx, myy, mxy, qx, qy):
+    """Element e's corner forces and moments into blocks[e] (global axes; the internal,
+    resisting forces), from the local ones: membrane (mf), warp (fzs), transverse shear
+    (A b·Q), bending (A b·M with the shear's ¼A Q moment) and hourglass (γ_I Q_hg).
+    Returns Σ_I f_x (a finiteness probe)."""
+    e1x, e1y, e1z = frame[0]
+    e2x, e2y, e2z = frame[1]
+    e3x, e3y, e3z = frame[2]
+    area = frame[4]
+    b1, b2 = frame[5]
+    fsum = 0.0
+    for i in range(4):
+        fx = mf_x[i] + gam[i] * hg0
+        fy = mf_y[i] + gam[i] * hg1
+        fz = area * (b1[i] * qx + b2[i] * qy) + gam[i] * hg2 + fzs[i]
+        mx = area * (-b2[i] * myy - b1[i] * mxy - 0.25 * qy) + gam[i] * hg3
+        my = area * (b1[i] * mxx + b2[i] * mxy + 0.25 * qx) + gam[i] * hg4
+        gx = fx * e1x + fy * e2x + fz * e3x
+        blocks[e, i, 0] = gx
+        blocks[e, i, 1] = fx * e1y + fy * e2y + fz * e3y
+        blocks[e, i, 2] = fx * e1z + fy * e2z + fz * e3z
+        blocks[e, i, 3] = mx * e1x + my * e2x
+        blocks[e, i, 4] = mx * e1y + my * e2y
+        blocks[e, i, 5] = mx * e1z + my * e2z
+        fsum += gx
+    return fsum
+
+
+@inline_kernel
+def element_stable_step(px, py, pz, area, c_memb, kgt, mu, a0, thick, d_b, bb):
+    """The element's stable step (eq. 4.9–4.11): L_e/c_e with L_e = A / longest edge and
+    c_e² = max(C_m, k G t)/μ, and no more than the rotational bound 2 √(I/k_θ).
+
+    Rotations: a corner's spin against this element's transverse-shear and bending
+    stiffness, k_θ = A (k G t/4 + D Σb²), with the rotary inertia the element lumped on
+    it, I = ¼ μ A0 max(t²/12, A0/8); ω Δt ≤ 2 needs Δt ≤ 2 √(I/k_θ). In an element that
+    has stretched far beyond its reference size (a broken yarn family) this, not the
+    membrane, governs.
+    """
+    edge2 = 0.0
+    for i in range(4):
+        j = (i + 1) % 4
+        dx = px[j] - px[i]
+        dy = py[j] - py[i]
+        dz = pz[j] - pz[i]
+        edge2 = max(edge2, dx * dx + dy * dy + dz * dz)
+    c2 = max(c_memb, kgt) / mu
+    dt_e = area / math.sqrt(edge2 * c2)
+    inertia = 0.25 * mu * a0 * max(thick * thick / 12.0, a0 / 8.0)
+    k_rot = area * (0.25 * kgt + d_b * bb)
+    return min(dt_e, 2.0 * math.sqrt(inertia / k_rot))
+
+
+@inline_kernel
 def carry_state(e, el_in, el_out, rows_in, rows_out, row0, n_rows):
     """Copy element e's state and its section's n_rows material point rows (from row0)
     from the start-of-step tables to the end-of-step ones; the step then updates the
@@ -499,60 +698,28 @@ def shell_force(
         return EL_OK, 0
     carry_state(e, el_in, el_out, rows_in, rows_out, row0, n_rows)
 
-    # 1. corotational frame at x^n (forces) and at x^{n−1/2} = x^n − ½Δt v (rates:
+    # 1. corotational frames at x^n (forces) and at x^{n−1/2} = x^n − ½Δt v (rates:
     # the velocities of the step belong to the midpoint configuration)
     c0, c1, c2_, c3 = (
         np.uint64(quads[e, 0]), np.uint64(quads[e, 1]), np.uint64(quads[e, 2]),
         np.uint64(quads[e, 3]),
     )
-    px = (x[c0, 0], x[c1, 0], x[c2_, 0], x[c3, 0])
-    py = (x[c0, 1], x[c1, 1], x[c2_, 1], x[c3, 1])
-    pz = (x[c0, 2], x[c1, 2], x[c2_, 2], x[c3, 2])
-    vx_ = (v[c0, 0], v[c1, 0], v[c2_, 0], v[c3, 0])
-    vy_ = (v[c0, 1], v[c1, 1], v[c2_, 1], v[c3, 1])
-    vz_ = (v[c0, 2], v[c1, 2], v[c2_, 2], v[c3, 2])
+    px, py, pz = corner_values(x, c0, c1, c2_, c3)
+    vx_, vy_, vz_ = corner_values(v, c0, c1, c2_, c3)
     frame = corotational_frame(px, py, pz)
     area = frame[4]
     if not (area > 0.0):
-        el_out[e, E_DT] = 0.0
-        clear_block(blocks, e)
-        return (EL_NAN if not math.isfinite(area) else EL_INVERTED), 0
-    e1x, e1y, e1z = frame[0]
-    e2x, e2y, e2z = frame[1]
-    e3x, e3y, e3z = frame[2]
+        return element_failed(e, el_out, blocks, area)
+    mid = midpoint_frame(px, py, pz, vx_, vy_, vz_, dt)
+    if not (mid[4] > 0.0):
+        return element_failed(e, el_out, blocks, mid[4])
     lx, ly = frame[3]
     b1, b2 = frame[5]
-    h = 0.5 * dt
-    mid = corotational_frame(
-        (px[0] - h * vx_[0], px[1] - h * vx_[1], px[2] - h * vx_[2], px[3] - h * vx_[3]),
-        (py[0] - h * vy_[0], py[1] - h * vy_[1], py[2] - h * vy_[2], py[3] - h * vy_[3]),
-        (pz[0] - h * vz_[0], pz[1] - h * vz_[1], pz[2] - h * vz_[2], pz[3] - h * vz_[3]),
-    )
-    if not (mid[4] > 0.0):
-        el_out[e, E_DT] = 0.0
-        clear_block(blocks, e)
-        return (EL_NAN if not math.isfinite(mid[4]) else EL_INVERTED), 0
 
     # 2. rates in the midpoint frame: curvature and transverse-shear increments
-    (m1x, m1y, m1z), (m2x, m2y, m2z), (m3x, m3y, m3z) = mid[0], mid[1], mid[2]
-    mb1, mb2 = mid[5]
-    wx_ = (omega[c0, 0], omega[c1, 0], omega[c2_, 0], omega[c3, 0])
-    wy_ = (omega[c0, 1], omega[c1, 1], omega[c2_, 1], omega[c3, 1])
-    wz_ = (omega[c0, 2], omega[c1, 2], omega[c2_, 2], omega[c3, 2])
-    vx = local_components(vx_, vy_, vz_, m1x, m1y, m1z)
-    vy = local_components(vx_, vy_, vz_, m2x, m2y, m2z)
-    vz = local_components(vx_, vy_, vz_, m3x, m3y, m3z)
-    tx = local_components(wx_, wy_, wz_, m1x, m1y, m1z)
-    ty = local_components(wx_, wy_, wz_, m2x, m2y, m2z)
-    kx = ky = kxy2 = gxz = gyz = 0.0
-    for i in range(4):
-        kx += mb1[i] * ty[i]
-        ky -= mb2[i] * tx[i]
-        kxy2 += mb2[i] * ty[i] - mb1[i] * tx[i]
-        gxz += mb1[i] * vz[i] + 0.25 * ty[i]
-        gyz += mb2[i] * vz[i] - 0.25 * tx[i]
-    dkx, dky, dkxy2 = kx * dt, ky * dt, kxy2 * dt
-    dgxz, dgyz = gxz * dt, gyz * dt
+    wx_, wy_, wz_ = corner_values(omega, c0, c1, c2_, c3)
+    vx, vy, vz, tx, ty, dkx, dky, dkxy2, dgxz, dgyz = midpoint_rates(
+        mid, vx_, vy_, vz_, wx_, wy_, wz_, dt)
     kap_x = el_in[e, E_KAPPA] + dkx
     kap_y = el_in[e, E_KAPPA + 1] + dky
     kap_xy2 = el_in[e, E_KAPPA + 2] + dkxy2
@@ -560,20 +727,14 @@ def shell_force(
     el_out[e, E_KAPPA + 1] = kap_y
     el_out[e, E_KAPPA + 2] = kap_xy2
 
-    # 3. membrane: F = Σ x̂_I ⊗ ∂N_I/∂X at the centre (one-point membrane, outputs)
+    # 3. membrane: F = Σ x̂_I ⊗ ∂N_I/∂X at the centre (one-point membrane, outputs),
+    # the section's resultants and the membrane's corner forces
     g1 = (ref_grad[e, 0, 0], ref_grad[e, 0, 1], ref_grad[e, 0, 2], ref_grad[e, 0, 3])
     g2 = (ref_grad[e, 1, 0], ref_grad[e, 1, 1], ref_grad[e, 1, 2], ref_grad[e, 1, 3])
-    f11 = f12 = f21 = f22 = 0.0
-    for i in range(4):
-        f11 += lx[i] * g1[i]
-        f12 += lx[i] * g2[i]
-        f21 += ly[i] * g1[i]
-        f22 += ly[i] * g2[i]
+    f11, f12, f21, f22 = centre_gradient(lx, ly, g1, g2)
     det = f11 * f22 - f12 * f21
     if not (det > 0.0):
-        el_out[e, E_DT] = 0.0
-        clear_block(blocks, e)
-        return (EL_NAN if not math.isfinite(det) else EL_INVERTED), 0
+        return element_failed(e, el_out, blocks, det)
     el_out[e, E_F] = f11
     el_out[e, E_F + 1] = f12
     el_out[e, E_F + 2] = f21
@@ -603,12 +764,7 @@ def shell_force(
         )
         eroded = status == 0 and n_alive == 0
         w_memb *= a0
-        # one point: f̂_I = A0 P ∂N_I/∂X
-        p11, p12, p21, p22 = first_piola(n11, n22, n12, f11, f12, f21, f22)
-        mf_x = (a0 * (p11 * g1[0] + p12 * g2[0]), a0 * (p11 * g1[1] + p12 * g2[1]),
-                a0 * (p11 * g1[2] + p12 * g2[2]), a0 * (p11 * g1[3] + p12 * g2[3]))
-        mf_y = (a0 * (p21 * g1[0] + p22 * g2[0]), a0 * (p21 * g1[1] + p22 * g2[1]),
-                a0 * (p21 * g1[2] + p22 * g2[2]), a0 * (p21 * g1[3] + p22 * g2[3]))
+        mf_x, mf_y = centre_membrane_forces(a0, n11, n22, n12, f11, f12, f21, f22, g1, g2)
         full = False
     if status != 0:
         el_out[e, E_N] = 0.0
@@ -634,96 +790,31 @@ def shell_force(
     # 4. bending and transverse shear: M = D Δκ accumulated (resultant section) or
     # from the points (integrated section, bending energy then in the membrane term)
     kgt = sections[sec, C_SHEAR_K] * sections[sec, C_SHEAR_G] * thick
-    m_old0, m_old1, m_old2 = el_in[e, E_M], el_in[e, E_M + 1], el_in[e, E_M + 2]
-    q_old0, q_old1 = el_in[e, E_Q], el_in[e, E_Q + 1]
-    if integrated:
-        d_b = c_memb * thick * thick / 12.0  # for the hourglass stiffness only
-        mxx, myy, mxy = mi_xx, mi_yy, mi_xy
-        w_bend = 0.0
-    else:
-        e_b = sections[sec, C_BEND_E]
-        nu_b = sections[sec, C_BEND_NU]
-        d_b = e_b * thick * thick * thick / (12.0 * (1.0 - nu_b * nu_b))
-        mxx = m_old0 + d_b * (dkx + nu_b * dky)
-        myy = m_old1 + d_b * (dky + nu_b * dkx)
-        mxy = m_old2 + d_b * 0.5 * (1.0 - nu_b) * dkxy2
-        w_bend = 1.0
-    qx = q_old0 + kgt * dgxz
-    qy = q_old1 + kgt * dgyz
-    el_out[e, E_M] = mxx
-    el_out[e, E_M + 1] = myy
-    el_out[e, E_M + 2] = mxy
-    el_out[e, E_Q] = qx
-    el_out[e, E_Q + 1] = qy
-    el_out[e, E_U_BEND] = el_in[e, E_U_BEND] + area * (
-        w_bend * (0.5 * (m_old0 + mxx) * dkx + 0.5 * (m_old1 + myy) * dky
-                  + 0.5 * (m_old2 + mxy) * dkxy2)
-        + 0.5 * (q_old0 + qx) * dgxz + 0.5 * (q_old1 + qy) * dgyz
-    )
+    d_b, mxx, myy, mxy, qx, qy, w_bend = bending_and_shear(
+        e, el_in, el_out, area, integrated, c_memb, thick, sections[sec, C_BEND_E],
+        sections[sec, C_BEND_NU], kgt, mi_xx, mi_yy, mi_xy, dkx, dky, dkxy2, dgxz, dgyz)
 
     # 5. hourglass (Flanagan–Belytschko): γ_I = ¼ (h_I − (h·x̂) b1_I − (h·ŷ) b2_I),
     # rates with the midpoint γ, forces with the current one
     gam, bb = hourglass_vectors(lx, ly, b1, b2)
-    gam_mid = hourglass_vectors(mid[3][0], mid[3][1], mb1, mb2)[0]
+    gam_mid = hourglass_vectors(mid[3][0], mid[3][1], mid[5][0], mid[5][1])[0]
     r = sections[sec, C_HOURGLASS]
     k_m = 0.0 if full else r * c_memb * area * bb  # a 2×2 membrane has no in-plane modes
     # w mode: the bilinear w of an element is the nodal-value trace of a twist;
     # k = 16 D Σb² is its twist energy for a square element (r = 1)
     k_w = r * 16.0 * d_b * bb
     k_t = r * d_b * area * bb
-    hg0, e_hg = hourglass_mode(el_in[e, E_HG], k_m, gam_mid, vx, dt)
-    hg1, de = hourglass_mode(el_in[e, E_HG + 1], k_m, gam_mid, vy, dt)
-    e_hg += de
-    hg2, de = hourglass_mode(el_in[e, E_HG + 2], k_w, gam_mid, vz, dt)
-    e_hg += de
-    hg3, de = hourglass_mode(el_in[e, E_HG + 3], k_t, gam_mid, tx, dt)
-    e_hg += de
-    hg4, de = hourglass_mode(el_in[e, E_HG + 4], k_t, gam_mid, ty, dt)
-    e_hg += de
-    el_out[e, E_HG] = hg0
-    el_out[e, E_HG + 1] = hg1
-    el_out[e, E_HG + 2] = hg2
-    el_out[e, E_HG + 3] = hg3
-    el_out[e, E_HG + 4] = hg4
-    el_out[e, E_U_HG] = el_in[e, E_U_HG] + e_hg
+    hg0, hg1, hg2, hg3, hg4 = hourglass_resultants(
+        e, el_in, el_out, k_m, k_w, k_t, gam_mid, vx, vy, vz, tx, ty, dt)
 
     # 6. corner forces (membrane, shear, hourglass) and moments in the local frame,
     # turned to global axes
     fzs = warp_forces(mf_x, mf_y, lx, ly, frame[6], area)
-    fsum = 0.0
-    for i in range(4):
-        fx = mf_x[i] + gam[i] * hg0
-        fy = mf_y[i] + gam[i] * hg1
-        fz = area * (b1[i] * qx + b2[i] * qy) + gam[i] * hg2 + fzs[i]
-        mx = area * (-b2[i] * myy - b1[i] * mxy - 0.25 * qy) + gam[i] * hg3
-        my = area * (b1[i] * mxx + b2[i] * mxy + 0.25 * qx) + gam[i] * hg4
-        gx = fx * e1x + fy * e2x + fz * e3x
-        blocks[e, i, 0] = gx
-        blocks[e, i, 1] = fx * e1y + fy * e2y + fz * e3y
-        blocks[e, i, 2] = fx * e1z + fy * e2z + fz * e3z
-        blocks[e, i, 3] = mx * e1x + my * e2x
-        blocks[e, i, 4] = mx * e1y + my * e2y
-        blocks[e, i, 5] = mx * e1z + my * e2z
-        fsum += gx
+    fsum = corner_forces(e, blocks, frame, mf_x, mf_y, fzs, gam, hg0, hg1, hg2, hg3, hg4,
+                         mxx, myy, mxy, qx, qy)
 
-    # 7. stable step: L_e = A / longest edge, c² = max(C_m, k G t) / μ
-    edge2 = 0.0
-    for i in range(4):
-        j = (i + 1) % 4
-        dx = px[j] - px[i]
-        dy = py[j] - py[i]
-        dz = pz[j] - pz[i]
-        edge2 = max(edge2, dx * dx + dy * dy + dz * dz)
-    c2 = max(c_memb, kgt) / mu
-    dt_e = area / math.sqrt(edge2 * c2)
-    # rotations: a corner's spin against this element's transverse-shear and bending
-    # stiffness, k_θ = A (k G t/4 + D Σb²), with the rotary inertia the element lumped
-    # on it, I = ¼ μ A0 max(t²/12, A0/8); ω Δt ≤ 2 needs Δt ≤ 2 √(I/k_θ). In an element
-    # that has stretched far beyond its reference size (a broken yarn family) this,
-    # not the membrane, governs.
-    inertia = 0.25 * mu * a0 * max(thick * thick / 12.0, a0 / 8.0)
-    k_rot = area * (0.25 * kgt + d_b * bb)
-    dt_e = min(dt_e, 2.0 * math.sqrt(inertia / k_rot))
+    # 7. stable step
+    dt_e = element_stable_step(px, py, pz, area, c_memb, kgt, mu, a0, thick, d_b, bb)
     el_out[e, E_DT] = dt_e
     if not math.isfinite(fsum + dt_e):
         return EL_NAN, 0

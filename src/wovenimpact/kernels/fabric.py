@@ -18,6 +18,12 @@ current corotational frame), the kernel
    resultant (§1.6), the stored energy per unit reference area and an upper
    bound of the membrane tangent stiffness for the stable time step.
 
+``fabric_point`` is these steps as named stages — ``yarn_frame``,
+``green_naghdi_stretches``, ``crossover_equilibrium``, ``sliver_erodes``,
+``yarn_resultant``, ``trellis_shear``, ``stored_energy`` — inlined into it at Numba IR
+level (the same operations in the same order) and tested alone
+(tests/unit/test_fabric_stages.py).
+
 Everything is a pure function of flat arrays; ``fabric_update_point`` handles
 one point and ``fabric_update_for_points`` loops over many in parallel (each
 point independent, so results are bitwise identical for any thread count).
@@ -30,7 +36,7 @@ import math
 import numpy as np
 from numba import prange
 
-from wovenimpact.jit import kernel, loop_kernel
+from wovenimpact.jit import inline_kernel, kernel, loop_kernel
 from wovenimpact.kernels.fabric_table import crossover_from_table
 from wovenimpact.kernels.fabric_layout import (
     CROSSOVER_TABLE,
@@ -344,95 +350,94 @@ def clear_eroded_point(s_out, i):
     s_out[i, S_SHEAR_ENERGY] = 0.0
 
 
-@kernel
-def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, i):
-    """Update crossover material point i from F_old to F_new (the module's steps 1–5).
+@inline_kernel
+def yarn_frame(f11, f12, f21, f22):
+    """Step 1 (eq. 6.5, fibre frame): the yarns' current stretches λ_w = |F e_x|,
+    λ_f = |F e_y|, unit directions e_w, e_f, cos θ and sin θ of the angle between them,
+    and the trellis angle γ = π/2 − θ.
 
-    The core of :func:`fabric_update_point`, for loop kernels: whole tables and row
-    indices instead of per-point views, F as scalars and N returned, so that a call
-    costs no array views or reference counting.
-
-    Args:
-        p, m: parameter table (n_materials, N_PARAM) and the material's row.
-        fo11, fo12, fo21, fo22: F_old (row-major); f11, f12, f21, f22: F_new.
-        s_in, s_out: state tables (n, N_STATE): row i at the start of the step, and
-            row i at the end (written; the tables may not alias). Pass the rows m and
-            i as unsigned integers (np.uint64) in loops: signed indices cost a
-            negative-index check at every access.
-
-    Returns:
-        (status, stiffness, N_xx, N_yy, N_xy): a STATUS_* code, an upper bound of the
-        membrane tangent stiffness dN/dε (N/m) for the stable time step (theory
-        §1.8), and the membrane resultant in N/m (0 unless the status is OK).
+    Returns (ok, λ_w, λ_f, e_wx, e_wy, e_fx, e_fy, cos θ, sin θ, γ); ok is False for a
+    zero, non-finite or inverted pair of yarn directions.
     """
-    for j in range(N_STATE):
-        s_out[i, j] = s_in[i, j]
-    thick = p[m, P_THICK]
-
-    # 1. kinematics: current yarn directions and angle (eq. 6.5, fibre frame)
     gwx, gwy = f11, f21
     gfx, gfy = f12, f22
     lam_w = math.sqrt(gwx * gwx + gwy * gwy)
     lam_f = math.sqrt(gfx * gfx + gfy * gfy)
     if not (lam_w > 0.0 and lam_f > 0.0):  # also catches NaN
-        return STATUS_BAD_KINEMATICS, 0.0, 0.0, 0.0, 0.0
+        return False, lam_w, lam_f, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     ewx, ewy = gwx / lam_w, gwy / lam_w
     efx, efy = gfx / lam_f, gfy / lam_f
     cos_t = ewx * efx + ewy * efy
     sin_t = ewx * efy - ewy * efx
     if not (sin_t > 0.0) or not math.isfinite(cos_t):
-        return STATUS_BAD_KINEMATICS, 0.0, 0.0, 0.0, 0.0
+        return False, lam_w, lam_f, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     gamma = 0.5 * math.pi - math.atan2(sin_t, cos_t)
+    return True, lam_w, lam_f, ewx, ewy, efx, efy, cos_t, sin_t, gamma
 
-    if p[m, P_FRAME] == FRAME_GREEN_NAGHDI:
-        # Incremental stretches (eq. 6.13–6.16) from the midpoint strain increment
-        # Δε = sym(ΔF F_mid⁻¹), and the shear increment of eq. (6.34).
-        a11 = 0.5 * (fo11 + f11)
-        a12 = 0.5 * (fo12 + f12)
-        a21 = 0.5 * (fo21 + f21)
-        a22 = 0.5 * (fo22 + f22)
-        det = a11 * a22 - a12 * a21
-        if not (det > 0.0):
-            return STATUS_BAD_KINEMATICS, 0.0, 0.0, 0.0, 0.0
-        i11, i12, i21, i22 = a22 / det, -a12 / det, -a21 / det, a11 / det
-        d11 = f11 - fo11
-        d12 = f12 - fo12
-        d21 = f21 - fo21
-        d22 = f22 - fo22
-        l11 = d11 * i11 + d12 * i21
-        l12 = d11 * i12 + d12 * i22
-        l21 = d21 * i11 + d22 * i21
-        l22 = d21 * i12 + d22 * i22
-        e11, e22, e12 = l11, l22, 0.5 * (l12 + l21)
-        # project on the yarn directions of the midpoint configuration, where Δε
-        # lives (second-order accurate; a rigid rotation gives Δε = 0 exactly,
-        # ΔF F_mid⁻¹ being the Cayley form of the rotation increment)
-        nw = math.sqrt(a11 * a11 + a21 * a21)
-        nf = math.sqrt(a12 * a12 + a22 * a22)
-        pwx, pwy = a11 / nw, a21 / nw
-        pfx, pfy = a12 / nf, a22 / nf
-        de_w = pwx * pwx * e11 + 2.0 * pwx * pwy * e12 + pwy * pwy * e22
-        de_f = pfx * pfx * e11 + 2.0 * pfx * pfy * e12 + pfy * pfy * e22
-        if not (1.0 + 2.0 * de_w > 0.0 and 1.0 + 2.0 * de_f > 0.0):
-            return STATUS_BAD_KINEMATICS, 0.0, 0.0, 0.0, 0.0
-        lam_w = s_in[i, S_LAMBDA] * math.sqrt(1.0 + 2.0 * de_w)
-        lam_f = s_in[i, S_LAMBDA + 1] * math.sqrt(1.0 + 2.0 * de_f)
-        # e_w · Δε · (e_w turned +90°) + (e_f turned −90°) · Δε · e_f  (eq. 6.34)
-        nwx, nwy = -pwy, pwx
-        mfx, mfy = pfy, -pfx
-        dgam = (pwx * nwx * e11 + (pwx * nwy + pwy * nwx) * e12 + pwy * nwy * e22) + (
-            mfx * pfx * e11 + (mfx * pfy + mfy * pfx) * e12 + mfy * pfy * e22
-        )
-        gamma = s_in[i, S_GAMMA] + dgam
-    dgamma = gamma - s_in[i, S_GAMMA]
-    s_out[i, S_LAMBDA] = lam_w
-    s_out[i, S_LAMBDA + 1] = lam_f
-    s_out[i, S_GAMMA] = gamma
 
-    if s_in[i, S_ALIVE] == 0.0:
-        clear_eroded_point(s_out, i)
-        return STATUS_OK, 0.0, 0.0, 0.0, 0.0
+@inline_kernel
+def green_naghdi_stretches(fo11, fo12, fo21, fo22, f11, f12, f21, f22, lam_w_old, lam_f_old,
+                           gamma_old):
+    """The thesis's incremental frame (option FRAME_GREEN_NAGHDI): the yarn stretches
+    and trellis angle advanced from their values at the start of the step.
 
+    Returns (ok, λ_w, λ_f, γ); ok is False if the midpoint F or a stretch is inadmissible.
+    """
+    # Incremental stretches (eq. 6.13–6.16) from the midpoint strain increment
+    # Δε = sym(ΔF F_mid⁻¹), and the shear increment of eq. (6.34).
+    a11 = 0.5 * (fo11 + f11)
+    a12 = 0.5 * (fo12 + f12)
+    a21 = 0.5 * (fo21 + f21)
+    a22 = 0.5 * (fo22 + f22)
+    det = a11 * a22 - a12 * a21
+    if not (det > 0.0):
+        return False, 0.0, 0.0, 0.0
+    i11, i12, i21, i22 = a22 / det, -a12 / det, -a21 / det, a11 / det
+    d11 = f11 - fo11
+    d12 = f12 - fo12
+    d21 = f21 - fo21
+    d22 = f22 - fo22
+    l11 = d11 * i11 + d12 * i21
+    l12 = d11 * i12 + d12 * i22
+    l21 = d21 * i11 + d22 * i21
+    l22 = d21 * i12 + d22 * i22
+    e11, e22, e12 = l11, l22, 0.5 * (l12 + l21)
+    # project on the yarn directions of the midpoint configuration, where Δε
+    # lives (second-order accurate; a rigid rotation gives Δε = 0 exactly,
+    # ΔF F_mid⁻¹ being the Cayley form of the rotation increment)
+    nw = math.sqrt(a11 * a11 + a21 * a21)
+    nf = math.sqrt(a12 * a12 + a22 * a22)
+    pwx, pwy = a11 / nw, a21 / nw
+    pfx, pfy = a12 / nf, a22 / nf
+    de_w = pwx * pwx * e11 + 2.0 * pwx * pwy * e12 + pwy * pwy * e22
+    de_f = pfx * pfx * e11 + 2.0 * pfx * pfy * e12 + pfy * pfy * e22
+    if not (1.0 + 2.0 * de_w > 0.0 and 1.0 + 2.0 * de_f > 0.0):
+        return False, 0.0, 0.0, 0.0
+    lam_w = lam_w_old * math.sqrt(1.0 + 2.0 * de_w)
+    lam_f = lam_f_old * math.sqrt(1.0 + 2.0 * de_f)
+    # e_w · Δε · (e_w turned +90°) + (e_f turned −90°) · Δε · e_f  (eq. 6.34)
+    nwx, nwy = -pwy, pwx
+    mfx, mfy = pfy, -pfx
+    dgam = (pwx * nwx * e11 + (pwx * nwy + pwy * nwx) * e12 + pwy * nwy * e22) + (
+        mfx * pfx * e11 + (mfx * pfy + mfy * pfx) * e12 + mfy * pfy * e22
+    )
+    return True, lam_w, lam_f, gamma_old + dgam
+
+
+@inline_kernel
+def crossover_equilibrium(p, m, s_in, i, lam_w, lam_f):
+    """Steps 2–3 of the module docstring for point i at the yarn stretches λ_w, λ_f:
+    the crossover's crimp heights and yarn tensions, the failure check (eq. 6.29, or
+    progressive softening) and one re-solve with the new damage if a yarn failed.
+
+    From the table (theory §1.9) while both families are intact and the point lies in
+    a tabulated cell, else by the exact solve of eq. 6.21–6.25 (the yarn that is
+    vertically stiffer carries the unknown), a broken family's partner decrimping.
+
+    Returns (converged, iterations, H_w, H_f, d_w, d_f, T_w, T_f, L_w − L0_w, L_f − L0_f,
+    L_w, L_f, compaction force, from_table, W, ∂W/∂λ_w, ∂W/∂λ_f); the last three are the
+    table's (0 when the exact solve ran).
+    """
     ell0_w = p[m, P_ELL0]
     ell0_f = p[m, P_ELL0 + 1]
     h0_w = p[m, P_H0]
@@ -441,13 +446,10 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
     ell_f = lam_f * ell0_f
     lt0_w = p[m, P_LT0]
     lt0_f = p[m, P_LT0 + 1]
-    s_total = h0_w + h0_f
     a = p[m, P_COMP_A]
     b = p[m, P_COMP_B]
     ea_w = p[m, P_E] * p[m, P_AREA]
     ea_f = p[m, P_E + 1] * p[m, P_AREA + 1]
-
-    # 2–3. crossover solve, failure check, and one re-solve if a yarn failed
     d_w = s_in[i, S_DAMAGE]
     d_f = s_in[i, S_DAMAGE + 1]
     h_w = s_in[i, S_H]
@@ -536,8 +538,8 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
                     break
                 warp_unknown = not warp_unknown
             if not ok:
-                s_out[i, S_ITER] = iters
-                return STATUS_NOT_CONVERGED, 0.0, 0.0, 0.0, 0.0
+                return (False, iters, h_w, h_f, d_w, d_f, t_w, t_f, ext_w, ext_f, l_w, l_f,
+                        f_c, use_table, w_cross, gw_cross, gf_cross)
         elif d_w < 1.0:  # fill broken: the warp loses its support and decrimps
             h_w = min(s_in[i, S_H], slack_height(ell_w, ell0_w, h0_w))
             f_c = 0.0
@@ -569,32 +571,40 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
         d_w = d_w_new
         d_f = d_f_new
 
-    s_out[i, S_H] = h_w
-    s_out[i, S_H + 1] = h_f
-    s_out[i, S_DAMAGE] = d_w
-    s_out[i, S_DAMAGE + 1] = d_f
-    s_out[i, S_TENSION] = t_w
-    s_out[i, S_TENSION + 1] = t_f
-    s_out[i, S_ITER] = iters
-    # eroded (theory §1.4): both families broken, or one broken and the point a sliver:
-    # the broken family stretched beyond P_ERODE_STRETCH (held by nothing across the
-    # break), or either family crushed below P_ERODE_CRUSH (slack intact yarns, or intact
-    # yarns bunched with nothing holding them apart)
+    return (True, iters, h_w, h_f, d_w, d_f, t_w, t_f, ext_w, ext_f, l_w, l_f, f_c,
+            use_table, w_cross, gw_cross, gf_cross)
+
+
+@inline_kernel
+def sliver_erodes(p, m, d_w, d_f, lam_w, lam_f):
+    """Theory §1.4: a point with a family broken erodes once it is a sliver — the broken
+    family stretched beyond P_ERODE_STRETCH (held by nothing across the break), or either
+    family crushed below P_ERODE_CRUSH (slack intact yarns, or intact yarns bunched with
+    nothing holding them apart); 0 disables either test."""
     lim = p[m, P_ERODE_STRETCH]
     crush = p[m, P_ERODE_CRUSH]
-    if (lim > 0.0 and ((d_w >= 1.0 and lam_w > lim) or (d_f >= 1.0 and lam_f > lim))) or (
+    return (lim > 0.0 and ((d_w >= 1.0 and lam_w > lim) or (d_f >= 1.0 and lam_f > lim))) or (
         crush > 0.0 and (d_w >= 1.0 or d_f >= 1.0) and min(lam_w, lam_f) < crush
-    ):
-        d_w = 1.0
-        d_f = 1.0
-        s_out[i, S_DAMAGE] = 1.0
-        s_out[i, S_DAMAGE + 1] = 1.0
-    if d_w >= 1.0 and d_f >= 1.0:
-        clear_eroded_point(s_out, i)
-        return STATUS_OK, 0.0, 0.0, 0.0, 0.0
+    )
 
-    # 4a. yarn membrane resultant (theory §1.5), with the extensions L − L0 and
-    # lengths L of the final heights from the solve above
+
+@inline_kernel
+def yarn_resultant(p, m, use_table, lam_w, lam_f, sin_t, d_w, d_f, t_w, t_f, l_w, l_f,
+                   gw_cross, gf_cross):
+    """Step 4a (theory §1.5): the yarn families' membrane resultants c_w, c_f (N/m, along
+    e_w ⊗ e_w and e_f ⊗ e_f) and the bound of the membrane tangent stiffness (§1.8).
+
+    Virial N = Σ 2 T_i ℓ_i cosψ_i e_i⊗e_i / A_cell (default); from the table's
+    gradient, c_i = λ_i ∂W/∂λ_i / J; or the thesis's σ = ½ Σ T_i/A_i e_i⊗e_i (eq. 6.30).
+    Returns (c_w, c_f, stiffness).
+    """
+    thick = p[m, P_THICK]
+    ell_w = lam_w * p[m, P_ELL0]
+    ell_f = lam_f * p[m, P_ELL0 + 1]
+    lt0_w = p[m, P_LT0]
+    lt0_f = p[m, P_LT0 + 1]
+    ea_w = p[m, P_E] * p[m, P_AREA]
+    ea_f = p[m, P_E + 1] * p[m, P_AREA + 1]
     if p[m, P_HOMOG] == HOMOG_THESIS:  # eq. (6.30), (6.38): σ = ½ Σ T_i/A_i e_i⊗e_i, × t
         c_w = 0.5 * thick * t_w / p[m, P_AREA]
         c_f = 0.5 * thick * t_f / p[m, P_AREA + 1]
@@ -619,13 +629,20 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
             ((1.0 - d_w) * ea_w * ell_w / lt0_w + t_w) / (2.0 * ell_f * sin_t),
             ((1.0 - d_f) * ea_f * ell_f / lt0_f + t_f) / (2.0 * ell_w * sin_t),
         )
-    n_xx = c_w * ewx * ewx + c_f * efx * efx
-    n_yy = c_w * ewy * ewy + c_f * efy * efy
-    n_xy = c_w * ewx * ewy + c_f * efx * efy
+    return c_w, c_f, stiff
 
-    # 4b. trellis shear (theory §1.6): τ(γ), applied through its work conjugate
-    area0 = 4.0 * ell0_w * ell0_f
-    jac = lam_w * lam_f * sin_t
+
+@inline_kernel
+def trellis_shear(p, m, s_in, i, gamma, dgamma, h_w, h_f, lam_w, lam_f):
+    """Step 4b (theory §1.6): the trellis shear stress τ(γ), its tangent and the shear
+    energy per unit reference area — the true law G(γ) with locking (default), or the
+    thesis's G(β) integrated incrementally (eq. 6.35–6.37).
+
+    Returns (τ, tangent modulus, shear energy).
+    """
+    thick = p[m, P_THICK]
+    ell_w = lam_w * p[m, P_ELL0]
+    ell_f = lam_f * p[m, P_ELL0 + 1]
     if p[m, P_SHEAR] == SHEAR_THESIS:  # eq. (6.35)–(6.37): G(β), τ integrated incrementally
         sin_beta = 0.5 * (h_w / ell_w + h_f / ell_f)
         g = shear_modulus_thesis(sin_beta, p[m, P_G1], p[m, P_G2], p[m, P_BETA1], p[m, P_BETA2])
@@ -638,24 +655,122 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
         )
         tau = g * gamma
         e_shear = thick * e_dens
+    return tau, g_tan, e_shear
+
+
+@inline_kernel
+def stored_energy(p, m, use_table, w_cross, e_shear, d_w, d_f, ext_w, ext_f, h_w, h_f, f_c):
+    """Step 5: stored energy per unit reference area — two half trusses per family, the
+    compaction spring and the shear energy (the table's W in place of the first two)."""
+    ell0_w = p[m, P_ELL0]
+    ell0_f = p[m, P_ELL0 + 1]
+    lt0_w = p[m, P_LT0]
+    lt0_f = p[m, P_LT0 + 1]
+    s_total = p[m, P_H0] + p[m, P_H0 + 1]
+    a = p[m, P_COMP_A]
+    b = p[m, P_COMP_B]
+    ea_w = p[m, P_E] * p[m, P_AREA]
+    ea_f = p[m, P_E + 1] * p[m, P_AREA + 1]
+    area0 = 4.0 * ell0_w * ell0_f
+    if use_table:
+        return w_cross + e_shear
+    else:
+        k_w = (1.0 - d_w) * ea_w / lt0_w
+        k_f = (1.0 - d_f) * ea_f / lt0_f
+        u_yarn = k_w * max(ext_w, 0.0) ** 2 + k_f * max(ext_f, 0.0) ** 2
+        delta = s_total - h_w - h_f if f_c > 0.0 else 0.0
+        return (u_yarn + compaction_energy(delta, a, b)) / area0 + e_shear
+
+
+@kernel
+def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, i):
+    """Update crossover material point i from F_old to F_new (the module's steps 1–5).
+
+    The core of :func:`fabric_update_point`, for loop kernels: whole tables and row
+    indices instead of per-point views, F as scalars and N returned, so that a call
+    costs no array views or reference counting.
+
+    Args:
+        p, m: parameter table (n_materials, N_PARAM) and the material's row.
+        fo11, fo12, fo21, fo22: F_old (row-major); f11, f12, f21, f22: F_new.
+        s_in, s_out: state tables (n, N_STATE): row i at the start of the step, and
+            row i at the end (written; the tables may not alias). Pass the rows m and
+            i as unsigned integers (np.uint64) in loops: signed indices cost a
+            negative-index check at every access.
+
+    Returns:
+        (status, stiffness, N_xx, N_yy, N_xy): a STATUS_* code, an upper bound of the
+        membrane tangent stiffness dN/dε (N/m) for the stable time step (theory
+        §1.8), and the membrane resultant in N/m (0 unless the status is OK).
+    """
+    for j in range(N_STATE):
+        s_out[i, j] = s_in[i, j]
+    thick = p[m, P_THICK]
+
+    # 1. kinematics: current yarn directions and angle (eq. 6.5, fibre frame), or the
+    # thesis's incremental stretches (eq. 6.13–6.16)
+    ok, lam_w, lam_f, ewx, ewy, efx, efy, cos_t, sin_t, gamma = yarn_frame(f11, f12, f21, f22)
+    if not ok:
+        return STATUS_BAD_KINEMATICS, 0.0, 0.0, 0.0, 0.0
+    if p[m, P_FRAME] == FRAME_GREEN_NAGHDI:
+        ok, lam_w, lam_f, gamma = green_naghdi_stretches(
+            fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in[i, S_LAMBDA],
+            s_in[i, S_LAMBDA + 1], s_in[i, S_GAMMA])
+        if not ok:
+            return STATUS_BAD_KINEMATICS, 0.0, 0.0, 0.0, 0.0
+    dgamma = gamma - s_in[i, S_GAMMA]
+    s_out[i, S_LAMBDA] = lam_w
+    s_out[i, S_LAMBDA + 1] = lam_f
+    s_out[i, S_GAMMA] = gamma
+
+    if s_in[i, S_ALIVE] == 0.0:
+        clear_eroded_point(s_out, i)
+        return STATUS_OK, 0.0, 0.0, 0.0, 0.0
+
+    # 2–3. crossover solve, failure check, and one re-solve if a yarn failed
+    (ok, iters, h_w, h_f, d_w, d_f, t_w, t_f, ext_w, ext_f, l_w, l_f, f_c, use_table,
+     w_cross, gw_cross, gf_cross) = crossover_equilibrium(p, m, s_in, i, lam_w, lam_f)
+    s_out[i, S_ITER] = iters
+    if not ok:
+        return STATUS_NOT_CONVERGED, 0.0, 0.0, 0.0, 0.0
+    s_out[i, S_H] = h_w
+    s_out[i, S_H + 1] = h_f
+    s_out[i, S_DAMAGE] = d_w
+    s_out[i, S_DAMAGE + 1] = d_f
+    s_out[i, S_TENSION] = t_w
+    s_out[i, S_TENSION + 1] = t_f
+    # eroded (theory §1.4): both families broken, or one broken and the point a sliver
+    if sliver_erodes(p, m, d_w, d_f, lam_w, lam_f):
+        d_w = 1.0
+        d_f = 1.0
+        s_out[i, S_DAMAGE] = 1.0
+        s_out[i, S_DAMAGE + 1] = 1.0
+    if d_w >= 1.0 and d_f >= 1.0:
+        clear_eroded_point(s_out, i)
+        return STATUS_OK, 0.0, 0.0, 0.0, 0.0
+
+    # 4a. yarn membrane resultant (theory §1.5), with the extensions L − L0 and
+    # lengths L of the final heights from the solve above
+    c_w, c_f, stiff = yarn_resultant(p, m, use_table, lam_w, lam_f, sin_t, d_w, d_f, t_w, t_f,
+                                     l_w, l_f, gw_cross, gf_cross)
+    n_xx = c_w * ewx * ewx + c_f * efx * efx
+    n_yy = c_w * ewy * ewy + c_f * efy * efy
+    n_xy = c_w * ewx * ewy + c_f * efx * efy
+
+    # 4b. trellis shear (theory §1.6): τ(γ), applied through its work conjugate
+    tau, g_tan, e_shear = trellis_shear(p, m, s_in, i, gamma, dgamma, h_w, h_f, lam_w, lam_f)
     s_out[i, S_TAU] = tau
     s_out[i, S_SHEAR_ENERGY] = e_shear
+    jac = lam_w * lam_f * sin_t
     cs = thick * tau / (jac * sin_t)
     n_xx += cs * (2.0 * ewx * efx - cos_t * (ewx * ewx + efx * efx))
     n_yy += cs * (2.0 * ewy * efy - cos_t * (ewy * ewy + efy * efy))
     n_xy += cs * (ewx * efy + ewy * efx - cos_t * (ewx * ewy + efx * efy))
     stiff += thick * g_tan
 
-    # 5. stored energy per unit reference area: two half trusses per family,
-    #    the compaction spring and the shear energy
-    if use_table:
-        s_out[i, S_ENERGY] = w_cross + e_shear
-    else:
-        k_w = (1.0 - d_w) * ea_w / lt0_w
-        k_f = (1.0 - d_f) * ea_f / lt0_f
-        u_yarn = k_w * max(ext_w, 0.0) ** 2 + k_f * max(ext_f, 0.0) ** 2
-        delta = s_total - h_w - h_f if f_c > 0.0 else 0.0
-        s_out[i, S_ENERGY] = (u_yarn + compaction_energy(delta, a, b)) / area0 + e_shear
+    # 5. stored energy per unit reference area
+    s_out[i, S_ENERGY] = stored_energy(p, m, use_table, w_cross, e_shear, d_w, d_f, ext_w,
+                                       ext_f, h_w, h_f, f_c)
     return STATUS_OK, stiff, n_xx, n_yy, n_xy
 
 

@@ -325,6 +325,64 @@ def test_steps_are_bitwise_identical_with_one_or_two_threads():
     assert results[0].mat[:, FL.S_TENSION].max() > 0.0  # yarn tensions were exercised
 
 
+def test_the_element_stage_writes_every_output_it_is_handed():
+    """Every element's blocks, status, eroded flag and alive byte, and its end-of-step
+    state row, are written by the parallel loop (the outputs reach it in bundles: a
+    Numba prange body can lose writes made through a named tuple, theory §4.6)."""
+    nodes, quads, _ = distorted_square()
+    model = build_model(nodes, quads, {"s": Section(elastic(), thickness=1e-3)},
+                        np.zeros(len(quads), int))
+    st = initial_state(model)
+    st.x = st.x * 1.01  # a uniform stretch: every element carries a force
+    ws = Workspace.for_model(model, st)
+    ws.blocks[:] = np.nan
+    ws.status[:] = 7
+    ws.eroded_now[:] = 7
+    ws.alive[:] = 7
+    ws.elem[:] = np.nan
+    element_forces(model, st, ws)
+    assert np.isfinite(ws.blocks).all() and np.abs(ws.blocks).max() > 0.0
+    assert (ws.status == 0).all() and (ws.eroded_now == 0).all() and (ws.alive == 1).all()
+    assert np.isfinite(ws.elem).all() and (ws.elem[:, SL.E_ALIVE] == 1.0).all()
+
+
+def test_the_node_pass_writes_every_output_it_is_handed():
+    """The node pass (``gather_and_update``, its arrays in bundles like the element
+    stage's) writes every node's internal force, external force, work, kinetic energy and
+    velocity: outputs filled with NaN come back finite, and a free node at rest moves off
+    with v = Δt^n (−f_int)/m."""
+    from wovenimpact.kernels.bundles import Motion, NodeForces, NodeModel
+    from wovenimpact.kernels.gather import gather_nodal_forces
+    from wovenimpact.kernels.integrate import gather_and_update
+
+    nodes, quads, _ = distorted_square()
+    model = build_model(nodes, quads, {"s": Section(elastic(), thickness=1e-3)},
+                        np.zeros(len(quads), int))
+    st = initial_state(model)
+    st.x = st.x * 1.01
+    ws = Workspace.for_model(model, st)
+    element_forces(model, st, ws)
+    expected = np.zeros_like(ws.f_int)
+    gather_nodal_forces(model.node_ptr, model.node_elem, model.node_corner, ws.blocks,
+                        ws.alive, expected, np.zeros(model.n_nodes, dtype=np.int64))
+    for a in (ws.f_int, ws.f_ext, ws.w_int, ws.w_ext, ws.ke, ws.ke_eroded):
+        a[:] = np.nan
+    dt = 1e-7
+    n_bad = gather_and_update(
+        ws.node_map, ws.results,
+        NodeModel(mass=ws.node_mass, inertia=ws.node_inertia, bc_code=model.bc_code,
+                  bc_velocity=model.bc_velocity, body_accel=model.body_accel),
+        np.zeros((model.n_nodes, 3)), 1.0, dt, dt,
+        NodeForces(f_int=ws.f_int, f_int_old=st.f_int, f_ext_old=st.f_ext, f_ext=ws.f_ext),
+        Motion(x=st.x, v=st.v, omega=st.omega), st.node_active, ws.energies)
+    assert n_bad == 0
+    assert np.array_equal(ws.f_int, expected) and np.abs(expected[:, :3]).max() > 0.0
+    for a in (ws.f_ext, ws.w_int, ws.w_ext, ws.ke, ws.ke_eroded):
+        assert np.isfinite(a).all()
+    np.testing.assert_allclose(st.v, -dt * expected[:, :3] / ws.node_mass[:, None],
+                               rtol=1e-14, atol=0.0)
+
+
 def test_body_force_accelerates_a_free_plate_uniformly_and_its_work_is_booked():
     """A free plate under a uniform body force a: every node has v = a t (exact for
     central differences), no stress, and the external work equals the kinetic energy."""

@@ -177,34 +177,54 @@ def update_node(
 
 
 @loop_kernel
-def gather_and_update(
-    node_ptr, node_elem, node_corner, blocks, alive,
-    mass, inertia, bc_code, bc_velocity, body_accel, f_con, amplitude, dt_old, dt_new,
-    f_int, f_int_old, f_ext_old, x, v, omega, node_active,
-    f_ext, w_int, w_ext, ke, ke_eroded,
-):
+def gather_and_update(node_map, elements, nodes, f_con, amplitude, dt_old, dt_new, forces,
+                      motion, node_active, energies):
     """Gather the internal forces of every node and advance it by one step.
 
     Args:
-        node_ptr, node_elem, node_corner: CSR map (Model).
-        blocks: (n_elems, 4, 6) element corner forces and moments at x^n.
-        alive: (n_elems,) uint8, 1 for a live element (written by the force kernel).
-        mass, inertia, bc_code, bc_velocity, body_accel: Model arrays.
+        node_map: ``bundles.NodeMap`` (Model).
+        elements: ``bundles.ElementResults`` of the element stage: its ``blocks``
+            (n_elems, 4, 6) corner forces and moments at x^n and ``alive`` bytes are read.
+        nodes: ``bundles.NodeModel``: masses, rotary inertias, constraints, body loads.
         f_con: (n, 3) contact forces at x^n (external loads of the shells).
         amplitude: prescribed-velocity amplitude at t^{n+1/2}.
         dt_old, dt_new: Δt^{n−1/2}, Δt^{n+1/2}.
-        f_int: (n, 6) written: internal forces at x^n (gathered from blocks).
-        f_int_old, f_ext_old: internal and external forces at x^{n−1}.
-        x, v, omega, node_active: advanced in place.
-        (Kinetic energy of the node: ½ m v^{n−1/2} · v^{n+1/2}, see the module docstring.)
-        f_ext: (n, 6) written: body forces plus reactions at x^n.
-        w_int, w_ext, ke, ke_eroded: (n,) written: per-node internal and external
-            work increments over [x^{n−1}, x^n], kinetic energy at t^n, and kinetic
-            energy removed with nodes eroded this step.
+        forces: ``bundles.NodeForces``: f_int written (gathered from the blocks),
+            f_int_old and f_ext_old at x^{n−1} read, f_ext written (body forces plus
+            reactions at x^n).
+        motion: ``bundles.Motion``: x, v, omega advanced in place.
+        node_active: (n,) advanced in place (0 once a node has lost its last element).
+        energies: ``bundles.NodeEnergies``, written: per-node internal and external work
+            increments over [x^{n−1}, x^n], kinetic energy at t^n (½ m v^{n−1/2} ·
+            v^{n+1/2}, see the module docstring), and kinetic energy removed with nodes
+            eroded this step.
 
     Returns:
         the number of nodes whose position x^{n+1} is not finite (0 when all is well).
     """
+    # one bundle member per statement, read before the parallel loop (a prange body that
+    # writes through a bundle can lose its writes: theory §4.6)
+    node_ptr = node_map.node_ptr
+    node_elem = node_map.node_elem
+    node_corner = node_map.node_corner
+    blocks = elements.blocks
+    alive = elements.alive
+    mass = nodes.mass
+    inertia = nodes.inertia
+    bc_code = nodes.bc_code
+    bc_velocity = nodes.bc_velocity
+    body_accel = nodes.body_accel
+    f_int = forces.f_int
+    f_int_old = forces.f_int_old
+    f_ext_old = forces.f_ext_old
+    f_ext = forces.f_ext
+    x = motion.x
+    v = motion.v
+    omega = motion.omega
+    w_int = energies.w_int
+    w_ext = energies.w_ext
+    ke = energies.ke
+    ke_eroded = energies.ke_eroded
     nn = x.shape[0]
     dt_mid = 0.5 * (dt_old + dt_new)
     n_bad = 0

@@ -47,6 +47,7 @@ from numba import prange
 
 from wovenimpact.jit import inline_kernel, kernel, loop_kernel
 from wovenimpact.kernels import fabric_layout as FL
+from wovenimpact.kernels.bundles import ElementTables
 from wovenimpact.kernels.fabric import fabric_point
 from wovenimpact.kernels.j2 import j2_point
 from wovenimpact.kernels.shell_layout import (
@@ -656,21 +657,16 @@ def carry_state(e, el_in, el_out, rows_in, rows_out, row0, n_rows):
 
 
 @kernel
-def shell_force(
-    e, x, v, omega, dt, quads, area0, ref_grad, gauss_grad, gauss_weight, sec, sections,
-    mat_kind, mat_params, el_in, el_out, rows_in, rows_out, point_blocks, blocks,
-):
+def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
     """Internal forces of shell element e at x^n (see the module docstring).
 
     Args:
         e: the element (row of every per-element table below), unsigned.
-        x, v, omega: (n_nodes, 3) positions x^n, velocities v^{n−1/2}, spins ω^{n−1/2}.
+        mesh: :class:`~wovenimpact.kernels.bundles.ShellMesh` (Model tables).
+        motion: :class:`~wovenimpact.kernels.bundles.Motion`: x^n, v^{n−1/2}, ω^{n−1/2}.
         dt: Δt^{n−1/2}, the step the rates act over (0 at the start).
-        quads: (n_elems, 4) node indices; area0: (n_elems,) reference areas A0;
-            ref_grad: (n_elems, 2, 4) ∂N_I/∂X in the material frame (centre);
-            gauss_grad, gauss_weight: the same at the 2×2 Gauss points, and det J.
-        sec: the element's row of sections (unsigned); mat_kind, mat_params: material kinds and
-            parameter table (row int(sections[sec, C_MAT])).
+        tables: :class:`~wovenimpact.kernels.bundles.ElementTables` whose material
+            tables are one row per point (rows_in, rows_out below).
         el_in, el_out: element state tables (shell_layout), start / end of step.
         rows_in, rows_out: material point states, start / end of step, one row per
             point: element e owns rows e·point_blocks … + point_blocks − 1, of which
@@ -684,6 +680,12 @@ def shell_force(
     Returns:
         (status, eroded_now): an EL_* code, and 1 if the element eroded this step.
     """
+    x, v, omega = motion.x, motion.v, motion.omega
+    quads, area0, ref_grad = mesh.quads, mesh.area0, mesh.ref_grad
+    gauss_grad, gauss_weight = mesh.gauss_grad, mesh.gauss_weight
+    sections, mat_kind, mat_params = mesh.sections, mesh.mat_kind, mesh.mat_params
+    el_in, el_out, rows_in, rows_out = tables.el_in, tables.el_out, tables.mat_in, tables.mat_out
+    sec = np.uint64(mesh.elem_section[e])
     # the rows the element's section uses (a fabric section of a model that also holds
     # 2×2×5-point metal uses 4 of the 20 point rows each element owns)
     n_rows = min(np.uint64(sections[sec, C_POINTS] * sections[sec, C_INPLANE]),
@@ -822,22 +824,19 @@ def shell_force(
 
 
 @loop_kernel
-def internal_force_for_shells(
-    x, v, omega, dt, quads, elem_section, sections, mat_kind, mat_params, area0, ref_grad,
-    gauss_grad, gauss_weight, el_in, el_out, m_in, m_out, point_width, blocks, status,
-    eroded_now, alive, dt_erode, erode_inverted,
-):
+def internal_force_for_shells(mesh, motion, dt, tables, results, dt_erode, erode_inverted):
     """``shell_force`` for every element (prange; each element writes its own rows).
 
-    Args: positions/velocities/spins (n_nodes, 3); dt; Model arrays; element and
-    material state in/out (m_in, m_out: (n_elems, width), an element's points' state
-    blocks of ``point_width`` values side by side); blocks (n_elems, 4, 6) written; status, eroded_now
-    (n_elems,) written; alive (n_elems,) uint8 written: 1 for an element alive at
-    the end of the step (a compact copy of ``el_out[:, E_ALIVE]`` for the node
-    kernels); dt_erode: an element whose own stable step L_e/c_e falls below it is
-    eroded (crushed or collapsed elements, e.g. fabric with one yarn family
-    broken; 0 disables); erode_inverted: an element inverted (non-positive area or
-    Jacobian) is eroded instead of stopping the run.
+    Args: mesh (``bundles.ShellMesh``); motion (``bundles.Motion``); dt; tables
+    (``bundles.ElementTables``: mat_in, mat_out (n_elems, width), an element's points'
+    state blocks of ``mesh.point_width`` values side by side); results
+    (``bundles.ElementResults``, written: blocks (n_elems, 4, 6); status, eroded_now
+    (n_elems,); alive (n_elems,) uint8: 1 for an element alive at the end of the step, a
+    compact copy of ``el_out[:, E_ALIVE]`` for the node kernels); dt_erode: an element
+    whose own stable step L_e/c_e falls below it is eroded (crushed or collapsed
+    elements, e.g. fabric with one yarn family broken; 0 disables); erode_inverted: an
+    element inverted (non-positive area or Jacobian) is eroded instead of stopping the
+    run.
 
     Returns:
         (n_failed, n_eroded, dt_min): elements with a non-OK status, elements
@@ -846,12 +845,23 @@ def internal_force_for_shells(
         exact in any order, so also the same for any thread count; meaningful only
         when n_failed is 0).
     """
-    ne = quads.shape[0]
+    # one bundle member per statement, read before the parallel loop: a prange body
+    # that writes through a bundle, or through arrays unpacked from a tuple in one
+    # statement, loses its writes (Numba issues 5872, 7135: open in 0.68)
+    ne = mesh.quads.shape[0]
+    el_out = tables.el_out
+    blocks = results.blocks
+    status = results.status
+    eroded_now = results.eroded_now
+    alive = results.alive
     n_failed = 0
     n_eroded = 0
     dt_min = math.inf
-    # the material state as one row per point: an element's row of m_in holds its
+    # the material state as one row per point: an element's row of mat_in holds its
     # points' state blocks side by side; elastic-only models have none (point_width 0)
+    m_in = tables.mat_in
+    m_out = tables.mat_out
+    point_width = mesh.point_width
     width = m_in.shape[1]
     point_blocks = width // point_width if point_width > 0 else 0
     if point_blocks > 0 and point_blocks * point_width == width:
@@ -861,12 +871,9 @@ def internal_force_for_shells(
         rows_in = m_in
         rows_out = m_out
         point_blocks = 1
+    rows = ElementTables(tables.el_in, el_out, rows_in, rows_out)
     for e in prange(ne):
-        st, er = shell_force(
-            np.uint64(e), x, v, omega, dt, quads, area0, ref_grad, gauss_grad, gauss_weight,
-            np.uint64(elem_section[e]), sections, mat_kind, mat_params, el_in, el_out,
-            rows_in, rows_out, point_blocks, blocks,
-        )
+        st, er = shell_force(np.uint64(e), mesh, motion, dt, rows, point_blocks, blocks)
         if st == EL_INVERTED and erode_inverted:
             # crushed through itself (LS-DYNA's erosion on a negative Jacobian): it goes,
             # with the energies it held at the start of the step

@@ -29,6 +29,16 @@ import numpy as np
 
 from wovenimpact.errors import SimulationError
 from wovenimpact.kernels import shell_layout as SL
+from wovenimpact.kernels.bundles import (
+    ElementResults,
+    ElementTables,
+    Motion,
+    NodeEnergies,
+    NodeForces,
+    NodeMap,
+    NodeModel,
+    ShellMesh,
+)
 from wovenimpact.kernels.gather import gather_nodal_forces
 from wovenimpact.kernels.integrate import force_pair_power, gather_and_update, smooth_step
 from wovenimpact.kernels.mass_scaling import node_masses, scale_element_masses, scaled_node_masses
@@ -77,6 +87,10 @@ class Workspace:
     node_mass: np.ndarray  # nodal masses with those added by mass scaling (kg)
     node_inertia: np.ndarray  # rotary inertias, scaled like the masses (kg m²)
     added_ke: np.ndarray  # kinetic energy each node gained with added mass, last step (J)
+    mesh: ShellMesh = None  # the Model's tables the element kernel reads
+    results: ElementResults = None  # blocks, status, eroded_now, alive (above)
+    node_map: NodeMap = None  # the Model's node → (element, corner) map
+    energies: NodeEnergies = None  # w_int, w_ext, ke, ke_eroded (above)
     contact: object = None  # solver.contact_stage.ContactBuffers
     dt_min: float = math.inf  # min_e L_e/c_e of the last element stage
     n_eroded: int = 0  # elements eroded in the last element stage
@@ -100,7 +114,7 @@ class Workspace:
         if state.contact_work.shape != (n,):
             state.contact_work = np.zeros(n)
         mass, inertia = node_masses(model.node_mass, model.node_inertia, state.added_mass)
-        return cls(
+        ws = cls(
             elem=state.elem.copy(), mat=state.mat.copy(),  # dead rows stay equal (shell_force)
             blocks=np.zeros((ne, 4, 6)), status=np.zeros(ne, dtype=np.int32),
             eroded_now=np.zeros(ne, dtype=np.int32), alive=np.zeros(ne, dtype=np.uint8),
@@ -110,17 +124,28 @@ class Workspace:
             node_mass=mass, node_inertia=inertia, added_ke=np.zeros(n),
             contact=ContactBuffers.for_model(model),
         )
+        ws.mesh = ShellMesh(
+            quads=model.quads, elem_section=model.elem_section, sections=model.sections,
+            mat_kind=model.mat_kind, mat_params=model.mat_params, area0=model.area0,
+            ref_grad=model.ref_grad, gauss_grad=model.gauss_grad,
+            gauss_weight=model.gauss_weight, point_width=int(model.point_width))
+        ws.results = ElementResults(blocks=ws.blocks, status=ws.status,
+                                    eroded_now=ws.eroded_now, alive=ws.alive)
+        ws.node_map = NodeMap(node_ptr=model.node_ptr, node_elem=model.node_elem,
+                              node_corner=model.node_corner)
+        ws.energies = NodeEnergies(w_int=ws.w_int, w_ext=ws.w_ext, ke=ws.ke,
+                                   ke_eroded=ws.ke_eroded)
+        return ws
 
 
 def shell_forces(model, state: State, ws: Workspace) -> None:
     """Stage 1: element forces at x^n into ws (blocks, element and material state,
     alive bytes, dt_min, n_eroded); stops naming the first failed element."""
     n_failed, ws.n_eroded, ws.dt_min = internal_force_for_shells(
-        state.x, state.v, state.omega, state.dt, model.quads, model.elem_section,
-        model.sections, model.mat_kind, model.mat_params, model.area0, model.ref_grad,
-        model.gauss_grad, model.gauss_weight, state.elem, ws.elem, state.mat, ws.mat,
-        model.point_width, ws.blocks, ws.status, ws.eroded_now, ws.alive,
-        model.erode_dt_fraction * state.dt_first / model.alpha, model.erode_inverted,
+        ws.mesh, Motion(x=state.x, v=state.v, omega=state.omega), state.dt,
+        ElementTables(el_in=state.elem, el_out=ws.elem, mat_in=state.mat, mat_out=ws.mat),
+        ws.results, model.erode_dt_fraction * state.dt_first / model.alpha,
+        model.erode_inverted,
     )
     if n_failed:
         bad = np.flatnonzero(ws.status)
@@ -230,11 +255,13 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     t0 = ws.tick("contact", t0)
     amplitude = smooth_step(state.t + 0.5 * dt_new, model.ramp_time)
     n_bad = gather_and_update(
-        model.node_ptr, model.node_elem, model.node_corner, ws.blocks, ws.alive,
-        ws.node_mass, ws.node_inertia, model.bc_code, model.bc_velocity, model.body_accel,
-        cb.f_con, amplitude, state.dt, dt_new, ws.f_int, state.f_int, state.f_ext,
-        state.x, state.v, state.omega, state.node_active, ws.f_ext,
-        ws.w_int, ws.w_ext, ws.ke, ws.ke_eroded,
+        ws.node_map, ws.results,
+        NodeModel(mass=ws.node_mass, inertia=ws.node_inertia, bc_code=model.bc_code,
+                  bc_velocity=model.bc_velocity, body_accel=model.body_accel),
+        cb.f_con, amplitude, state.dt, dt_new,
+        NodeForces(f_int=ws.f_int, f_int_old=state.f_int, f_ext_old=state.f_ext,
+                   f_ext=ws.f_ext),
+        Motion(x=state.x, v=state.v, omega=state.omega), state.node_active, ws.energies,
     )
     t0 = ws.tick("gather + integrate", t0)
     if n_bad:

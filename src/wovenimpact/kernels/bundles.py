@@ -1,0 +1,103 @@
+"""Named bundles of arrays handed to the step's kernels (issue 13).
+
+The element loop (``shell.internal_force_for_shells``) and the node pass
+(``integrate.gather_and_update``) took 24 and 26 positional arrays, most of one dtype:
+two swapped arguments compiled and ran. They now take named tuples, built
+with keywords, the way MuJoCo Warp hands ``Model`` and ``Data`` to every kernel; Numba
+passes a named tuple of arrays as its members (a field read is resolved at compile
+time), so a bundle costs nothing in the compiled loop (theory §4.6: instruction counts
+before and after). In a ``prange`` loop, read each member into a local, one per
+statement, before the loop: writes through a bundle in the loop body can be lost
+(theory §4.6; a sentinel test of each loop guards it).
+
+:class:`ShellMesh`, :class:`ElementResults`, :class:`NodeMap` and :class:`NodeEnergies`
+are built once per Workspace, the others per step from the arrays the step swaps; none
+is stored in a checkpoint.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+
+class ShellMesh(NamedTuple):
+    """What the element kernel reads of a Model (never written)."""
+
+    quads: np.ndarray  # (n_elems, 4) node indices
+    elem_section: np.ndarray  # (n_elems,) row of ``sections``
+    sections: np.ndarray  # (n_sections, N_SECTION) shell_layout C_* columns
+    mat_kind: np.ndarray  # (n_materials,) MAT_* codes
+    mat_params: np.ndarray  # (n_materials, n_par) parameter rows
+    area0: np.ndarray  # (n_elems,) reference areas A0
+    ref_grad: np.ndarray  # (n_elems, 2, 4) ∂N_I/∂X at the centre, material frame
+    gauss_grad: np.ndarray  # (n_elems, 4, 2, 4) the same at the 2×2 Gauss points
+    gauss_weight: np.ndarray  # (n_elems, 4) their weights (det J)
+    point_width: int  # values per material point state block
+
+
+class Motion(NamedTuple):
+    """Nodal positions x^n, velocities v^{n−1/2} and spins ω^{n−1/2}, (n_nodes, 3) each."""
+
+    x: np.ndarray
+    v: np.ndarray
+    omega: np.ndarray
+
+
+class ElementTables(NamedTuple):
+    """Element and material-point state at the start (``*_in``) and end (``*_out``) of
+    the step; the out tables are written (shell_layout E_*, and the materials' S_*)."""
+
+    el_in: np.ndarray  # (n_elems, N_ELEM_STATE)
+    el_out: np.ndarray
+    mat_in: np.ndarray  # (n_elems, width): an element's point blocks side by side
+    mat_out: np.ndarray
+
+
+class ElementResults(NamedTuple):
+    """What the element stage writes beside the state tables."""
+
+    blocks: np.ndarray  # (n_elems, 4, 6) corner forces and moments (global)
+    status: np.ndarray  # (n_elems,) int32 EL_* codes
+    eroded_now: np.ndarray  # (n_elems,) int32, 1 where an element eroded this step
+    alive: np.ndarray  # (n_elems,) uint8, 1 for an element alive at the end of the step
+
+
+class NodeMap(NamedTuple):
+    """The node → (element, corner) map in CSR form (Model)."""
+
+    node_ptr: np.ndarray
+    node_elem: np.ndarray
+    node_corner: np.ndarray
+
+
+class NodeModel(NamedTuple):
+    """Nodal masses (with any added by mass scaling), constraints and body loads."""
+
+    mass: np.ndarray  # (n_nodes,) kg
+    inertia: np.ndarray  # (n_nodes,) rotary inertia, kg m²
+    bc_code: np.ndarray  # (n_nodes, 6) integrate FREE / FIXED / PRESCRIBED / ROTATING
+    bc_velocity: np.ndarray  # (n_nodes, 6) prescribed velocities (or ω and the centre)
+    body_accel: np.ndarray  # (n_nodes, 3) body-force acceleration, m/s²
+
+
+class NodeForces(NamedTuple):
+    """Nodal forces, (n_nodes, 6) each: internal at x^n (written by the gather), internal
+    and external at x^{n−1}, external (body forces plus reactions) at x^n (written)."""
+
+    f_int: np.ndarray
+    f_int_old: np.ndarray
+    f_ext_old: np.ndarray
+    f_ext: np.ndarray
+
+
+class NodeEnergies(NamedTuple):
+    """Per-node energy figures of the step (written), (n_nodes,) each: internal and
+    external work over [x^{n−1}, x^n], kinetic energy at t^n, kinetic energy of nodes
+    eroded now."""
+
+    w_int: np.ndarray
+    w_ext: np.ndarray
+    ke: np.ndarray
+    ke_eroded: np.ndarray

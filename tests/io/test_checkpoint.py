@@ -107,3 +107,21 @@ def test_other_files_are_ignored(tmp_path):
 def test_keep_must_be_positive(tmp_path, keep):
     with pytest.raises(InputError, match="keep"):
         save_checkpoint(tmp_path, make_state(), DIGEST, keep=keep)
+
+
+def test_a_checkpoint_without_a_later_array_is_refused_but_its_arrays_still_load(tmp_path):
+    """A file written before ``contact_work`` existed: ``--restart`` refuses it (its code
+    digest differs anyway, and the file says what it lacks), while ``State.from_arrays``
+    (diagnostics reading old runs) gives that array its empty default (``Workspace.
+    for_model`` sizes it)."""
+    s = make_state()
+    s.contact_work = np.arange(5.0)
+    path = save_checkpoint(tmp_path / "ck", s, DIGEST)
+    with np.load(path) as npz:
+        data = {k: npz[k] for k in npz.files if k != "contact_work"}
+    np.savez(path, **data)
+    with pytest.raises(InputError, match="incomplete.*contact_work"):
+        load_checkpoint(path, DIGEST)
+    back = State.from_arrays(data)
+    assert back.contact_work.size == 0
+    assert np.array_equal(back.x, s.x) and back.step == s.step

@@ -34,13 +34,40 @@ def layer_sets(model) -> list[str]:
     return out
 
 
+def anchored_casing_nodes(model, state, casing: np.ndarray) -> np.ndarray:
+    """The nodes of ``casing`` joined through live casing elements to a constrained
+    casing node (the clamped ends and cut edges hold the casing): a boolean mask over
+    ``casing``. A piece of ply torn free and flying ahead of the fragment holds nothing
+    (theory §8.3). A casing with no constrained node (a user's free-standing mesh) has
+    nothing to be joined to: then every node with a live element counts."""
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+
+    in_casing = np.zeros(model.n_nodes, dtype=bool)
+    in_casing[casing] = True
+    q = model.quads[(state.elem[:, SL.E_ALIVE] != 0.0) & in_casing[model.quads].all(axis=1)]
+    live = np.zeros(model.n_nodes, dtype=bool)
+    live[q.ravel()] = True
+    held = in_casing & live & np.any(model.bc_code != 0, axis=1)
+    if not np.any(in_casing & np.any(model.bc_code != 0, axis=1)):
+        return live[casing]
+    edges = np.concatenate([q[:, [0, 1]], q[:, [1, 2]], q[:, [2, 3]], q[:, [3, 0]]])
+    graph = coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])),
+                       shape=(model.n_nodes, model.n_nodes))
+    _, label = connected_components(graph, directed=False)
+    anchored = np.zeros(label.max() + 1, dtype=bool)
+    anchored[label[held]] = True
+    return live[casing] & anchored[label[casing]]
+
+
 def fragment_row(model, state) -> dict:
     """The fragment's kinematics and the intact casing material outside it.
 
-    ``intact_casing_outside``: 1 if a casing node that still has a live element lies
-    within the fragment's path window (angular and axial extent of the fragment × 1.5
-    about its centre of mass, at least two casing elements either way) at a larger
-    radius than the fragment's outermost node.
+    ``intact_casing_outside``: 1 if a casing node joined to the casing's supports
+    through live elements (:func:`anchored_casing_nodes`) lies within the fragment's
+    path window (angular and axial extent of the fragment × 1.5 about its centre of
+    mass, at least two casing elements either way) at a larger radius than the
+    fragment's outermost node.
     """
     nodes = model.node_sets[FRAGMENT]
     m = model.node_mass[nodes]
@@ -61,9 +88,7 @@ def fragment_row(model, state) -> dict:
     half_angle = max(WINDOW * float(np.max(np.abs(np.angle(np.exp(1j * (phi - phi_cm)))))),
                      size / r_casing)
     half_z = max(WINDOW * float(np.max(np.abs(x[:, 2] - cm[2]))), size)
-    live = np.zeros(model.n_nodes, dtype=bool)
-    live[model.quads[state.elem[:, SL.E_ALIVE] != 0.0].ravel()] = True
-    casing = casing[live[casing]]
+    casing = casing[anchored_casing_nodes(model, state, casing)]
     xc = state.x[casing]
     near = (np.abs(np.angle(np.exp(1j * (np.arctan2(xc[:, 1], xc[:, 0]) - phi_cm))))
             <= half_angle) & (np.abs(xc[:, 2] - cm[2]) <= half_z)

@@ -228,3 +228,32 @@ def coarse_two_ply_casing():
     set_dotted(doc, "mesh.casing.layers", 2)
     compiled = compile_case(case_from_dict(doc, str(path)), path.parent)
     return compiled.model, compiled.state
+
+
+def test_a_piece_of_ply_torn_free_ahead_of_the_fragment_does_not_hold_it():
+    """Only casing material joined to the supports through live elements counts as
+    intact: a patch of the outer ply cut free (every element round it eroded) and lying
+    beyond the fragment does not keep a run undecided; the same patch still part of
+    its ply does."""
+    import math
+
+    from wovenimpact.containment import FRAGMENT, fragment_row, layer_elements
+    from wovenimpact.kernels import shell_layout as SL
+
+    model, state = coarse_two_ply_casing()
+    nodes = model.node_sets[FRAGMENT]
+    cm = model.node_mass[nodes] @ state.x[nodes] / model.node_mass[nodes].sum()
+    phi_cm = math.atan2(cm[1], cm[0])
+    layers = layer_elements(model)
+    centroid = state.x[model.quads].mean(axis=1)
+    dphi = np.abs(np.angle(np.exp(1j * (np.arctan2(centroid[:, 1], centroid[:, 0]) - phi_cm))))
+    patch = layers[-1][(dphi[layers[-1]] < 0.06) & (np.abs(centroid[layers[-1], 2] - cm[2])
+                                                     < 0.02)]
+    assert 0 < patch.size < layers[-1].size // 4
+    assert fragment_row(model, state)["intact_casing_outside"] == 1
+    for inner in layers[:-1]:  # the shell and the first ply gone
+        state.elem[inner, SL.E_ALIVE] = 0.0
+    assert fragment_row(model, state)["intact_casing_outside"] == 1  # the outer ply holds
+    rest = np.setdiff1d(layers[-1], patch)
+    state.elem[rest, SL.E_ALIVE] = 0.0  # the patch alone is left, free of the supports
+    assert fragment_row(model, state)["intact_casing_outside"] == 0

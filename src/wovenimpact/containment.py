@@ -110,9 +110,14 @@ CONTAINMENT_COLUMNS = ("fragment_speed_m_per_s", "fragment_radial_velocity_m_per
 
 def outer_layer_bulge(model, state) -> float:
     """The outermost casing layer's largest outward radial displacement (m): max over its
-    nodes of r(x) − r(x0), r the distance from the casing axis (the z axis). Eroded
-    nodes keep their last position, so a bulge once reached is not lost with them."""
+    nodes still joined to the supports through live elements (:func:`anchored_casing_nodes`)
+    of r(x) − r(x0), r the distance from the casing axis (the z axis); 0 once none is.
+    Torn-off pieces flying away are not a bulge (a 4-ply run read 330 mm from them); a
+    bulge reached before the layer tore stays in the run's maximum (``max_bulge_m``)."""
     nodes = model.node_sets[layer_sets(model)[-1]]
+    nodes = nodes[anchored_casing_nodes(model, state, nodes)]
+    if nodes.size == 0:
+        return 0.0
     r0 = np.hypot(model.x0[nodes, 0], model.x0[nodes, 1])
     r1 = np.hypot(state.x[nodes, 0], state.x[nodes, 1])
     return float(np.max(r1 - r0))

@@ -233,8 +233,8 @@ def coarse_two_ply_casing():
 def test_a_piece_of_ply_torn_free_ahead_of_the_fragment_does_not_hold_it():
     """Only casing material joined to the supports through live elements counts as
     intact: a patch of the outer ply cut free (every element round it eroded) and lying
-    beyond the fragment does not keep a run undecided; the same patch still part of
-    its ply does."""
+    beyond the fragment does not keep a run undecided, nor is it the layer's bulge; the
+    same patch still part of its ply does both."""
     import math
 
     from wovenimpact.containment import FRAGMENT, fragment_row, layer_elements
@@ -254,6 +254,13 @@ def test_a_piece_of_ply_torn_free_ahead_of_the_fragment_does_not_hold_it():
     for inner in layers[:-1]:  # the shell and the first ply gone
         state.elem[inner, SL.E_ALIVE] = 0.0
     assert fragment_row(model, state)["intact_casing_outside"] == 1  # the outer ply holds
+    # the patch pushed 0.2 m out while still part of its ply is the layer's bulge
+    moved = np.unique(model.quads[patch])
+    radial = state.x[moved, :2] / np.hypot(*state.x[moved, :2].T)[:, None]
+    state.x[moved, :2] += 0.2 * radial
+    assert fragment_row(model, state)["outer_layer_bulge_m"] == pytest.approx(0.2, rel=1e-9)
     rest = np.setdiff1d(layers[-1], patch)
     state.elem[rest, SL.E_ALIVE] = 0.0  # the patch alone is left, free of the supports
-    assert fragment_row(model, state)["intact_casing_outside"] == 0
+    row = fragment_row(model, state)
+    assert row["intact_casing_outside"] == 0
+    assert row["outer_layer_bulge_m"] == 0.0  # debris is not a bulge

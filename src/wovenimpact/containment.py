@@ -93,18 +93,26 @@ def fragment_row(model, state) -> dict:
     near = (np.abs(np.angle(np.exp(1j * (np.arctan2(xc[:, 1], xc[:, 0]) - phi_cm))))
             <= half_angle) & (np.abs(xc[:, 2] - cm[2]) <= half_z)
     outside = bool(np.any(np.hypot(xc[near, 0], xc[near, 1]) > float(r_nodes.max())))
+    # is there casing at the fragment's angle and height at all? A sector's cut edges
+    # end the model: past them the rest of the ring is missing, not broken
+    x0 = model.x0[np.concatenate([model.node_sets[s] for s in layer_sets(model)])]
+    covered = bool(np.any(
+        (np.abs(np.angle(np.exp(1j * (np.arctan2(x0[:, 1], x0[:, 0]) - phi_cm))))
+         <= size / r_casing) & (np.abs(x0[:, 2] - cm[2]) <= size)))
     return {
         "fragment_speed_m_per_s": float(np.linalg.norm(v_cm)),
         "fragment_radial_velocity_m_per_s": float(radial),
         "fragment_cm_radius_m": float(r_cm),
         "fragment_max_radius_m": float(r_nodes.max()),
         "intact_casing_outside": int(outside),
+        "fragment_beyond_casing": int(not covered),
         "outer_layer_bulge_m": outer_layer_bulge(model, state),
     }
 
 
 CONTAINMENT_COLUMNS = ("fragment_speed_m_per_s", "fragment_radial_velocity_m_per_s",
                        "fragment_cm_radius_m", "fragment_max_radius_m", "intact_casing_outside",
+                       "fragment_beyond_casing",
                        "outer_layer_bulge_m")
 
 
@@ -185,16 +193,23 @@ def containment_outcome(h: dict, inner_radius: float) -> dict:
       inner radius) and at the end moves inwards or along the casing (radial velocity
       ≤ 1 % of its initial speed) with intact material outside it;
     - ``undecided``: anything else (still pushing intact layers outwards, or never
-      arrived): run longer. A heavy fragment still pushing intact layers is never
-      ``escaped``.
+      arrived): run longer — or the fragment has left the modelled casing sideways
+      (``fragment_beyond_casing``: past a sector's cut edge, where the rest of the ring
+      is not modelled): model more of the ring. A heavy fragment still pushing intact
+      layers is never ``escaped``.
     Returns the outcome, ``contained`` (bool) and the exit speed (its speed at the end
     if escaped, else 0)."""
     speed = np.asarray(h["fragment_speed_m_per_s"], dtype=float)
     radial = np.asarray(h["fragment_radial_velocity_m_per_s"], dtype=float)
     reach = np.asarray(h["fragment_max_radius_m"], dtype=float)
     outside = np.asarray(h["intact_casing_outside"], dtype=float)
+    beyond = np.asarray(h.get("fragment_beyond_casing", np.zeros(outside.shape)), dtype=float)
     arrived = bool(np.any(reach >= 0.99 * inner_radius))
     v0 = float(speed[0]) if speed.size else 0.0
+    if beyond.size and beyond[-1]:
+        # past a sector's cut edge or the casing's end: the model cannot tell
+        return {"outcome": "undecided", "contained": False,
+                "fragment_exit_speed_m_per_s": float(speed[-1])}
     if not outside[-1] and radial[-1] > 0.0:
         return {"outcome": "escaped", "contained": False,
                 "fragment_exit_speed_m_per_s": float(speed[-1])}

@@ -264,3 +264,36 @@ def test_a_piece_of_ply_torn_free_ahead_of_the_fragment_does_not_hold_it():
     row = fragment_row(model, state)
     assert row["intact_casing_outside"] == 0
     assert row["outer_layer_bulge_m"] == 0.0  # debris is not a bulge
+
+
+def test_a_fragment_past_the_sectors_cut_edge_is_undecided_not_escaped():
+    """Beyond a 120° sector's cut edge there is no casing in the model (the rest of the
+    ring is missing, not broken): a fragment there is ``fragment_beyond_casing`` and the
+    run is undecided, however it moves; inside the sector it is not."""
+    import math
+
+    from wovenimpact.containment import FRAGMENT, fragment_row
+
+    model, state = coarse_two_ply_casing()
+    nodes = model.node_sets[FRAGMENT]
+    centre = model.node_mass[nodes] @ state.x[nodes] / model.node_mass[nodes].sum()
+
+    def turned(deg):
+        c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
+        x = state.x.copy()
+        x[nodes, 0] = c * state.x[nodes, 0] - s * state.x[nodes, 1]
+        x[nodes, 1] = s * state.x[nodes, 0] + c * state.x[nodes, 1]
+        return x
+
+    start = math.degrees(math.atan2(centre[1], centre[0]))
+    assert 60.0 < start < 180.0  # the example's sector spans 60°–180°
+    assert fragment_row(model, state)["fragment_beyond_casing"] == 0
+    state.x = turned(175.0 - start)
+    assert fragment_row(model, state)["fragment_beyond_casing"] == 0
+    state.x = turned(200.0 - 175.0)
+    assert fragment_row(model, state)["fragment_beyond_casing"] == 1
+    h = history([150.0, 70.0], [0.0, 20.0], [0.24, 0.29], [1, 0])
+    h["fragment_beyond_casing"] = [0, 1]
+    assert containment_outcome(h, R)["outcome"] == "undecided"
+    h["fragment_beyond_casing"] = [0, 0]
+    assert containment_outcome(h, R)["outcome"] == "escaped"

@@ -48,9 +48,10 @@ def anchored_casing_nodes(model, state, casing: np.ndarray) -> np.ndarray:
     q = model.quads[(state.elem[:, SL.E_ALIVE] != 0.0) & in_casing[model.quads].all(axis=1)]
     live = np.zeros(model.n_nodes, dtype=bool)
     live[q.ravel()] = True
-    held = in_casing & live & np.any(model.bc_code != 0, axis=1)
-    if not np.any(in_casing & np.any(model.bc_code != 0, axis=1)):
+    constrained = in_casing & np.any(model.bc_code != 0, axis=1)
+    if not np.any(constrained):
         return live[casing]
+    held = constrained & live
     edges = np.concatenate([q[:, [0, 1]], q[:, [1, 2]], q[:, [2, 3]], q[:, [3, 0]]])
     graph = coo_matrix((np.ones(len(edges)), (edges[:, 0], edges[:, 1])),
                        shape=(model.n_nodes, model.n_nodes))
@@ -88,14 +89,15 @@ def fragment_row(model, state) -> dict:
     half_angle = max(WINDOW * float(np.max(np.abs(np.angle(np.exp(1j * (phi - phi_cm)))))),
                      size / r_casing)
     half_z = max(WINDOW * float(np.max(np.abs(x[:, 2] - cm[2]))), size)
-    casing = casing[anchored_casing_nodes(model, state, casing)]
-    xc = state.x[casing]
+    anchored = np.zeros(model.n_nodes, dtype=bool)
+    anchored[casing] = anchored_casing_nodes(model, state, casing)
+    xc = state.x[anchored]
     near = (np.abs(np.angle(np.exp(1j * (np.arctan2(xc[:, 1], xc[:, 0]) - phi_cm))))
             <= half_angle) & (np.abs(xc[:, 2] - cm[2]) <= half_z)
     outside = bool(np.any(np.hypot(xc[near, 0], xc[near, 1]) > float(r_nodes.max())))
     # is there casing at the fragment's angle and height at all? A sector's cut edges
     # end the model: past them the rest of the ring is missing, not broken
-    x0 = model.x0[np.concatenate([model.node_sets[s] for s in layer_sets(model)])]
+    x0 = model.x0[casing]
     covered = bool(np.any(
         (np.abs(np.angle(np.exp(1j * (np.arctan2(x0[:, 1], x0[:, 0]) - phi_cm))))
          <= size / r_casing) & (np.abs(x0[:, 2] - cm[2]) <= size)))
@@ -106,7 +108,7 @@ def fragment_row(model, state) -> dict:
         "fragment_max_radius_m": float(r_nodes.max()),
         "intact_casing_outside": int(outside),
         "fragment_beyond_casing": int(not covered),
-        "outer_layer_bulge_m": outer_layer_bulge(model, state),
+        "outer_layer_bulge_m": outer_layer_bulge(model, state, anchored),
     }
 
 
@@ -116,14 +118,19 @@ CONTAINMENT_COLUMNS = ("fragment_speed_m_per_s", "fragment_radial_velocity_m_per
                        "outer_layer_bulge_m")
 
 
-def outer_layer_bulge(model, state) -> float:
+def outer_layer_bulge(model, state, anchored: np.ndarray | None = None) -> float:
     """The outermost casing layer's largest outward radial displacement (m): max over its
     nodes still joined to the supports through live elements (:func:`anchored_casing_nodes`)
     of r(x) − r(x0), r the distance from the casing axis (the z axis); 0 once none is.
     Torn-off pieces flying away are not a bulge (a 4-ply run read 330 mm from them); a
-    bulge reached before the layer tore stays in the run's maximum (``max_bulge_m``)."""
+    bulge reached before the layer tore stays in the run's maximum (``max_bulge_m``).
+    ``anchored``: the caller's (n_nodes,) mask of those nodes, if it has one (the layers
+    share no node, so the outer layer's share of the whole casing's mask is its own)."""
     nodes = model.node_sets[layer_sets(model)[-1]]
-    nodes = nodes[anchored_casing_nodes(model, state, nodes)]
+    if anchored is None:
+        nodes = nodes[anchored_casing_nodes(model, state, nodes)]
+    else:
+        nodes = nodes[anchored[nodes]]
     if nodes.size == 0:
         return 0.0
     r0 = np.hypot(model.x0[nodes, 0], model.x0[nodes, 1])

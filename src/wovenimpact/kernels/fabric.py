@@ -351,6 +351,16 @@ def clear_eroded_point(s_out, i):
 
 
 @inline_kernel
+def yarn_constants(p, m):
+    """The material's crossover constants the stages share: ℓ_w0, ℓ_f0 (half-lengths),
+    h_w0, h_f0 (crimp amplitudes), L_w0, L_f0 (truss lengths), E A per family and the
+    compaction law's a, b (m, m, m, N)."""
+    return (p[m, P_ELL0], p[m, P_ELL0 + 1], p[m, P_H0], p[m, P_H0 + 1], p[m, P_LT0],
+            p[m, P_LT0 + 1], p[m, P_E] * p[m, P_AREA], p[m, P_E + 1] * p[m, P_AREA + 1],
+            p[m, P_COMP_A], p[m, P_COMP_B])
+
+
+@inline_kernel
 def yarn_frame(f11, f12, f21, f22):
     """Step 1 (eq. 6.5, fibre frame): the yarns' current stretches λ_w = |F e_x|,
     λ_f = |F e_y|, unit directions e_w, e_f, cos θ and sin θ of the angle between them,
@@ -438,18 +448,9 @@ def crossover_equilibrium(p, m, s_in, i, lam_w, lam_f):
     L_w, L_f, compaction force, from_table, W, ∂W/∂λ_w, ∂W/∂λ_f); the last three are the
     table's (0 when the exact solve ran).
     """
-    ell0_w = p[m, P_ELL0]
-    ell0_f = p[m, P_ELL0 + 1]
-    h0_w = p[m, P_H0]
-    h0_f = p[m, P_H0 + 1]
+    ell0_w, ell0_f, h0_w, h0_f, lt0_w, lt0_f, ea_w, ea_f, a, b = yarn_constants(p, m)
     ell_w = lam_w * ell0_w
     ell_f = lam_f * ell0_f
-    lt0_w = p[m, P_LT0]
-    lt0_f = p[m, P_LT0 + 1]
-    a = p[m, P_COMP_A]
-    b = p[m, P_COMP_B]
-    ea_w = p[m, P_E] * p[m, P_AREA]
-    ea_f = p[m, P_E + 1] * p[m, P_AREA + 1]
     d_w = s_in[i, S_DAMAGE]
     d_f = s_in[i, S_DAMAGE + 1]
     h_w = s_in[i, S_H]
@@ -599,12 +600,9 @@ def yarn_resultant(p, m, use_table, lam_w, lam_f, sin_t, d_w, d_f, t_w, t_f, l_w
     Returns (c_w, c_f, stiffness).
     """
     thick = p[m, P_THICK]
-    ell_w = lam_w * p[m, P_ELL0]
-    ell_f = lam_f * p[m, P_ELL0 + 1]
-    lt0_w = p[m, P_LT0]
-    lt0_f = p[m, P_LT0 + 1]
-    ea_w = p[m, P_E] * p[m, P_AREA]
-    ea_f = p[m, P_E + 1] * p[m, P_AREA + 1]
+    ell0_w, ell0_f, _, _, lt0_w, lt0_f, ea_w, ea_f, _, _ = yarn_constants(p, m)
+    ell_w = lam_w * ell0_w
+    ell_f = lam_f * ell0_f
     if p[m, P_HOMOG] == HOMOG_THESIS:  # eq. (6.30), (6.38): σ = ½ Σ T_i/A_i e_i⊗e_i, × t
         c_w = 0.5 * thick * t_w / p[m, P_AREA]
         c_f = 0.5 * thick * t_f / p[m, P_AREA + 1]
@@ -662,24 +660,14 @@ def trellis_shear(p, m, s_in, i, gamma, dgamma, h_w, h_f, lam_w, lam_f):
 def stored_energy(p, m, use_table, w_cross, e_shear, d_w, d_f, ext_w, ext_f, h_w, h_f, f_c):
     """Step 5: stored energy per unit reference area — two half trusses per family, the
     compaction spring and the shear energy (the table's W in place of the first two)."""
-    ell0_w = p[m, P_ELL0]
-    ell0_f = p[m, P_ELL0 + 1]
-    lt0_w = p[m, P_LT0]
-    lt0_f = p[m, P_LT0 + 1]
-    s_total = p[m, P_H0] + p[m, P_H0 + 1]
-    a = p[m, P_COMP_A]
-    b = p[m, P_COMP_B]
-    ea_w = p[m, P_E] * p[m, P_AREA]
-    ea_f = p[m, P_E + 1] * p[m, P_AREA + 1]
-    area0 = 4.0 * ell0_w * ell0_f
     if use_table:
         return w_cross + e_shear
-    else:
-        k_w = (1.0 - d_w) * ea_w / lt0_w
-        k_f = (1.0 - d_f) * ea_f / lt0_f
-        u_yarn = k_w * max(ext_w, 0.0) ** 2 + k_f * max(ext_f, 0.0) ** 2
-        delta = s_total - h_w - h_f if f_c > 0.0 else 0.0
-        return (u_yarn + compaction_energy(delta, a, b)) / area0 + e_shear
+    ell0_w, ell0_f, h0_w, h0_f, lt0_w, lt0_f, ea_w, ea_f, a, b = yarn_constants(p, m)
+    k_w = (1.0 - d_w) * ea_w / lt0_w
+    k_f = (1.0 - d_f) * ea_f / lt0_f
+    u_yarn = k_w * max(ext_w, 0.0) ** 2 + k_f * max(ext_f, 0.0) ** 2
+    delta = h0_w + h0_f - h_w - h_f if f_c > 0.0 else 0.0
+    return (u_yarn + compaction_energy(delta, a, b)) / (4.0 * ell0_w * ell0_f) + e_shear
 
 
 @kernel

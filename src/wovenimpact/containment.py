@@ -207,31 +207,52 @@ def containment_outcome(h: dict, inner_radius: float) -> dict:
     Returns the outcome, ``contained`` (bool) and the exit speed (its speed at the end
     if escaped, else 0)."""
     speed = np.asarray(h["fragment_speed_m_per_s"], dtype=float)
+    outcome = str(row_outcomes(h, inner_radius)[-1])
+    return {"outcome": outcome, "contained": outcome == "contained",
+            "fragment_exit_speed_m_per_s": 0.0 if outcome == "contained" else float(speed[-1])}
+
+
+def row_outcomes(h: dict, inner_radius: float) -> np.ndarray:
+    """:func:`containment_outcome` of the history up to each row: what the run would
+    have read had it ended there (``arrived`` counts the rows up to that one)."""
+    speed = np.asarray(h["fragment_speed_m_per_s"], dtype=float)
     radial = np.asarray(h["fragment_radial_velocity_m_per_s"], dtype=float)
     reach = np.asarray(h["fragment_max_radius_m"], dtype=float)
-    outside = np.asarray(h["intact_casing_outside"], dtype=float)
-    beyond = np.asarray(h.get("fragment_beyond_casing", np.zeros(outside.shape)), dtype=float)
-    arrived = bool(np.any(reach >= 0.99 * inner_radius))
+    outside = np.asarray(h["intact_casing_outside"], dtype=float) != 0.0
+    beyond = np.asarray(h.get("fragment_beyond_casing", np.zeros(outside.shape)),
+                        dtype=float) != 0.0
+    arrived = np.maximum.accumulate(reach >= 0.99 * inner_radius) if reach.size else reach
     v0 = float(speed[0]) if speed.size else 0.0
-    if beyond.size and beyond[-1]:
-        # past a sector's cut edge or the casing's end: the model cannot tell
-        return {"outcome": "undecided", "contained": False,
-                "fragment_exit_speed_m_per_s": float(speed[-1])}
-    if not outside[-1] and radial[-1] > 0.0:
-        return {"outcome": "escaped", "contained": False,
-                "fragment_exit_speed_m_per_s": float(speed[-1])}
-    if arrived and outside[-1] and radial[-1] <= 0.01 * v0:
-        return {"outcome": "contained", "contained": True, "fragment_exit_speed_m_per_s": 0.0}
-    return {"outcome": "undecided", "contained": False,
-            "fragment_exit_speed_m_per_s": float(speed[-1])}
+    out = np.full(speed.shape, "undecided", dtype=object)
+    out[arrived & outside & (radial <= 0.01 * v0)] = "contained"
+    out[~outside & (radial > 0.0)] = "escaped"
+    # past a sector's cut edge or the casing's end: the model cannot tell
+    out[beyond] = "undecided"
+    return out
+
+
+def decided_since(h: dict, inner_radius: float) -> tuple[str, float]:
+    """The outcome the history reads at its last row and the time from which every row
+    has read it (``run.stop_when_decided`` stops a run once that lasts long enough)."""
+    rows = row_outcomes(h, inner_radius)
+    t = np.asarray(h["time_s"], dtype=float)
+    if rows.size == 0:
+        return "undecided", float("nan")
+    changed = np.flatnonzero(rows != rows[-1])
+    return str(rows[-1]), float(t[changed[-1] + 1] if changed.size else t[0])
+
+
+def casing_inner_radius(model) -> float:
+    """The smallest radius of any casing node in the reference configuration (m)."""
+    return min(float(np.min(np.hypot(*model.x0[model.node_sets[s], :2].T)))
+               for s in layer_sets(model))
 
 
 def casing_summary(model, state, h: dict) -> dict:
     """summary.json keys of a containment run (whole model; symmetry is not used)."""
     nodes = model.node_sets[FRAGMENT]
     layers = layer_sets(model)
-    inner = min(float(np.min(np.hypot(*model.x0[model.node_sets[s], :2].T))) for s in layers)
-    outcome = containment_outcome(h, inner)
+    outcome = containment_outcome(h, casing_inner_radius(model))
     casing_elems = np.flatnonzero(np.isin(model.quads, np.concatenate(
         [model.node_sets[s] for s in layers])).all(axis=1))
     mass = float(np.sum(model.sections[model.elem_section[casing_elems], SL.C_AREAL_MASS]

@@ -58,7 +58,9 @@ from wovenimpact.quantities import (
 )
 from wovenimpact.containment import (
     CONTAINMENT_COLUMNS,
+    casing_inner_radius,
     casing_summary,
+    decided_since,
     fragment_row,
     is_containment,
 )
@@ -229,6 +231,7 @@ def run_spec(
     """
     compiled = compile_case(spec, Path(base))
     model = compiled.model
+    watch = decision_watch(model, spec.run.stop_when_decided)
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     n_threads = threads or spec.run.threads
@@ -267,8 +270,9 @@ def run_spec(
         history.write_csv(out / "history.csv")
         save_checkpoint(ckpt_dir, state, digest, meta=meta)
 
+    decided = watch(history) if watch else None
     taken = 0
-    while state.t < run.end_time:
+    while state.t < run.end_time and not decided:
         if max_steps is not None and taken >= max_steps:
             return {"interrupted_at_step": state.step, "time_s": state.t}
         try:
@@ -283,7 +287,8 @@ def run_spec(
             row = history_row(model, state, normaliser)
             normaliser = row["energy_normaliser_part_J"]
             history.append(row)
-        if f_sched.due(state.t) or state.t >= run.end_time:
+            decided = watch(history) if watch else None
+        if f_sched.due(state.t) or state.t >= run.end_time or decided:
             fields.write(state)
         if c_sched.due(state.t):
             checkpoint()
@@ -295,6 +300,8 @@ def run_spec(
     checkpoint()
     summary = summarise(spec, compiled, state, meta["wall_time_s"], history.arrays())
     summary["restarted_from_step"] = meta["restarted_from_step"]
+    if run.stop_when_decided is not None:
+        summary["stopped_when_decided"] = decided
     summary["provenance"] = prov
     from wovenimpact.io.plots import deflection_plot, energy_plot, fragment_plot, impactor_plot
 
@@ -330,6 +337,27 @@ def clear_outputs(out: Path) -> None:
                       "(checkpoints, fields, plots, history, summary, report, error) before "
                       "this one",
                       InputWarning, stacklevel=3)
+
+
+def decision_watch(model, hold: float | None):
+    """``run.stop_when_decided``: None if it is not set; else a function of the history
+    that returns the outcome (``"contained"`` or ``"escaped"``) once every row of the
+    last ``hold`` seconds has read it (containment.decided_since), else None."""
+    if hold is None:
+        return None
+    if not is_containment(model):
+        raise InputError(f"run.stop_when_decided = {hold!r} s: only a containment case "
+                         "(a blade fragment and casing layers) has an outcome to decide; "
+                         "remove it")
+    inner = casing_inner_radius(model)
+    columns = CONTAINMENT_COLUMNS + ("time_s",)
+
+    def watch(history: History) -> str | None:
+        h = history.arrays(columns)
+        outcome, since = decided_since(h, inner)
+        return outcome if outcome != "undecided" and h["time_s"][-1] - since >= hold else None
+
+    return watch
 
 
 def resume(out: Path, model, digest: str, parts: dict, end_time: float):

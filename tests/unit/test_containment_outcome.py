@@ -297,3 +297,65 @@ def test_a_fragment_past_the_sectors_cut_edge_is_undecided_not_escaped():
     assert containment_outcome(h, R)["outcome"] == "undecided"
     h["fragment_beyond_casing"] = [0, 0]
     assert containment_outcome(h, R)["outcome"] == "escaped"
+
+
+def test_decided_since_is_the_start_of_the_last_outcomes_streak():
+    """row_outcomes reads each row as containment_outcome would have had the run ended
+    there; decided_since gives the outcome of the last row and the first time of the
+    unbroken run of rows that read it."""
+    from wovenimpact.containment import decided_since, row_outcomes
+
+    t = np.arange(10) * 1e-4
+    h = history(np.full(10, 100.0), [20, 20, -5, -5, 20, -5, -5, -5, -5, -5],
+                np.full(10, 0.26), outside=1)
+    h["time_s"] = t
+    rows = row_outcomes(h, R)
+    assert list(rows[:5]) == ["undecided", "undecided", "contained", "contained", "undecided"]
+    for n in range(1, 11):
+        part = {k: v[:n] for k, v in h.items()}
+        assert rows[n - 1] == containment_outcome(part, R)["outcome"]
+    assert decided_since(h, R) == ("contained", t[5])
+
+
+def test_stop_when_decided_ends_the_run_once_the_outcome_has_held(tmp_path, monkeypatch):
+    """run.stop_when_decided: the run ends at the first history row at which the
+    outcome has read the same for the hold (not at end_time), writes its checkpoint,
+    history and summary there, and says so in the summary. The outcome is forced here
+    (escaped from 10 µs on: a real casing takes milliseconds to decide) to test the
+    stopping alone; row_outcomes has its own tests above."""
+    from pathlib import Path
+
+    import wovenimpact.runs as runs
+    from wovenimpact.io.history import read_csv
+
+    real = runs.decided_since
+
+    def forced(h, inner):
+        assert real(h, inner)[0] == "undecided"  # the real rule on a run before impact
+        t = np.asarray(h["time_s"])
+        since = t[t >= 10e-6]
+        return ("escaped", float(since[0])) if since.size else ("undecided", float(t[0]))
+
+    monkeypatch.setattr(runs, "decided_since", forced)
+    case = Path(__file__).resolve().parents[2] / "examples" / "containment" / "hybrid_4.toml"
+    out = tmp_path / "out"
+    summary = runs.run_case(case, out, overrides=[
+        'run.end_time="60 us"', 'mesh.element_size="10 mm"', "mesh.casing.layers=1",
+        'run.stop_when_decided="20 us"', 'run.history_interval="2 us"'])
+    t = read_csv(out / "history.csv")["time_s"]
+    assert summary["stopped_when_decided"] == "escaped"
+    assert 30e-6 <= summary["end_time_s"] < 34e-6  # the first row ≥ 10 + 20 µs
+    assert t[-1] == pytest.approx(summary["end_time_s"], rel=1e-12)
+    assert t[-2] < 30e-6
+
+
+def test_stop_when_decided_on_a_case_without_a_fragment_is_refused(tmp_path):
+    from pathlib import Path
+
+    from wovenimpact.errors import InputError
+    from wovenimpact.runs import run_case
+
+    case = Path(__file__).resolve().parents[2] / "examples" / "plate_impact" / "plies1_100.toml"
+    with pytest.raises(InputError, match="run.stop_when_decided"):
+        run_case(case, tmp_path / "out", overrides=['run.stop_when_decided="0.1 ms"'])
+    assert not (tmp_path / "out" / "history.csv").exists()

@@ -189,3 +189,56 @@ def test_the_default_blade_relaxes_with_coarse_elements(size):
     assert np.linalg.norm(v_cm) == pytest.approx(1047.0 * np.hypot(cm[0], cm[1]), rel=1e-3)
     blade = compiled.mesh.elem_sets["blade.blade"]
     assert np.max(st.elem[blade, 4]) > 0.0  # the centrifugal pre-stress is in (N_xx > 0)
+
+
+@pytest.mark.parametrize("sector, fine", [(360.0, 150.0), (240.0, 120.0), (360.0, 360.0)])
+def test_a_graded_ring_is_fine_in_its_impact_zone_and_grows_gently_outside(sector, fine):
+    """casing_mesh with fine_sector / coarse_size: within the fine sector about the
+    centre angle every element is 7 mm around (the ungraded ring's width there), outside
+    no element is wider than 21 mm and neighbours differ by at most 25 %; the nodes still
+    lie on their layer's radius, the layer's area is the polygon's, a full ring has no
+    seam (every column of nodes is used by two elements' edges) and a sector keeps its
+    cut edges at ±sector/2."""
+    r0, size, coarse, centre = 0.25, 7e-3, 21e-3, 175.0
+    mesh = casing_mesh([r0, 0.26], 0.15, size, sector=sector, centre_angle=centre,
+                       fine_sector=fine, coarse_size=coarse)
+    nodes = mesh.node_sets["layer0"]
+    theta = np.unique(np.round(np.mod(np.arctan2(mesh.nodes[nodes, 1], mesh.nodes[nodes, 0])
+                                      - math.radians(centre - sector / 2), 2 * math.pi), 12))
+    edges = np.append(theta, 2 * math.pi) if sector == 360.0 else theta
+    width = r0 * np.diff(edges)
+    mid = np.degrees(0.5 * (edges[1:] + edges[:-1])) - sector / 2  # from the centre angle
+    inside = np.abs(mid) < fine / 2
+    n_fine = math.ceil(r0 * math.radians(fine) / size - 1e-9)
+    assert inside.sum() == n_fine
+    assert np.allclose(width[inside], r0 * math.radians(fine) / n_fine, rtol=1e-9)
+    assert np.all(width <= coarse * (1 + 1e-9))
+    ratio = width[1:] / width[:-1]
+    if sector == 360.0:
+        ratio = np.append(ratio, width[0] / width[-1])
+    assert np.all(np.maximum(ratio, 1 / ratio) <= 1.25)
+    if fine < sector:
+        assert width.max() > 0.9 * coarse  # it does coarsen
+    assert np.allclose(np.hypot(*mesh.nodes[nodes, :2].T), r0, rtol=1e-12)
+    area = np.linalg.norm(mesh.area_vectors()[mesh.elem_sets["layer0"]], axis=1).sum()
+    assert area == pytest.approx(np.sum(2 * r0 * np.sin(0.5 * np.diff(edges))) * 0.15, rel=1e-9)
+    if sector == 360.0:
+        assert mesh.node_sets["cut_edges"].size == 0
+        assert np.array_equal(np.unique(mesh.quads[mesh.elem_sets["layer0"]]), np.sort(nodes))
+    else:
+        ang = np.degrees(np.arctan2(mesh.nodes[mesh.node_sets["cut_edges"], 1],
+                                    mesh.nodes[mesh.node_sets["cut_edges"], 0]))
+        assert np.allclose(np.sort(np.unique(np.round(np.mod(ang, 360.0), 9))),
+                           [centre - sector / 2, np.mod(centre + sector / 2, 360.0)])
+
+
+@pytest.mark.parametrize("kwargs, field", [
+    ({"fine_sector": 150.0}, "coarse_element_size"),
+    ({"fine_sector": 400.0, "coarse_size": 0.02}, "fine_sector"),
+    ({"fine_sector": 150.0, "coarse_size": 0.005}, "coarse_element_size"),
+])
+def test_a_graded_ring_refuses_what_it_cannot_build(kwargs, field):
+    from wovenimpact.errors import InputError
+
+    with pytest.raises(InputError, match=field):
+        casing_mesh([0.25], 0.15, 7e-3, **kwargs)

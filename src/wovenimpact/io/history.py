@@ -64,9 +64,11 @@ class History:
                              f"valid: {list(self.columns)}")
         self._rows.append(tuple(_scalar(c, row[c]) for c in self.columns))
 
-    def arrays(self) -> dict[str, np.ndarray]:
-        """Each column as an array (int64 if all its values are integers, else float64)."""
-        return {c: _column_array([r[i] for r in self._rows]) for i, c in enumerate(self.columns)}
+    def arrays(self, columns: Sequence[str] | None = None) -> dict[str, np.ndarray]:
+        """Each column (or only ``columns``) as an array (int64 if all its values are
+        integers, else float64)."""
+        return {c: _column_array([r[i] for r in self._rows]) for i, c in enumerate(self.columns)
+                if columns is None or c in columns}
 
     def keep_first(self, n: int) -> None:
         """Keep the first ``n`` rows (a restart keeps those its checkpoint counted)."""

@@ -35,6 +35,8 @@ def casing_mesh(
     element_size: float,
     sector: float = 360.0,
     centre_angle: float = 0.0,
+    fine_sector: float | None = None,
+    coarse_size: float | None = None,
 ) -> Mesh:
     """Coaxial cylindrical layers about the z axis, z ∈ [−length/2, length/2].
 
@@ -46,6 +48,11 @@ def casing_mesh(
             elements are slightly longer circumferentially the further out it is).
         sector: angular extent (degrees); 360 is the full ring (periodic, no seam).
         centre_angle: angle of the sector's middle (degrees, from +x towards +y).
+        fine_sector, coarse_size: a graded ring (:func:`graded_angles`): ``element_size``
+            around the circumference within ``fine_sector`` degrees centred on
+            ``centre_angle`` (the impact zone), growing by at most 20 % per element
+            to ``coarse_size`` outside it; axially ``element_size`` everywhere. Both
+            or neither.
 
     Elements are counter-clockwise about the outward normal (first edge along the
     circumference, second along +z). Node sets: ``ends`` (z = ±length/2, every layer),
@@ -61,13 +68,18 @@ def casing_mesh(
         raise InputError(f"casing sector = {sector!r}°; valid: 0 < sector ≤ 360")
     full = sector >= 360.0
     span = math.radians(sector)
-    n_t = _divisions(radii[0] * span, element_size, "casing circumference")
-    if full:
-        n_t = max(n_t, 8)
     n_z = _divisions(length, element_size, "casing length")
     t0 = math.radians(centre_angle) - 0.5 * span
+    if fine_sector is None and coarse_size is None:
+        n_t = _divisions(radii[0] * span, element_size, "casing circumference")
+        if full:
+            n_t = max(n_t, 8)
+        theta = t0 + span * np.arange(n_t + 1) / n_t
+    else:
+        theta = t0 + graded_angles(radii[0], span, element_size, fine_sector, coarse_size)
+        n_t = theta.size - 1
     n_tn = n_t if full else n_t + 1  # node columns around
-    theta = t0 + span * np.arange(n_tn) / n_t
+    theta = theta[:n_tn]
     z = np.linspace(-0.5 * length, 0.5 * length, n_z + 1)
     per_layer = n_tn * (n_z + 1)
     nodes, quads, ply = [], [], []
@@ -100,6 +112,60 @@ def casing_mesh(
     node_sets["cut_edges"] = idx[(col == 0) | (col == n_tn - 1)] if not full else idx[:0]
     return Mesh(nodes=nodes, quads=np.concatenate(quads), ply=np.concatenate(ply),
                 node_sets=node_sets, elem_sets=elem_sets)
+
+
+GROWTH = 1.2  # largest ratio of neighbouring element widths in a graded ring
+
+
+def graded_angles(radius: float, span: float, size: float, fine_sector, coarse_size,
+                  ) -> np.ndarray:
+    """Node angles (rad, from 0 to ``span``) of a ring graded about its middle.
+
+    Within ``fine_sector`` (degrees) about the middle the arc ``radius``·Δθ is at most
+    ``size``; outside it the target width s(ξ) = min(size + (GROWTH − 1) ξ, coarse_size)
+    grows with the arc ξ from the fine zone's edge — on a full ring from both edges,
+    meeting half-way — which is geometric growth by GROWTH per element. Each outer
+    stretch gets ⌈∫dξ/s⌉ elements, placed where ∫dξ/s takes equal steps, so no element
+    is wider than its target and neighbours differ by about GROWTH at most.
+    """
+    if fine_sector is None or coarse_size is None:
+        raise InputError("a graded casing needs both fine_sector and coarse_element_size "
+                         f"(given {fine_sector!r} deg and {coarse_size!r} m)")
+    fine = math.radians(fine_sector)
+    if not (0.0 < fine <= span + 1e-12):
+        raise InputError(f"casing fine_sector = {fine_sector!r}° must be > 0 and at most the "
+                         f"sector ({math.degrees(span):g}°)")
+    if not (math.isfinite(coarse_size) and coarse_size >= size):
+        raise InputError(f"casing coarse_element_size = {coarse_size!r} m must be at least "
+                         f"element_size ({size!r} m)")
+    fine = min(fine, span)
+    n_f = _divisions(radius * fine, size, "casing fine sector")
+    full = span >= 2.0 * math.pi - 1e-12
+    rest = radius * (span - fine)  # arc outside the fine zone
+
+    def stretch(arc: float, both_ends: bool) -> np.ndarray:
+        """Node arcs 0 … arc of one outer stretch, graded away from ξ = 0 (and ξ = arc)."""
+        if arc <= 1e-12 * radius:
+            return np.array([0.0])
+        xi = np.linspace(0.0, arc, 4001)
+        d = np.minimum(xi, arc - xi) if both_ends else xi
+        count = np.concatenate([[0.0], np.cumsum(
+            0.5 * np.diff(xi) * (1.0 / np.minimum(size + (GROWTH - 1.0) * d[1:], coarse_size)
+                                 + 1.0 / np.minimum(size + (GROWTH - 1.0) * d[:-1],
+                                                    coarse_size)))])
+        n = max(int(math.ceil(count[-1] - 1e-9)), 1)
+        return np.interp(np.linspace(0.0, count[-1], n + 1), count, xi)
+
+    fine_arcs = radius * fine * np.arange(n_f + 1) / n_f
+    if full:
+        outer = stretch(rest, both_ends=True)
+        arcs = np.concatenate([fine_arcs, fine_arcs[-1] + outer[1:]])
+        # the fine zone centred in 0 … 2π; the last node is the first one again
+        return arcs / radius + 0.5 * (span - fine)
+    side = stretch(0.5 * rest, both_ends=False)
+    arcs = np.concatenate([side[-1] - side[::-1], side[-1] + fine_arcs[1:],
+                           side[-1] + fine_arcs[-1] + side[1:]])
+    return arcs / radius
 
 
 def circumferential_directions(mesh: Mesh, axis=(0.0, 0.0, 1.0)) -> np.ndarray:

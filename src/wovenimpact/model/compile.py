@@ -251,8 +251,11 @@ def containment_mesh(m, sections) -> tuple[Mesh, list[str], np.ndarray]:
         raise InputError(f"mesh.blade.tip_radius = {b.tip_radius:g} m must be inside the "
                          f"casing (mesh.casing.inner_radius = {c.inner_radius:g} m)")
     try:
-        casing = casing_mesh(radii, c.length, m.element_size, sector=math.degrees(c.sector),
-                             centre_angle=math.degrees(c.centre_angle))
+        casing = casing_mesh(
+            radii, c.length, m.element_size, sector=math.degrees(c.sector),
+            centre_angle=math.degrees(c.centre_angle),
+            fine_sector=None if c.fine_sector is None else math.degrees(c.fine_sector),
+            coarse_size=c.coarse_element_size)
         blade = blade_mesh(b.root_radius, b.tip_radius, b.crack_radius, b.root_chord,
                            b.tip_chord, m.element_size, angle=math.degrees(b.angle),
                            stagger=math.degrees(b.stagger))

@@ -184,10 +184,21 @@ class CasingSpec(BaseModel):
     length: Length = 0.15
     sector: Angle = 2.0 * 3.141592653589793
     centre_angle: quantity("angle", example="90 deg") = 0.0
+    # a graded ring: mesh.element_size within fine_sector about centre_angle, growing by
+    # at most ~20 % per element to coarse_element_size around the rest (model.casing)
+    fine_sector: quantity("angle", gt=0, example="180 deg") | None = None
+    coarse_element_size: quantity("length", gt=0, example="14 mm") | None = None
     inner_section: str | None = None
     layer_section: str = Field(min_length=1)
     layers: int = Field(ge=1, le=200)
     layer_spacing: Length | None = None
+
+    @model_validator(mode="after")
+    def _grading_needs_both(self):
+        if (self.fine_sector is None) != (self.coarse_element_size is None):
+            raise ValueError("a graded casing needs both fine_sector and coarse_element_size "
+                             "(with units), or neither")
+        return self
 
 
 class BladeSpec(BaseModel):
@@ -307,6 +318,9 @@ class RunSpec(BaseModel):
     energy_tolerance: quantity("dimensionless", gt=0, le=1, example="0.01") = 0.01
     # the predicted step count end_time / Δt₁ above which a run is refused (model.sanity)
     max_steps: int = Field(default=DEFAULT_MAX_STEPS, ge=1)
+    # a containment run ends once its outcome (contained or escaped) has read the same
+    # for this long (runs.run_case; docs/theory.md §8.3); omitted: it runs to end_time
+    stop_when_decided: quantity("time", gt=0, example="500 us") | None = None
 
     @model_validator(mode="after")
     def _scaling_above_erosion(self):

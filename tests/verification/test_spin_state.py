@@ -242,3 +242,15 @@ def test_a_graded_ring_refuses_what_it_cannot_build(kwargs, field):
 
     with pytest.raises(InputError, match=field):
         casing_mesh([0.25], 0.15, 7e-3, **kwargs)
+
+
+def test_a_sector_of_360_degrees_read_through_radians_is_the_full_ring():
+    """"360 deg" in a case file reaches casing_mesh as degrees(radians(360)), which is
+    360.0000000000002: still the full ring (no cut edges), not refused."""
+    from wovenimpact.units import to_si
+
+    sector = math.degrees(to_si("360 deg", "angle", "mesh.casing.sector"))
+    assert sector != 360.0  # the rounding this test is about
+    mesh = casing_mesh([0.25], 0.15, 5e-3, sector=sector)
+    assert mesh.node_sets["cut_edges"].size == 0
+    assert mesh.n_elems == casing_mesh([0.25], 0.15, 5e-3).n_elems

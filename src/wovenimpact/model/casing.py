@@ -64,9 +64,11 @@ def casing_mesh(
         raise InputError(f"casing layer radii {radii.tolist()} must be positive numbers")
     if np.any(np.diff(radii) <= 0.0):
         raise InputError(f"casing layer radii {radii.tolist()} must increase outwards")
-    if not (0.0 < sector <= 360.0):
+    # "360 deg" read through radians comes back as 360.0000000000002
+    if not (0.0 < sector <= 360.0 + 1e-9):
         raise InputError(f"casing sector = {sector!r}°; valid: 0 < sector ≤ 360")
-    full = sector >= 360.0
+    full = sector >= 360.0 - 1e-9
+    sector = 360.0 if full else sector
     span = math.radians(sector)
     n_z = _divisions(length, element_size, "casing length")
     t0 = math.radians(centre_angle) - 0.5 * span

@@ -632,6 +632,17 @@ def build() -> Corpus:
                          ("layers_0", "mesh.casing.layers=0")]:
         c.add(f"containment_{label}", ["run", hybrid, "--out", f"out/cont_{label}", "--set",
                                        value], "error", "case", timeout=120)
+    # a graded ring given by halves or inside out, a stop rule with no time
+    for label, values in [("fine_sector_alone", ["mesh.casing.fine_sector=150 deg"]),
+                          ("coarse_below_fine", ["mesh.casing.fine_sector=100 deg",
+                                                 "mesh.casing.coarse_element_size=1 mm"]),
+                          ("fine_wider_than_sector", ["mesh.casing.fine_sector=200 deg",
+                                                      "mesh.casing.coarse_element_size=21 mm"]),
+                          ("stop_when_decided_negative", ["run.stop_when_decided=-1 us"])]:
+        args = ["run", hybrid, "--out", f"out/cont_{label}"]
+        for v in values:
+            args += ["--set", v]
+        c.add(f"containment_{label}", args, "error", "case", timeout=120)
 
     # studies
     S = STUDY

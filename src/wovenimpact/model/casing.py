@@ -131,15 +131,15 @@ def graded_angles(radius: float, span: float, size: float, fine_sector, coarse_s
     is wider than its target and neighbours differ by about GROWTH at most.
     """
     if fine_sector is None or coarse_size is None:
-        raise InputError("a graded casing needs both fine_sector and coarse_element_size "
-                         f"(given {fine_sector!r} deg and {coarse_size!r} m)")
+        raise InputError("a graded casing needs both casing.fine_sector and "
+                         f"casing.coarse_element_size (got {fine_sector!r}° and {coarse_size!r} m)")
     fine = math.radians(fine_sector)
     if not (0.0 < fine <= span + 1e-12):
-        raise InputError(f"casing fine_sector = {fine_sector!r}° must be > 0 and at most the "
-                         f"sector ({math.degrees(span):g}°)")
+        raise InputError(f"casing.fine_sector = {fine_sector:.6g}° must be > 0 and at most "
+                         f"casing.sector ({math.degrees(span):.6g}°)")
     if not (math.isfinite(coarse_size) and coarse_size >= size):
-        raise InputError(f"casing coarse_element_size = {coarse_size!r} m must be at least "
-                         f"element_size ({size!r} m)")
+        raise InputError(f"casing.coarse_element_size = {coarse_size * 1e3:.6g} mm must be at "
+                         f"least element_size ({size * 1e3:.6g} mm)")
     fine = min(fine, span)
     n_f = _divisions(radius * fine, size, "casing fine sector")
     full = span >= 2.0 * math.pi - 1e-12

@@ -87,3 +87,16 @@ def test_a_study_tells_each_input_warning_once_not_once_per_variant(tmp_path):
         warn_once({"a": result, "b": result, "c": {"status": "done"}}, 3)
     assert sorted(str(w.message)[:31] for w in record) == [
         "2 of 3 variants: run.checkpoint", "2 of 3 variants: run.field_inte"]
+
+
+def test_a_boundary_on_an_empty_node_set_is_warned_of():
+    """The containment example's clamped cut edges on a full ring (sector = 360°): the
+    set exists but holds no node, so the boundary does nothing — said, not silent."""
+    from wovenimpact.model.compile import compile_case
+
+    spec, base = load_case(ROOT / "examples" / "containment" / "hybrid_4.toml",
+                           ['mesh.casing.sector="360 deg"', 'mesh.element_size="10 mm"',
+                            "mesh.casing.layers=1"])
+    with pytest.warns(InputWarning, match=r"casing\.cut_edges' holds no node \(a full casing "
+                                          r"ring has no cut edges\)"):
+        compile_case(spec, base)

@@ -10,12 +10,13 @@ from __future__ import annotations
 
 import copy
 import math
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from wovenimpact.errors import InputError
+from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.model.abaqus import read_inp
 from wovenimpact.model.gmsh import read_msh
 from wovenimpact.model.mesh import Mesh, plate_mesh
@@ -345,6 +346,11 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     bcs = BoundaryConditions(mesh.n_nodes, ramp_time=spec.amplitude.ramp_time)
     for i, b in enumerate(spec.boundary):
         nodes = node_set(mesh, b.nodes, f"boundary[{i}].nodes")
+        if nodes.size == 0:
+            hint = (" (a full casing ring has no cut edges)" if b.nodes == "casing.cut_edges"
+                    else "")
+            warnings.warn(f"boundary[{i}].nodes = {b.nodes!r} holds no node{hint}: this "
+                          "boundary constrains nothing", InputWarning, stacklevel=2)
         if b.type == "clamped":
             bcs.fix(nodes)
         elif b.type == "pinned":

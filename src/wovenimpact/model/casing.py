@@ -149,7 +149,7 @@ def graded_angles(radius: float, span: float, size: float, fine_sector, coarse_s
         """Node arcs 0 … arc of one outer stretch, graded away from ξ = 0 (and ξ = arc)."""
         if arc <= 1e-12 * radius:
             return np.array([0.0])
-        xi = np.linspace(0.0, arc, 4001)
+        xi = np.linspace(0.0, arc, max(4001, int(20.0 * arc / size) + 1))  # ≥ 20 per element
         d = np.minimum(xi, arc - xi) if both_ends else xi
         count = np.concatenate([[0.0], np.cumsum(
             0.5 * np.diff(xi) * (1.0 / np.minimum(size + (GROWTH - 1.0) * d[1:], coarse_size)

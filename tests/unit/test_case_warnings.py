@@ -90,13 +90,19 @@ def test_a_study_tells_each_input_warning_once_not_once_per_variant(tmp_path):
 
 
 def test_a_boundary_on_an_empty_node_set_is_warned_of():
-    """The containment example's clamped cut edges on a full ring (sector = 360°): the
-    set exists but holds no node, so the boundary does nothing — said, not silent."""
+    """A sector case's clamped cut edges kept on the full ring (the containment
+    example, a ring, given that boundary): the set exists but holds no node, so the
+    boundary does nothing — said, not silent."""
     from wovenimpact.model.compile import compile_case
+    from wovenimpact.spec.case import case_from_dict
+    from wovenimpact.spec.fields import read_toml, set_dotted
 
-    spec, base = load_case(ROOT / "examples" / "containment" / "hybrid_4.toml",
-                           ['mesh.casing.sector="360 deg"', 'mesh.element_size="10 mm"',
-                            "mesh.casing.layers=1"])
+    path = ROOT / "examples" / "containment" / "hybrid_4.toml"
+    doc = read_toml(path, "case")
+    set_dotted(doc, "mesh.element_size", "10 mm")
+    set_dotted(doc, "mesh.casing.layers", 1)
+    doc["boundary"].append({"nodes": "casing.cut_edges", "type": "clamped"})
+    spec, base = case_from_dict(doc, str(path)), path.parent
     with pytest.warns(InputWarning, match=r"casing\.cut_edges' holds no node \(a full casing "
                                           r"ring has no cut edges\)"):
         compile_case(spec, base)

@@ -214,8 +214,9 @@ def test_force_pair_power_books_each_nodes_share_and_keeps_the_sum():
     assert acc == pytest.approx(2.0 * per_node, rel=1e-12)
 
 
-def coarse_two_ply_casing():
-    """Model and initial state of the 4-ply example reduced to 2 plies at 10 mm."""
+def coarse_two_ply_casing(sector: bool = False):
+    """Model and initial state of the 4-ply example reduced to 2 plies at 10 mm (with
+    ``sector``: a 120° sector, 60°–180°, its cut edges clamped, in place of the ring)."""
     from pathlib import Path
 
     from wovenimpact.model.compile import compile_case
@@ -226,6 +227,12 @@ def coarse_two_ply_casing():
     doc = read_toml(path, "case")
     set_dotted(doc, "mesh.element_size", "10 mm")
     set_dotted(doc, "mesh.casing.layers", 2)
+    if sector:
+        set_dotted(doc, "mesh.casing.sector", "120 deg")
+        set_dotted(doc, "mesh.casing.centre_angle", "120 deg")
+        for key in ("fine_sector", "coarse_element_size"):
+            doc["mesh"]["casing"].pop(key)
+        doc["boundary"].append({"nodes": "casing.cut_edges", "type": "clamped"})
     compiled = compile_case(case_from_dict(doc, str(path)), path.parent)
     return compiled.model, compiled.state
 
@@ -274,7 +281,7 @@ def test_a_fragment_past_the_sectors_cut_edge_is_undecided_not_escaped():
 
     from wovenimpact.containment import FRAGMENT, fragment_row
 
-    model, state = coarse_two_ply_casing()
+    model, state = coarse_two_ply_casing(sector=True)
     nodes = model.node_sets[FRAGMENT]
     centre = model.node_mass[nodes] @ state.x[nodes] / model.node_mass[nodes].sum()
 
@@ -297,6 +304,11 @@ def test_a_fragment_past_the_sectors_cut_edge_is_undecided_not_escaped():
     assert containment_outcome(h, R)["outcome"] == "undecided"
     h["fragment_beyond_casing"] = [0, 0]
     assert containment_outcome(h, R)["outcome"] == "escaped"
+    # the example's full ring has casing at every angle
+    model, state = coarse_two_ply_casing()
+    for deg in (90.0, 180.0, 90.0):
+        state.x = turned(deg)
+        assert fragment_row(model, state)["fragment_beyond_casing"] == 0
 
 
 def test_decided_since_is_the_start_of_the_last_outcomes_streak():

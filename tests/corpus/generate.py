@@ -632,12 +632,10 @@ def build() -> Corpus:
                          ("layers_0", "mesh.casing.layers=0")]:
         c.add(f"containment_{label}", ["run", hybrid, "--out", f"out/cont_{label}", "--set",
                                        value], "error", "case", timeout=120)
-    # a graded ring given by halves or inside out, a stop rule with no time
-    for label, values in [("fine_sector_alone", ["mesh.casing.fine_sector=150 deg"]),
-                          ("coarse_below_fine", ["mesh.casing.fine_sector=100 deg",
-                                                 "mesh.casing.coarse_element_size=1 mm"]),
-                          ("fine_wider_than_sector", ["mesh.casing.fine_sector=200 deg",
-                                                      "mesh.casing.coarse_element_size=21 mm"]),
+    # the example's graded ring made empty or inside out, a stop rule with no time
+    for label, values in [("fine_sector_0", ["mesh.casing.fine_sector=0 deg"]),
+                          ("coarse_below_fine", ["mesh.casing.coarse_element_size=1 mm"]),
+                          ("fine_wider_than_sector", ["mesh.casing.sector=120 deg"]),
                           ("stop_when_decided_negative", ["run.stop_when_decided=-1 us"])]:
         args = ["run", hybrid, "--out", f"out/cont_{label}"]
         for v in values:

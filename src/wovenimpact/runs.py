@@ -300,7 +300,7 @@ def run_spec(
     checkpoint()
     summary = summarise(spec, compiled, state, meta["wall_time_s"], history.arrays())
     summary["restarted_from_step"] = meta["restarted_from_step"]
-    if run.stop_when_decided is not None:
+    if is_containment(model):  # the outcome that ended the run early (None: end_time)
         summary["stopped_when_decided"] = decided
     summary["provenance"] = prov
     from wovenimpact.io.plots import deflection_plot, energy_plot, fragment_plot, impactor_plot
@@ -508,7 +508,7 @@ CONTAINMENT_SUMMARY_KEYS = ("outcome", "contained", "fragment_exit_speed_m_per_s
                             "fragment_mass_kg", "fragment_initial_speed_m_per_s", "max_bulge_m",
                             "casing_mass_kg", "casing_mass_per_area_kg_per_m2", "casing_layers",
                             "absorbed_energy_per_layer_J", "held_energy_per_layer_J",
-                            "absorbed_energy_per_material_J")
+                            "absorbed_energy_per_material_J", "stopped_when_decided")
 COMMON_SUMMARY_KEYS = (
     "summary_version", "case", "end_time_s", "steps", "elements", "nodes", "first_time_step_s",
     "last_time_step_s", "wall_time_s", "element_cycles", "ns_per_element_cycle",

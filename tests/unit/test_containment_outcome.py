@@ -122,6 +122,12 @@ def test_containment_outputs_bulge_layer_and_material_energies_and_fragment_plot
     model = compile_case(spec, base).model
     state = load_checkpoint(latest_checkpoint(out / "checkpoints"), model.digest())
     assert state.t == pytest.approx(summary["end_time_s"], rel=1e-12)
+    # every key a study may ask of a containment case is there (stopped_when_decided:
+    # None, the run reached its end time undecided)
+    from wovenimpact.runs import summary_keys
+
+    assert set(summary_keys(spec)) <= set(summary)
+    assert summary["stopped_when_decided"] is None and summary["outcome"] == "undecided"
     assert layer_absorbed_energies(model, state) == pytest.approx(per_layer, rel=1e-12)
     total = float(np.sum(state.contact_work))
     assert total == pytest.approx(-summary["contact_energy_J"], rel=1e-9)

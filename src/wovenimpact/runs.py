@@ -1,6 +1,7 @@
 """Running a case: the time loop with outputs, checkpoints and restart.
 
-:func:`run_case` compiles a case file, steps it to ``run.end_time`` and writes
+:func:`run_case` compiles a case file, steps it to ``run.end_time`` (a containment
+case with ``run.stop_when_decided``: until its outcome has held that long) and writes
 
 - ``OUT/history.csv``: energies and time-step data every ``history_interval``. A
   column's name says its scope: ``*_part_J`` energies are of the modelled part (a

@@ -488,7 +488,11 @@ def check_mesh_size(m) -> list[Problem]:
             return [Problem("mesh.element_size", f"gives fewer than 2 elements along the "
                             f"casing's length or the released fragment ({shortest:g} m)",
                             m.element_size, f"element_size ≤ {shortest / 2.0:.4g} m")]
-        area = (c.sector * c.inner_radius * c.length * (c.layers + 1)
+        arc = c.sector  # a graded ring: its coarse part as the equivalent fine arc
+        if c.fine_sector is not None and c.coarse_element_size is not None:
+            fine = min(c.fine_sector, c.sector)
+            arc = fine + (c.sector - fine) * min(m.element_size / c.coarse_element_size, 1.0)
+        area = (arc * c.inner_radius * c.length * (c.layers + 1)
                 + (b.tip_radius - b.root_radius) * max(b.root_chord, b.tip_chord))
         count = area / m.element_size / m.element_size  # no underflow to 0 at 1e-300
         context = f"casing and blade, {c.layers} layers"

@@ -287,34 +287,39 @@ def test_a_fragment_past_the_sectors_cut_edge_is_undecided_not_escaped():
 
     from wovenimpact.containment import FRAGMENT, fragment_row
 
-    model, state = coarse_two_ply_casing(sector=True)
-    nodes = model.node_sets[FRAGMENT]
-    centre = model.node_mass[nodes] @ state.x[nodes] / model.node_mass[nodes].sum()
-
-    def turned(deg):
+    def turned(model, state, deg):
+        """The fragment's nodes of ``state`` turned by ``deg`` about the casing axis."""
+        nodes = model.node_sets[FRAGMENT]
         c, s = math.cos(math.radians(deg)), math.sin(math.radians(deg))
         x = state.x.copy()
         x[nodes, 0] = c * state.x[nodes, 0] - s * state.x[nodes, 1]
         x[nodes, 1] = s * state.x[nodes, 0] + c * state.x[nodes, 1]
         return x
 
+    model, state = coarse_two_ply_casing(sector=True)
+    nodes = model.node_sets[FRAGMENT]
+    centre = model.node_mass[nodes] @ state.x[nodes] / model.node_mass[nodes].sum()
     start = math.degrees(math.atan2(centre[1], centre[0]))
     assert 60.0 < start < 180.0  # the example's sector spans 60°–180°
     assert fragment_row(model, state)["fragment_beyond_casing"] == 0
-    state.x = turned(175.0 - start)
+    state.x = turned(model, state, 175.0 - start)
     assert fragment_row(model, state)["fragment_beyond_casing"] == 0
-    state.x = turned(200.0 - 175.0)
+    state.x = turned(model, state, 200.0 - 175.0)
     assert fragment_row(model, state)["fragment_beyond_casing"] == 1
     h = history([150.0, 70.0], [0.0, 20.0], [0.24, 0.29], [1, 0])
     h["fragment_beyond_casing"] = [0, 1]
     assert containment_outcome(h, R)["outcome"] == "undecided"
     h["fragment_beyond_casing"] = [0, 0]
     assert containment_outcome(h, R)["outcome"] == "escaped"
-    # the example's full ring has casing at every angle
+    # the example's full ring has casing at every angle: its fragment turned to the
+    # sector's "beyond" angle (200°) and on round the ring is always covered
     model, state = coarse_two_ply_casing()
-    for deg in (90.0, 180.0, 90.0):
-        state.x = turned(deg)
+    nodes = model.node_sets[FRAGMENT]
+    centre = model.node_mass[nodes] @ state.x[nodes] / model.node_mass[nodes].sum()
+    state.x = turned(model, state, 200.0 - math.degrees(math.atan2(centre[1], centre[0])))
+    for _ in range(4):
         assert fragment_row(model, state)["fragment_beyond_casing"] == 0
+        state.x = turned(model, state, 90.0)
 
 
 def test_decided_since_is_the_start_of_the_last_outcomes_streak():
@@ -360,11 +365,15 @@ def test_stop_when_decided_ends_the_run_once_the_outcome_has_held(tmp_path, monk
     summary = runs.run_case(case, out, overrides=[
         'run.end_time="60 us"', 'mesh.element_size="10 mm"', "mesh.casing.layers=1",
         'run.stop_when_decided="20 us"', 'run.history_interval="2 us"'])
+    from wovenimpact.io.checkpoint import checkpoint_meta, latest_checkpoint
+
     t = read_csv(out / "history.csv")["time_s"]
     assert summary["stopped_when_decided"] == "escaped"
     assert 30e-6 <= summary["end_time_s"] < 34e-6  # the first row ≥ 10 + 20 µs
     assert t[-1] == pytest.approx(summary["end_time_s"], rel=1e-12)
     assert t[-2] < 30e-6
+    # the last checkpoint is the stop's: it counts every history row written
+    assert checkpoint_meta(latest_checkpoint(out / "checkpoints"))["history_rows"] == len(t)
 
 
 def test_stop_when_decided_on_a_case_without_a_fragment_is_refused(tmp_path):

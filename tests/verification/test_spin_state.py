@@ -199,8 +199,8 @@ def test_a_graded_ring_is_fine_in_its_impact_zone_and_grows_gently_outside(secto
     centre angle every element is 7 mm around (the ungraded ring's width there), outside
     no element is wider than 21 mm and neighbours differ by at most 25 %; the nodes still
     lie on their layer's radius, the layer's area is the polygon's, a full ring has no
-    seam (every column of nodes is used by two elements' edges) and a sector keeps its
-    cut edges at ±sector/2."""
+    seam (as many node columns as elements around, every node used) and a sector keeps
+    its cut edges at ±sector/2."""
     r0, size, coarse, centre = 0.25, 7e-3, 21e-3, 175.0
     mesh = casing_mesh([r0, 0.26], 0.15, size, sector=sector, centre_angle=centre,
                        fine_sector=fine, coarse_size=coarse)
@@ -224,8 +224,12 @@ def test_a_graded_ring_is_fine_in_its_impact_zone_and_grows_gently_outside(secto
     assert np.allclose(np.hypot(*mesh.nodes[nodes, :2].T), r0, rtol=1e-12)
     area = np.linalg.norm(mesh.area_vectors()[mesh.elem_sets["layer0"]], axis=1).sum()
     assert area == pytest.approx(np.sum(2 * r0 * np.sin(0.5 * np.diff(edges))) * 0.15, rel=1e-9)
+    n_z = np.unique(np.round(mesh.nodes[nodes, 2], 12)).size - 1
+    n_around = mesh.elem_sets["layer0"].size // n_z
+    assert n_around == width.size
     if sector == 360.0:
         assert mesh.node_sets["cut_edges"].size == 0
+        assert nodes.size == n_around * (n_z + 1)  # a seam would add a column
         assert np.array_equal(np.unique(mesh.quads[mesh.elem_sets["layer0"]]), np.sort(nodes))
     else:
         ang = np.degrees(np.arctan2(mesh.nodes[mesh.node_sets["cut_edges"], 1],

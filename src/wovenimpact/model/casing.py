@@ -50,7 +50,7 @@ def casing_mesh(
         centre_angle: angle of the sector's middle (degrees, from +x towards +y).
         fine_sector, coarse_size: a graded ring (:func:`graded_angles`): ``element_size``
             around the circumference within ``fine_sector`` degrees centred on
-            ``centre_angle`` (the impact zone), growing by at most 20 % per element
+            ``centre_angle`` (the impact zone), growing by about 20 % per element
             to ``coarse_size`` outside it; axially ``element_size`` everywhere. Both
             or neither.
 

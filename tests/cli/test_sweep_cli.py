@@ -253,3 +253,47 @@ def test_a_killed_sweep_leaves_no_worker_behind(tmp_path: Path):
         os.kill(w, signal.SIGKILL)
     assert not left, f"workers {left} outlived the killed sweep"
     assert not any(out.glob("runs/*/summary.json"))  # they were cut short, as they should
+
+
+def test_an_interrupted_variant_resumes_from_its_checkpoint(tmp_path: Path):
+    """A variant cut short (a killed job, a session that ended: checkpoints, no summary)
+    is restarted by the next sweep, not redone — what makes an hours-long ladder (the
+    containment report) finish across sessions — and ends as the uninterrupted run; a
+    checkpoint left by other values is not resumed."""
+    import pytest
+
+    from wovenimpact.errors import InputWarning
+    from wovenimpact.runs import run_spec
+    from wovenimpact.spec.case import case_from_dict
+    from wovenimpact.studies.sweep import load_study, run_study
+
+    write_case(tmp_path, end="12 us")
+    study = tmp_path / "study.toml"
+    study.write_text(STUDY.replace(', ["0 m/s", "0 m/s", "-60 m/s"], ["0 m/s", "0 m/s", "-60"]',
+                                   ""))
+    _, (v,), base = load_study(study)
+
+    def summary(root):
+        return json.loads((root / "runs" / v.id / "summary.json").read_text())
+
+    assert run_study(study, tmp_path / "whole", workers=1)[0]["status"] == "done"
+    whole = summary(tmp_path / "whole")
+    cut = tmp_path / "cut" / "runs" / v.id
+    cut.mkdir(parents=True)
+    (cut / "parameters.json").write_text(json.dumps(v.values, indent=2, default=str) + "\n")
+    run_spec(case_from_dict(v.document), base, cut, max_steps=int(0.8 * whole["steps"]))
+    assert not (cut / "summary.json").exists()
+    assert run_study(study, tmp_path / "cut", workers=1)[0]["status"] == "done"
+    resumed = summary(tmp_path / "cut")
+    assert resumed["restarted_from_step"] > 0.5 * whole["steps"]  # only the rest ran
+    assert resumed["steps"] == whole["steps"]
+    assert resumed["element_cycles"] == whole["element_cycles"]
+    assert (cut / "history.csv").read_text() == (
+        tmp_path / "whole" / "runs" / v.id / "history.csv").read_text()
+    # the same directory cut short again, then asked for with other values: from the start
+    (cut / "summary.json").unlink()
+    (cut / "parameters.json").write_text(json.dumps({"other": 1}) + "\n")
+    with pytest.warns(InputWarning, match="removed .* output files of an earlier run"):
+        assert run_study(study, tmp_path / "cut", workers=1)[0]["status"] == "done"
+    again = summary(tmp_path / "cut")
+    assert again["restarted_from_step"] is None and again["steps"] == whole["steps"]

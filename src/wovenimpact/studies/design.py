@@ -17,7 +17,6 @@ search stops with advice to run longer.
 from __future__ import annotations
 
 import copy
-import json
 import traceback
 from collections.abc import Callable
 from pathlib import Path
@@ -105,31 +104,17 @@ def _run_one(doc: dict, base: str, out: str) -> str:
     ``"failed: <reason>"`` (written to its ``error.txt``), so the other packs of the
     batch finish and stay reusable."""
     from wovenimpact.io.atomic import atomic_write_text
-    from wovenimpact.io.checkpoint import latest_checkpoint
-    from wovenimpact.runs import run_spec
     from wovenimpact.spec.case import case_from_dict
-    from wovenimpact.studies.sweep import finished, outcome_of
+    from wovenimpact.studies.sweep import finished, outcome_of, run_resuming, start_or_resume
 
     out_dir = Path(out)
     done, _ = finished(out_dir, doc, doc, base)  # the sweep's test: parameters and digest
     if done is not None:
         return _pack_outcome(done)
-    params = out_dir / "parameters.json"
-    text = json.dumps(doc, indent=2, default=str) + "\n"
-    restart = (params.exists() and json.loads(params.read_text()) == json.loads(text)
-               and latest_checkpoint(out_dir / "checkpoints") is not None)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    (out_dir / "summary.json").unlink(missing_ok=True)
-    (out_dir / "error.txt").unlink(missing_ok=True)
-    atomic_write_text(params, text)
+    resume = start_or_resume(out_dir, doc)
     try:
         spec = case_from_dict(doc, source=out)
-        try:
-            summary = run_spec(spec, base, out, threads=1, restart=restart)
-        except InputError as err:
-            if not (restart and str(err).startswith("--restart")):
-                raise
-            summary = run_spec(spec, base, out, threads=1)  # a stale checkpoint: start again
+        summary = run_resuming(spec, base, out_dir, resume)
         return _pack_outcome(outcome_of(summary))
     except Exception as err:  # one failing pack is reported, the others finish
         message = f"{type(err).__name__}: {err}"

@@ -170,19 +170,54 @@ def quiet_spec(document: dict, source: str):
             return None
 
 
-def run_variant(document: dict, base: str, out_dir: str, values: dict, threads: int = 1) -> dict:
-    """Run one variant (in a worker process); never raises: failures are reported."""
+def start_or_resume(out: Path, values: dict) -> bool:
+    """Prepare ``out`` for a run of ``values`` (written to its ``parameters.json``); True
+    if the run may resume: an earlier run of the same values left a checkpoint there (it
+    was interrupted: a crash, a killed job, a session that ended). A summary or error of
+    an earlier run is removed first, so that nothing stale outlives this run."""
+    from wovenimpact.io.checkpoint import latest_checkpoint
+
+    params = out / "parameters.json"
+    text = json.dumps(values, indent=2, default=str) + "\n"
+    try:
+        same = json.loads(params.read_text(encoding="utf-8")) == json.loads(text)
+    except (OSError, ValueError):
+        same = False
+    resume = same and latest_checkpoint(out / "checkpoints") is not None
+    out.mkdir(parents=True, exist_ok=True)
+    (out / "summary.json").unlink(missing_ok=True)
+    (out / "error.txt").unlink(missing_ok=True)
+    atomic_write_text(params, text)
+    return resume
+
+
+def run_resuming(spec, base: str | Path, out: Path, resume: bool, threads: int = 1) -> dict:
+    """``run_spec`` in ``out``, from its newest checkpoint if ``resume``; a checkpoint
+    written for another case, file or code (``--restart`` refuses it) runs from the start."""
     from wovenimpact.runs import run_spec
+
+    if resume:
+        try:
+            return run_spec(spec, base, out, threads=threads, restart=True)
+        except InputError as err:
+            if not str(err).startswith("--restart"):
+                raise
+    return run_spec(spec, base, out, threads=threads)
+
+
+def run_variant(document: dict, base: str, out_dir: str, values: dict, threads: int = 1) -> dict:
+    """Run one variant (in a worker process), resuming an interrupted run of the same
+    values from its last checkpoint (:func:`start_or_resume`); never raises: failures
+    are reported."""
     from wovenimpact.spec.case import case_from_dict
 
     out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    atomic_write_text(out / "parameters.json", json.dumps(values, indent=2, default=str) + "\n")
+    resume = start_or_resume(out, values)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", InputWarning)
         try:
             spec = case_from_dict(document, source=f"variant {out.name}")
-            result = outcome_of(run_spec(spec, base, out, threads=threads))
+            result = outcome_of(run_resuming(spec, base, out, resume, threads=threads))
         except Exception as err:  # one failing case is reported, the others finish
             message = f"{type(err).__name__}: {err}"
             atomic_write_text(out / "error.txt", message + "\n\n" + traceback.format_exc())

@@ -17,6 +17,7 @@ search stops with advice to run longer.
 from __future__ import annotations
 
 import copy
+import json
 import traceback
 from collections.abc import Callable
 from pathlib import Path

@@ -37,6 +37,7 @@ def test_regression_uses_escaped_runs_and_finds_their_zero():
     assert reg.root == pytest.approx(60.0 - 600.0**0.5, rel=1e-9)
     assert reg.plies_to_stop == 36
     assert res["fewest_contained"] == 36  # V(30) = 15 escaped, V(36) = −1.2 contained
+    assert res["most_escaped_below"] == 30
     assert res["undecided"] == [20]
     assert res["mass_per_area"](36) == pytest.approx(2.7 + 0.5 * 36)
 
@@ -46,7 +47,7 @@ def test_section_tables_the_ladders_names_undecided_and_counts_the_inner_shell(t
     ladders = {"containment_hybrid": ladder(), "containment_metal": ladder(0.0, -5.0, 130.0,
                                                                            0.0, 1.35)}
     monkeypatch.setattr("wovenimpact.studies.sweep.run_study",
-                        lambda path, out, workers=2: ladders[path.stem])
+                        lambda path, out, workers=2, overrides=(): ladders[path.stem])
     text = "\n".join(cv.containment_section(tmp_path / "work", tmp_path / "figs"))
     assert "| 4 | escaped | 126.8 | 133.0 |" in text  # ours beside the thesis's
     assert "undecided" in text and "20 plies — run them longer" in text
@@ -65,7 +66,8 @@ def test_validate_containment_writes_its_own_report(tmp_path, monkeypatch):
     from wovenimpact.cli import app
 
     monkeypatch.setattr(cv, "containment_section",
-                        lambda work, figures, workers=2, log=None: ["## section", "body"])
+                        lambda work, figures, workers=2, log=None, overrides=(), runs=():
+                        ["## section", "body"])
     report = tmp_path / "docs" / "validation_containment.md"
     result = CliRunner().invoke(app, ["validate", "--containment", "--work",
                                       str(tmp_path / "w"), "--report", str(report)])
@@ -73,3 +75,77 @@ def test_validate_containment_writes_its_own_report(tmp_path, monkeypatch):
     text = report.read_text()
     assert text.startswith("# Validation: fan-blade containment (thesis chapter 8)")
     assert "## section\nbody\n" in text
+
+
+def _run_dir(root, name, layers, materials, outcome, exit_speed, per_area, digest="abc"):
+    """A finished containment run's folder: its summary.json, as runs.summarise writes it."""
+    import json
+
+    d = root / name
+    d.mkdir(parents=True)
+    summary = {**_row(0, outcome, exit_speed, per_area), "casing_layers": layers,
+               "absorbed_energy_per_material_J": {m: 100.0 for m in materials},
+               "elements": 1000 * layers, "provenance": {"source_digest": digest}}
+    for k in ("id", "status", cv.KEY):
+        summary.pop(k)
+    (d / "summary.json").write_text(json.dumps(summary))
+    return d
+
+
+def test_a_report_from_given_runs_sorts_them_into_ladders_and_names_what_is_unfinished(
+        tmp_path):
+    """``--runs``: a casing of aluminium and fabric is a hybrid one of layers − 1 plies,
+    one of aluminium alone an all-metal one of its layers; a run with checkpoints and no
+    summary is named with the time it reached and left out; the code digests are said;
+    a folder that is not a containment run is refused."""
+    from wovenimpact.errors import InputError
+    from wovenimpact.io.history import History
+
+    runs = tmp_path / "runs"
+    _run_dir(runs, "r4", 5, ("aluminium", "fabric"), "escaped", 104.8, 4.68)
+    _run_dir(runs, "r10", 11, ("aluminium", "fabric"), "contained", 0.0, 7.53, digest="def")
+    _run_dir(runs, "m4", 4, ("aluminium",), "escaped", 120.0, 5.4)
+    cut = runs / "r8"
+    (cut / "checkpoints").mkdir(parents=True)
+    (cut / "checkpoints" / "checkpoint_000000100.npz").write_bytes(b"")
+    h = History(["time_s", "step"])
+    h.append({"time_s": 0.0, "step": 0})
+    h.append({"time_s": 2.75e-3, "step": 100})
+    h.write_csv(cut / "history.csv")
+    ladders, unfinished = cv.rows_from_runs([runs])
+    assert [r[cv.KEY] for r in ladders["containment_hybrid"]] == [4, 10]
+    assert [r[cv.KEY] for r in ladders["containment_metal"]] == [4]
+    assert unfinished == [f"{cut} (stopped at 2.75 ms)"]
+    text = "\n".join(cv.containment_section(tmp_path / "w", tmp_path / "f", runs=[runs]))
+    assert "| 4 | escaped | 104.8 | 133.0 |" in text and "| 10 | contained |" in text
+    assert "| 5000 |" in text  # the 4-ply run's elements
+    assert "`abc`, `def`" in text and "stopped at 2.75 ms" in text
+    assert ("Fewest plies run that contained the fragment: **10**; 4 let it through and "
+            "5–9 are not decided by a run: by runs the answer lies between 5 and 10 plies."
+            in text)
+    assert not (tmp_path / "w").exists()  # nothing ran
+    (runs / "plate").mkdir()
+    (runs / "plate" / "summary.json").write_text('{"outcome": "stopped"}')
+    with pytest.raises(InputError, match="not a containment run"):
+        cv.rows_from_runs([runs])
+
+
+def test_validate_containment_from_runs_names_its_command_and_set_needs_containment(tmp_path):
+    """The report made from ``--runs`` says the command that made it; ``--set`` or
+    ``--runs`` without ``--containment`` is refused (the chapter-7 studies run their own
+    cases), before anything runs."""
+    from typer.testing import CliRunner
+
+    from wovenimpact.cli import app
+
+    runs = tmp_path / "runs"
+    _run_dir(runs, "r4", 5, ("aluminium", "fabric"), "escaped", 104.8, 4.68)
+    report = tmp_path / "docs" / "validation_containment.md"
+    result = CliRunner().invoke(app, ["validate", "--containment", "--runs", str(runs),
+                                      "--report", str(report)])
+    assert result.exit_code == 0, result.output
+    assert f"`wovenimpact validate --containment --runs {runs}`" in report.read_text()
+    bad = CliRunner().invoke(app, ["validate", "--set", "mesh.element_size=7 mm",
+                                   "--work", str(tmp_path / "w")])
+    assert bad.exit_code != 0 and "--set goes with --containment" in bad.output
+    assert not (tmp_path / "w").exists()

@@ -18,7 +18,9 @@ layers of 0.5 mm aluminium) — and returns Markdown lines:
 Undecided runs (still pushing intact layers at the end time) enter neither the
 regression nor the answer; they are listed with a word. ``wovenimpact validate
 --containment`` writes the section alone to docs/validation_containment.md (the ladders
-take hours: they are not part of the chapter-7 report).
+take hours: they are not part of the chapter-7 report). ``--set`` changes the ladders'
+case (a coarser mesh); ``--runs`` tabulates runs made elsewhere instead
+(:func:`rows_from_runs`), each with its mesh size and code digest.
 """
 
 from __future__ import annotations
@@ -67,7 +69,8 @@ def _mm(value) -> float | None:
 def ladder_result(rows: list[dict]) -> dict:
     """What a ladder's finished rows say: the regression of the escaped runs' exit speed
     against N (None with fewer than three distinct N), the fewest layers that contained
-    the fragment in a run (None if none did), the undecided N, and the mass per unit area
+    the fragment in a run (None if none did), the most layers below those that let it
+    through, the undecided N, and the mass per unit area
     of a casing of N layers interpolated between the runs (a function of N)."""
     from wovenimpact.studies.ballistics import quadratic_ply_regression
 
@@ -89,22 +92,25 @@ def ladder_result(rows: list[dict]) -> dict:
         (n0, m0), (n1, m1) = per_area[0], per_area[-1]
         return m0 + (m1 - m0) * (n - n0) / (n1 - n0) if n1 != n0 else None
 
+    below = [n for n, _ in escaped if not contained or n < contained[0]]
     return {"regression": regression, "fewest_contained": contained[0] if contained else None,
+            "most_escaped_below": int(max(below)) if below else None,
             "undecided": undecided, "mass_per_area": mass_per_area}
 
 
 def ladder_lines(name: str, title: str, unit: str, thesis: dict, note: str, rows: list[dict],
                  figures: Path) -> tuple[list[str], dict]:
     """The table, figure and regression of one ladder (rows: its study results)."""
-    lines = [f"### {title} (examples/studies/{name}.toml)", "", f"Thesis: {note}.", "",
+    lines = [f"### {title} (examples/studies/{name}.toml)", "", f"{note[0].upper()}{note[1:]}.", "",
              f"| {unit} | outcome | exit speed (m/s) | thesis (m/s) | casing (kg) | "
-             "kg/m² | largest bulge (mm) | energy error | hourglass / internal work | wall (s) |",
-             "|---|---|---|---|---|---|---|---|---|---|"]
+             "kg/m² | largest bulge (mm) | energy error | hourglass / internal work | wall (s) | "
+             "elements |",
+             "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         n = int(float(r[KEY]))
         if r.get("status") != "done":
             lines.append(f"| {n} | {r.get('status')}: {r.get('error', '')} | | "
-                         f"{_fmt(thesis.get(n), '.1f')} | | | | | | |")
+                         f"{_fmt(thesis.get(n), '.1f')} | | | | | | | |")
             continue
         lines.append(
             f"| {n} | {r['outcome']} | {_fmt(r['fragment_exit_speed_m_per_s'], '.1f')} | "
@@ -112,7 +118,8 @@ def ladder_lines(name: str, title: str, unit: str, thesis: dict, note: str, rows
             f"{_fmt(r['casing_mass_per_area_kg_per_m2'], '.2f')} | "
             f"{_fmt(_mm(r.get('max_bulge_m')), '.1f')} | "
             f"{_fmt(r['energy_error_fraction'], '.1e')} | "
-            f"{_fmt(r.get('hourglass_fraction'), '.1%', 'n/a')} | {_fmt(r.get('wall_time_s'), '.0f')} |")
+            f"{_fmt(r.get('hourglass_fraction'), '.1%', 'n/a')} | {_fmt(r.get('wall_time_s'), '.0f')} | "
+            f"{_fmt(r.get('elements'), '.0f')} |")
     result = ladder_result(rows)
     reg = result["regression"]
     lines.append("")
@@ -125,8 +132,13 @@ def ladder_lines(name: str, title: str, unit: str, thesis: dict, note: str, rows
     else:
         lines.append("No regression: it needs escaped runs at three or more N.")
     if result["fewest_contained"] is not None:
-        lines.append(f"Fewest {unit} that contained the fragment in a run: "
-                     f"**{result['fewest_contained']}**.")
+        fewest, below = result["fewest_contained"], result["most_escaped_below"]
+        lines.append(f"Fewest {unit} run that contained the fragment: **{fewest}**" + (
+            "." if below is None else
+            f"; {below} let it through, so by runs the answer is **{fewest}** {unit}."
+            if below == fewest - 1 else
+            f"; {below} let it through and {below + 1}–{fewest - 1} are not decided by a "
+            f"run: by runs the answer lies between {below + 1} and {fewest} {unit}."))
     if result["undecided"]:
         lines.append(f"Undecided (still pushing intact layers at the end time; not used): "
                      f"{', '.join(map(str, result['undecided']))} {unit} — run them longer.")
@@ -185,30 +197,109 @@ def mass_table(results: dict[str, dict]) -> list[str]:
     return lines + [""]
 
 
-def containment_section(work: str | Path, figures: str | Path, log=_quiet, workers: int = 2
-                        ) -> list[str]:
-    """The containment report (module docstring): the runs live in ``work/containment``,
-    the figures go to ``figures``."""
+def containment_section(work: str | Path, figures: str | Path, log=_quiet, workers: int = 2,
+                        overrides=(), runs=()) -> list[str]:
+    """The containment report (module docstring): the runs live in ``work/containment``
+    (``overrides``: ``--set KEY=VALUE`` for every run of both ladders), or are the finished
+    runs under the ``runs`` directories; the figures go to ``figures``."""
     from wovenimpact.studies.sweep import run_study
 
     work = Path(work) / "containment"
     figures = Path(figures)
     figures.mkdir(parents=True, exist_ok=True)
-    lines = ["## Fan-blade containment (thesis chapter 8; issue 11)", "",
-             "A titanium fragment released at 1047 rad/s (examples/containment/; geometry, "
-             "spin state and release: docs/theory.md §8) against a 120° casing sector. The "
-             "thesis's numbers are trends to compare with, not targets; nothing is tuned to "
-             "them.", ""]
+    lines = intro_lines()
     results = {}
+    from_runs, unfinished = rows_from_runs(runs) if runs else (None, [])
+    if runs:
+        lines += runs_lines(from_runs, unfinished)
     for name, title, unit, thesis, note in LADDERS:
-        path = ROOT / "examples" / "studies" / f"{name}.toml"
-        if not path.exists():
-            raise InputError(f"no study file {path}")
-        log(f"study {name} → {work / name}")
-        rows = run_study(path, work / name, workers=workers)
+        if from_runs is not None:
+            rows = from_runs[name]
+        else:
+            path = ROOT / "examples" / "studies" / f"{name}.toml"
+            if not path.exists():
+                raise InputError(f"no study file {path}")
+            log(f"study {name} → {work / name}")
+            rows = run_study(path, work / name, workers=workers, overrides=overrides)
         ladder, results[name] = ladder_lines(name, title, unit, thesis, note, rows, figures)
         lines += ladder
         plots = work / name / "plots"
-        for png in sorted(plots.glob("*.png")) if plots.exists() else ():
+        for png in sorted(plots.glob("*.png")) if plots.exists() and not runs else ():
             shutil.copy(png, figures / f"{name}_{png.name}")
     return lines + mass_table(results)
+
+
+def intro_lines() -> list[str]:
+    """The section's opening paragraph."""
+    return ["## Fan-blade containment (thesis chapter 8; issue 11)", "",
+            "A titanium fragment released at 1047 rad/s (examples/containment/; geometry, "
+            "spin state and release: docs/theory.md §8) against the full casing ring, "
+            "graded: `element_size` within 150° about the impact zone, growing to the coarse "
+            "size around the rest. The thesis's numbers are trends to compare with, not "
+            "targets; nothing is tuned to them.", ""]
+
+
+def runs_lines(ladders: dict[str, list[dict]], unfinished: list[str]) -> list[str]:
+    """What a report made from given runs says of them: their meshes and code digests,
+    and the runs that have not finished."""
+    rows = [r for rs in ladders.values() for r in rs]
+    digests = sorted({str(r.get("source_digest")) for r in rows})
+    lines = [f"Tabulated from {len(rows)} finished runs (`--runs`), not rerun: their meshes "
+             "are the table's element counts; code (source digest) "
+             f"{', '.join(f'`{d}`' for d in digests)}."]
+    if unfinished:
+        lines.append(f"Not finished, left out: {'; '.join(unfinished)}.")
+    return lines + [""]
+
+
+def _ladder_of(summary: dict) -> tuple[str, int] | None:
+    """Which ladder a containment run belongs to and its N: a casing of two materials is
+    a hybrid one (its innermost layer is the aluminium shell, the rest are plies: N =
+    layers − 1), a casing of one material an all-metal one (N = layers); None for a run
+    that is not a containment run."""
+    materials = summary.get("absorbed_energy_per_material_J")
+    layers = summary.get("casing_layers")
+    if not materials or not layers:
+        return None
+    return ("containment_hybrid", int(layers) - 1) if len(materials) > 1 else (
+        "containment_metal", int(layers))
+
+
+def rows_from_runs(paths) -> dict[str, list[dict]]:
+    """Ladder rows (as :func:`run_study` gives them) from finished run directories: each
+    path is a run (it holds summary.json) or a folder of runs. A run cut short (a
+    checkpoint, no summary) cannot say which ladder it belongs to: it is listed apart,
+    with the time it reached. Every row carries its elements and its code's source
+    digest. Returns the rows of each ladder, sorted by N, and the unfinished runs."""
+    import json
+
+    from wovenimpact.io.checkpoint import latest_checkpoint
+    from wovenimpact.io.history import read_csv
+
+    dirs = []
+    for p in map(Path, paths):
+        if not p.is_dir():
+            raise InputError(f"--runs {p}: no such directory")
+        dirs += [p] if (p / "summary.json").exists() or (p / "checkpoints").is_dir() else sorted(
+            d for d in p.iterdir() if (d / "summary.json").exists() or (d / "checkpoints").is_dir())
+    out: dict[str, list[dict]] = {name: [] for name, *_ in LADDERS}
+    unfinished: list[str] = []
+    for d in dirs:
+        if not (d / "summary.json").exists():
+            if latest_checkpoint(d / "checkpoints") is None or not (d / "history.csv").exists():
+                continue
+            t = read_csv(d / "history.csv")["time_s"]
+            unfinished.append(f"{d} (stopped at {float(t[-1]) * 1e3:.2f} ms)" if len(t)
+                              else str(d))
+            continue
+        summary = json.loads((d / "summary.json").read_text(encoding="utf-8"))
+        ladder = _ladder_of(summary)
+        if ladder is None:
+            raise InputError(f"--runs {d}: not a containment run (its summary has no casing)")
+        name, n = ladder
+        out[name].append({**summary, "id": d.name, "status": "done", KEY: n,
+                          "source_digest": summary.get("provenance", {}).get("source_digest")})
+    for rows in out.values():
+        rows.sort(key=lambda r: float(r[KEY]))
+    return out, unfinished
+

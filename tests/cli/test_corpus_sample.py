@@ -4,7 +4,6 @@ its warning — never a traceback, a hang or accepted nonsense."""
 
 from __future__ import annotations
 
-import pytest
 
 from tests.corpus.generate import write_corpus
 from tests.corpus.runner import run_item

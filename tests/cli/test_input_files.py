@@ -6,7 +6,6 @@ the middle of a run is a one-line error, not a traceback."""
 from __future__ import annotations
 
 import errno
-import shutil
 from pathlib import Path
 
 import pytest

@@ -155,7 +155,7 @@ def plate_inp(n: int = 3, h: float = 0.001, dup_node: bool = False, dup_elem: bo
             x = "nan" if nan and k == 5 else f"{i * h:.6g}"
             lines.append(f"{k}, {x}, {j * h:.6g}, 0.0")
     if dup_node:
-        lines.append(f"1, 0.5, 0.5, 0.0")
+        lines.append("1, 0.5, 0.5, 0.0")
     lines.append(f"*ELEMENT, TYPE={etype}")
     e = 1
     for j in range(n):

@@ -24,7 +24,6 @@ Writes ``DIR/results.csv`` and prints the counts.
 from __future__ import annotations
 
 import argparse
-import contextlib
 import csv
 import os
 import resource

@@ -86,10 +86,8 @@ def test_containment_outputs_bulge_layer_and_material_energies_and_fragment_plot
     two VTU blocks."""
     from pathlib import Path
 
-    from wovenimpact.containment import layer_energies, layer_materials
     from wovenimpact.io.history import read_csv
     from wovenimpact.model.compile import compile_case
-    from wovenimpact.quantities import ply_energies
     from wovenimpact.runs import run_case
 
     case = Path(__file__).resolve().parents[2] / "examples" / "containment" / "hybrid_4.toml"

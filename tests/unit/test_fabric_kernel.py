@@ -15,7 +15,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.optimize import brentq
 
-from tests.conftest import reference_fabric, with_options
+from tests.conftest import reference_fabric
 from wovenimpact.errors import MaterialPointError
 from wovenimpact.kernels import fabric_layout as L
 from wovenimpact.kernels.fabric import (

@@ -4,7 +4,6 @@ against the exact solve, and the kernel's use of the table."""
 from __future__ import annotations
 
 import dataclasses
-import math
 
 import numpy as np
 import pytest

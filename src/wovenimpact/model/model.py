@@ -18,7 +18,6 @@ import numpy as np
 
 from wovenimpact.errors import InputError
 from wovenimpact.impactor import BODY_PENALTY_SCALE, Impactor
-from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels.integrate import FIXED, PRESCRIBED, ROTATING
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as SL

@@ -65,7 +65,7 @@ from typing import Annotated, Any, Literal
 
 from pydantic import AfterValidator, BaseModel, Field, ValidationError, model_validator
 
-from wovenimpact.errors import InputError, InputWarning
+from wovenimpact.errors import InputWarning
 from wovenimpact.impactor import BODY_PENALTY_SCALE
 from wovenimpact.spec.fields import (
     STRICT,

@@ -28,7 +28,6 @@ from typing import Any, Literal
 from pydantic import BaseModel, Field, ValidationError
 
 from wovenimpact.calibration.crimp import crimp_amplitude, half_length_from_thread_count
-from wovenimpact.errors import InputError
 from wovenimpact.kernels.j2_layout import N_HARD_MAX
 from wovenimpact.materials.fabric import FabricOptions, FabricParameters, YarnFamily
 from wovenimpact.materials.metal import DamageParameters, MetalParameters, RateParameters

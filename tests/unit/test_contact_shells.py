@@ -191,7 +191,6 @@ class RawSearch:
     """The broad-phase kernels driven on raw arrays, the way ShellContact drives them."""
 
     def __init__(self, mesh, h_node, h_seg, margin, self_contact, capacity=0):
-
         ne, nn = mesh.n_elems, mesh.n_nodes
         self.mesh, self.h_node, self.h_seg = mesh, h_node, h_seg
         self.margin, self.self_contact = margin, self_contact

@@ -351,6 +351,9 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
         f"`{work}`. Impactor: the .22-calibre 17-grain FSP (steel, 5.56 mm, 1.1 g, flat "
         "face), a stated assumption: the thesis's impactor is not in its text. The thesis's "
         "units were inconsistent, so its numbers are trends; nothing is tuned to them.", "",
+        "The fan-blade containment of chapter 8 has its own report, "
+        "[validation_containment.md](validation_containment.md) (`wovenimpact validate "
+        "--containment`: its ladders take hours).", "",
         "## Example cases (97 mm pack, quarter model, 0.94 mm elements)", "",
         "| case | outcome | residual (m/s) | thesis (m/s) | rebound (m/s) | absorbed (J) | "
         "max deflection (mm) | energy error | hourglass / internal work | wall (s)¹ |",

@@ -435,26 +435,139 @@ def green_naghdi_stretches(fo11, fo12, fo21, fo22, f11, f12, f21, f22, lam_w_old
 
 
 @inline_kernel
+def yarn_damage(p, m, strain_w, strain_f, t_w, t_f, d_w, d_f, ea_w, ea_f):
+    """Step 3, the failure check, for yarn strains ε and tensions T at a point: the
+    damages after it. Progressive softening (theory §1.7) of each family not yet
+    broken, or eq. (6.29): a yarn breaks for good when T ≥ T_u. A broken family
+    (d = 1) stays broken. Returns (d_w, d_f)."""
+    d_w_new = d_w
+    d_f_new = d_f
+    if p[m, P_FAILURE] == FAILURE_PROGRESSIVE:
+        if d_w < 1.0:
+            d_w_new = softening_damage(strain_w, d_w, ea_w, p[m, P_TU], p[m, P_SOFT])
+        if d_f < 1.0:
+            d_f_new = softening_damage(strain_f, d_f, ea_f, p[m, P_TU + 1], p[m, P_SOFT])
+    else:
+        if d_w < 1.0 and t_w >= p[m, P_TU]:
+            d_w_new = 1.0
+        if d_f < 1.0 and t_f >= p[m, P_TU + 1]:
+            d_f_new = 1.0
+    return d_w_new, d_f_new
+
+
+@inline_kernel
+def tabulated_crossover(p, m, lam_w, lam_f, yc):
+    """Step 2′ (theory §1.9), both families intact: W, its gradient and the crimp
+    heights from the C¹ interpolant of the material's table, the tensions from
+    ∂W/∂λ_i = 2 T_i cos ψ_i ℓ_i0 / A0 (yc: :func:`yarn_constants`).
+
+    Returns (inside, H_w, H_f, T_w, T_f, L_w, L_f, W, ∂W/∂λ_w, ∂W/∂λ_f); inside is
+    False for stretches outside the tabulated cells (the exact solve takes over).
+    """
+    ell0_w, ell0_f = yc[0], yc[1]
+    inside, w_tab, gw_tab, gf_tab, hw_tab, hf_tab = crossover_from_table(p, m, lam_w, lam_f)
+    if not inside:
+        return False, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0
+    ell_w = lam_w * ell0_w
+    ell_f = lam_f * ell0_f
+    area0 = 4.0 * ell0_w * ell0_f
+    h_w = max(hw_tab, 0.0)
+    h_f = max(hf_tab, 0.0)
+    l_w = math.sqrt(ell_w * ell_w + h_w * h_w)
+    l_f = math.sqrt(ell_f * ell_f + h_f * h_f)
+    t_w = max(gw_tab * area0 * l_w / (2.0 * ell0_w * ell_w), 0.0)
+    t_f = max(gf_tab * area0 * l_f / (2.0 * ell0_f * ell_f), 0.0)
+    return True, h_w, h_f, t_w, t_f, l_w, l_f, w_tab, gw_tab, gf_tab
+
+
+@inline_kernel
+def intact_crimp_heights(s_in, i, k_w, k_f, ell_w, ell_f, yc):
+    """Step 2 with both families intact: the crimp heights and compaction force of eq.
+    6.21–6.25 (yarn stiffnesses k = (1 − d) E A / L0, half-lengths ℓ; yc:
+    :func:`yarn_constants`), from point i's heights and tensions at the start of the
+    step.
+
+    The yarn that is vertically stiffer (dF/dH of eq. 6.22 at the previous heights)
+    carries the unknown ("a"): the other yarn's height above slack, u = D − δ − u_a, is
+    then the larger one and keeps its relative accuracy. If the converged offsets say
+    otherwise, the roles swap and the solve restarts from the solution (rare: cold
+    starts, role changes).
+
+    Returns (ok, iterations, H_w, H_f, compaction force).
+    """
+    ell0_w, ell0_f, h0_w, h0_f, lt0_w, lt0_f, ea_w, ea_f, a, b = yc
+    warp_unknown = yarn_vertical_stiffness(k_w, ell_w, s_in[i, S_H], lt0_w) >= (
+        yarn_vertical_stiffness(k_f, ell_f, s_in[i, S_H + 1], lt0_f)
+    )
+    ok = False
+    iters = 0
+    h_w = 0.0
+    h_f = 0.0
+    f_c = 0.0
+    for role in range(2):
+        if warp_unknown:
+            k_a, ell_a, ell0_a, h0_a, lt0_a = k_w, ell_w, ell0_w, h0_w, lt0_w
+            k_b, ell_b, ell0_b, h0_b, lt0_b = k_f, ell_f, ell0_f, h0_f, lt0_f
+            t_prev, h_prev, h_last = s_in[i, S_TENSION], s_in[i, S_H], h_w
+        else:
+            k_a, ell_a, ell0_a, h0_a, lt0_a = k_f, ell_f, ell0_f, h0_f, lt0_f
+            k_b, ell_b, ell0_b, h0_b, lt0_b = k_w, ell_w, ell0_w, h0_w, lt0_w
+            t_prev, h_prev, h_last = s_in[i, S_TENSION + 1], s_in[i, S_H + 1], h_f
+        if role == 0:
+            h_guess = tension_predictor(t_prev, k_a, lt0_a, ell_a, h_prev)
+        else:
+            h_guess = h_last
+        h_a, h_b, f_c, res, it, ok, swap = solve_crimp_heights(
+            k_a, ell_a, ell0_a, h0_a, lt0_a, k_b, ell_b, ell0_b, h0_b, lt0_b, a, b,
+            h_guess,
+        )
+        if warp_unknown:
+            h_w, h_f = h_a, h_b
+        else:
+            h_f, h_w = h_a, h_b
+        iters += it
+        if not (ok and swap):
+            break
+        warp_unknown = not warp_unknown
+    return ok, iters, h_w, h_f, f_c
+
+
+@inline_kernel
 def crossover_equilibrium(p, m, s_in, i, lam_w, lam_f):
     """Steps 2–3 of the module docstring for point i at the yarn stretches λ_w, λ_f:
     the crossover's crimp heights and yarn tensions, the failure check (eq. 6.29, or
     progressive softening) and one re-solve with the new damage if a yarn failed.
 
-    From the table (theory §1.9) while both families are intact and the point lies in
-    a tabulated cell, else by the exact solve of eq. 6.21–6.25 (the yarn that is
-    vertically stiffer carries the unknown), a broken family's partner decrimping.
+    From the table (:func:`tabulated_crossover`, theory §1.9) while both families are
+    intact and the point lies in a tabulated cell, else by the exact solve of eq.
+    6.21–6.25 (:func:`intact_crimp_heights`), a broken family's partner decrimping.
 
     Returns (converged, iterations, H_w, H_f, d_w, d_f, T_w, T_f, L_w − L0_w, L_f − L0_f,
     L_w, L_f, compaction force, from_table, W, ∂W/∂λ_w, ∂W/∂λ_f); the last three are the
     table's (0 when the exact solve ran).
     """
-    ell0_w, ell0_f, h0_w, h0_f, lt0_w, lt0_f, ea_w, ea_f, a, b = yarn_constants(p, m)
+    yc = yarn_constants(p, m)
+    ell0_w, ell0_f, h0_w, h0_f, lt0_w, lt0_f, ea_w, ea_f, a, b = yc
     ell_w = lam_w * ell0_w
     ell_f = lam_f * ell0_f
     d_w = s_in[i, S_DAMAGE]
     d_f = s_in[i, S_DAMAGE + 1]
     h_w = s_in[i, S_H]
     h_f = s_in[i, S_H + 1]
+    if p[m, P_CROSSOVER] == CROSSOVER_TABLE and d_w == 0.0 and d_f == 0.0:
+        inside, hw_t, hf_t, tw_t, tf_t, lw_t, lf_t, w_t, gw_t, gf_t = tabulated_crossover(
+            p, m, lam_w, lam_f, yc)
+        if inside:
+            d_w_new, d_f_new = yarn_damage(p, m, tw_t / ea_w, tf_t / ea_f, tw_t, tf_t, d_w,
+                                           d_f, ea_w, ea_f)
+            if d_w_new == d_w and d_f_new == d_f:
+                return (True, 0, hw_t, hf_t, d_w, d_f, tw_t, tf_t, 0.0, 0.0, lw_t, lf_t, 0.0,
+                        True, w_t, gw_t, gf_t)
+            # a yarn failed: the exact solve takes over with the new damage
+            d_w = d_w_new
+            d_f = d_f_new
+            h_w = hw_t  # a broken family's height stays the table's
+            h_f = hf_t
     f_c = 0.0
     t_w = 0.0
     t_f = 0.0
@@ -463,84 +576,15 @@ def crossover_equilibrium(p, m, s_in, i, lam_w, lam_f):
     l_w = 1.0
     l_f = 1.0
     iters = 0
-    w_cross = 0.0  # crossover energy per reference area from the table (use_table)
-    use_table = False
-    gw_cross = 0.0
-    gf_cross = 0.0
-    if p[m, P_CROSSOVER] == CROSSOVER_TABLE and d_w == 0.0 and d_f == 0.0:
-        # 2'. tabulated crossover (theory §1.9): W, its gradient and the heights from the
-        # C¹ interpolant; the tensions follow from ∂W/∂λ_i = 2 T_i cosψ_i ℓ_i0 / A0
-        inside, w_tab, gw_tab, gf_tab, hw_tab, hf_tab = crossover_from_table(p, m, lam_w, lam_f)
-        if inside:
-            area0 = 4.0 * ell0_w * ell0_f
-            h_w = max(hw_tab, 0.0)
-            h_f = max(hf_tab, 0.0)
-            l_w = math.sqrt(ell_w * ell_w + h_w * h_w)
-            l_f = math.sqrt(ell_f * ell_f + h_f * h_f)
-            t_w = max(gw_tab * area0 * l_w / (2.0 * ell0_w * ell_w), 0.0)
-            t_f = max(gf_tab * area0 * l_f / (2.0 * ell0_f * ell_f), 0.0)
-            d_w_new = d_w
-            d_f_new = d_f
-            if p[m, P_FAILURE] == FAILURE_PROGRESSIVE:
-                d_w_new = softening_damage(t_w / ea_w, d_w, ea_w, p[m, P_TU], p[m, P_SOFT])
-                d_f_new = softening_damage(t_f / ea_f, d_f, ea_f, p[m, P_TU + 1], p[m, P_SOFT])
-            else:
-                if t_w >= p[m, P_TU]:
-                    d_w_new = 1.0
-                if t_f >= p[m, P_TU + 1]:
-                    d_f_new = 1.0
-            if d_w_new == d_w and d_f_new == d_f:
-                use_table = True
-                w_cross = w_tab
-                gw_cross = gw_tab
-                gf_cross = gf_tab
-            else:  # a yarn failed: the exact solve takes over with the new damage
-                d_w = d_w_new
-                d_f = d_f_new
     for attempt in range(2):
-        if use_table:
-            break
         k_w = (1.0 - d_w) * ea_w / lt0_w
         k_f = (1.0 - d_f) * ea_f / lt0_f
         if d_w < 1.0 and d_f < 1.0:
-            # The yarn that is vertically stiffer (dF/dH of eq. 6.22 at the
-            # previous heights) carries the unknown ("a"): the other yarn's height
-            # above slack, u = D − δ − u_a, is then the larger one and keeps its
-            # relative accuracy. If the converged offsets say otherwise, the roles
-            # swap and the solve restarts from the solution (rare: cold starts,
-            # role changes).
-            warp_unknown = yarn_vertical_stiffness(k_w, ell_w, s_in[i, S_H], lt0_w) >= (
-                yarn_vertical_stiffness(k_f, ell_f, s_in[i, S_H + 1], lt0_f)
-            )
-            ok = False
-            for role in range(2):
-                if warp_unknown:
-                    k_a, ell_a, ell0_a, h0_a, lt0_a = k_w, ell_w, ell0_w, h0_w, lt0_w
-                    k_b, ell_b, ell0_b, h0_b, lt0_b = k_f, ell_f, ell0_f, h0_f, lt0_f
-                    t_prev, h_prev, h_last = s_in[i, S_TENSION], s_in[i, S_H], h_w
-                else:
-                    k_a, ell_a, ell0_a, h0_a, lt0_a = k_f, ell_f, ell0_f, h0_f, lt0_f
-                    k_b, ell_b, ell0_b, h0_b, lt0_b = k_w, ell_w, ell0_w, h0_w, lt0_w
-                    t_prev, h_prev, h_last = s_in[i, S_TENSION + 1], s_in[i, S_H + 1], h_f
-                if role == 0:
-                    h_guess = tension_predictor(t_prev, k_a, lt0_a, ell_a, h_prev)
-                else:
-                    h_guess = h_last
-                h_a, h_b, f_c, res, it, ok, swap = solve_crimp_heights(
-                    k_a, ell_a, ell0_a, h0_a, lt0_a, k_b, ell_b, ell0_b, h0_b, lt0_b, a, b,
-                    h_guess,
-                )
-                if warp_unknown:
-                    h_w, h_f = h_a, h_b
-                else:
-                    h_f, h_w = h_a, h_b
-                iters += it
-                if not (ok and swap):
-                    break
-                warp_unknown = not warp_unknown
+            ok, it, h_w, h_f, f_c = intact_crimp_heights(s_in, i, k_w, k_f, ell_w, ell_f, yc)
+            iters += it
             if not ok:
                 return (False, iters, h_w, h_f, d_w, d_f, t_w, t_f, ext_w, ext_f, l_w, l_f,
-                        f_c, use_table, w_cross, gw_cross, gf_cross)
+                        f_c, False, 0.0, 0.0, 0.0)
         elif d_w < 1.0:  # fill broken: the warp loses its support and decrimps
             h_w = min(s_in[i, S_H], slack_height(ell_w, ell0_w, h0_w))
             f_c = 0.0
@@ -553,27 +597,15 @@ def crossover_equilibrium(p, m, s_in, i, lam_w, lam_f):
         t_f = k_f * max(ext_f, 0.0)
         if attempt == 1:
             break
-        d_w_new = d_w
-        d_f_new = d_f
-        if p[m, P_FAILURE] == FAILURE_PROGRESSIVE:
-            if d_w < 1.0:
-                d_w_new = softening_damage(ext_w / lt0_w, d_w, ea_w, p[m, P_TU], p[m, P_SOFT])
-            if d_f < 1.0:
-                d_f_new = softening_damage(
-                    ext_f / lt0_f, d_f, ea_f, p[m, P_TU + 1], p[m, P_SOFT]
-                )
-        else:  # eq. (6.29): a yarn breaks for good when T ≥ T_u
-            if d_w < 1.0 and t_w >= p[m, P_TU]:
-                d_w_new = 1.0
-            if d_f < 1.0 and t_f >= p[m, P_TU + 1]:
-                d_f_new = 1.0
+        d_w_new, d_f_new = yarn_damage(p, m, ext_w / lt0_w, ext_f / lt0_f, t_w, t_f, d_w, d_f,
+                                       ea_w, ea_f)
         if d_w_new == d_w and d_f_new == d_f:
             break
         d_w = d_w_new
         d_f = d_f_new
 
     return (True, iters, h_w, h_f, d_w, d_f, t_w, t_f, ext_w, ext_f, l_w, l_f, f_c,
-            use_table, w_cross, gw_cross, gf_cross)
+            False, 0.0, 0.0, 0.0)
 
 
 @inline_kernel

@@ -64,6 +64,7 @@ from wovenimpact.containment import (
     decided_since,
     fragment_row,
     is_containment,
+    speed_settled,
 )
 from wovenimpact.provenance import changed_parts, digest_of, provenance, restart_parts
 from wovenimpact.solver import Workspace, energy_balance, step
@@ -343,7 +344,9 @@ def clear_outputs(out: Path) -> None:
 def decision_watch(model, hold: float | None):
     """``run.stop_when_decided``: None if it is not set; else a function of the history
     that returns the outcome (``"contained"`` or ``"escaped"``) once every row of the
-    last ``hold`` seconds has read it (containment.decided_since), else None."""
+    last ``hold`` seconds has read it (containment.decided_since) and, for ``escaped``,
+    the fragment's speed has settled over that hold (containment.speed_settled: its exit
+    speed is known), else None."""
     if hold is None:
         return None
     if not is_containment(model):
@@ -356,7 +359,12 @@ def decision_watch(model, hold: float | None):
     def watch(history: History) -> str | None:
         h = history.arrays(columns)
         outcome, since = decided_since(h, inner)
-        return outcome if outcome != "undecided" and h["time_s"][-1] - since >= hold else None
+        t_last = h["time_s"][-1]
+        if outcome == "undecided" or t_last - since < hold:
+            return None
+        if outcome == "escaped" and not speed_settled(h, t_last - hold):
+            return None
+        return outcome
 
     return watch
 

@@ -338,6 +338,51 @@ def test_decided_since_is_the_start_of_the_last_outcomes_streak():
     assert decided_since(h, R) == ("contained", t[5])
 
 
+def test_an_escape_stops_the_run_only_once_the_fragments_speed_has_settled():
+    """The stop rule on histories (runs.decision_watch): escaped rows for the whole hold
+    are not enough while the fragment is still losing speed (dragging torn plies, as 2
+    plies on the 7 mm ring did: 117.7 → 111.5 m/s in the 500 µs after it passed); once
+    its speed has stayed within 0.5 % for the hold, the run stops. Contained stops on
+    the hold alone; undecided never stops."""
+    from types import SimpleNamespace
+
+    from wovenimpact.containment import EXIT_SPEED_SETTLED, speed_settled
+    from wovenimpact.io.history import History
+    from wovenimpact.runs import CONTAINMENT_COLUMNS, decision_watch
+
+    model, _ = coarse_two_ply_casing()
+    watch = decision_watch(model, 500e-6)
+    n = 11  # rows 0 … 1 ms, 100 µs apart; escaped (nothing intact outside) from row 1
+    t = np.arange(n) * 100e-6
+
+    def read(speed, radial, outside):
+        h = History(CONTAINMENT_COLUMNS + ("time_s",))
+        for i in range(n):
+            h.append({"time_s": t[i], "fragment_speed_m_per_s": speed[i],
+                      "fragment_radial_velocity_m_per_s": radial[i],
+                      "fragment_cm_radius_m": 0.3, "fragment_max_radius_m": 0.3,
+                      "intact_casing_outside": outside[i], "fragment_beyond_casing": 0,
+                      "outer_layer_bulge_m": 0.0})
+        return watch(h)
+
+    out = [1] + [0] * (n - 1)
+    falling = np.linspace(150.0, 100.0, n)  # 5 m/s every 100 µs
+    assert read(falling, np.full(n, 50.0), out) is None
+    settled = np.r_[np.linspace(150.0, 112.0, 5), np.full(n - 5, 111.5)]
+    assert read(settled, np.full(n, 50.0), out) == "escaped"
+    # within the tolerance counts as settled, just beyond it does not
+    tol = EXIT_SPEED_SETTLED * 111.5
+    wobble = settled.copy()
+    wobble[6] += 0.99 * tol
+    assert read(wobble, np.full(n, 50.0), out) == "escaped"
+    wobble[6] += 0.02 * tol
+    assert read(wobble, np.full(n, 50.0), out) is None
+    assert not speed_settled({"time_s": t, "fragment_speed_m_per_s": falling}, t[-1] + 1.0)
+    # contained (turned back, intact casing outside): stops on the hold, speed or not
+    assert read(falling, np.r_[50.0, np.full(n - 1, -5.0)], [1] * n) == "contained"
+    assert read(falling, np.full(n, 20.0), [1] * n) is None  # still pushing: undecided
+
+
 def test_stop_when_decided_ends_the_run_once_the_outcome_has_held(tmp_path, monkeypatch):
     """run.stop_when_decided: the run ends at the first history row at which the
     outcome has read the same for the hold (not at end_time), writes its checkpoint,

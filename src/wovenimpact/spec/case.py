@@ -319,7 +319,8 @@ class RunSpec(BaseModel):
     # the predicted step count end_time / Δt₁ above which a run is refused (model.sanity)
     max_steps: int = Field(default=DEFAULT_MAX_STEPS, ge=1)
     # a containment run ends once its outcome (contained or escaped) has read the same
-    # for this long (runs.run_case; docs/theory.md §8.3); omitted: it runs to end_time
+    # for this long, an escape also with the fragment's speed settled within 0.5 % over
+    # it (runs.decision_watch; docs/theory.md §8.3); omitted: it runs to end_time
     stop_when_decided: quantity("time", gt=0, example="500 us") | None = None
 
     @model_validator(mode="after")

@@ -13,9 +13,11 @@ Every summary.json carries ``provenance`` (:func:`provenance`):
   have now; anything else runs again, and the reason is said.
 
 :func:`restart_parts` are the same with ``run.end_time``, ``run.threads``, the output
-intervals and ``run.energy_tolerance`` left out (a restart may run a case further or
-shorter, on other threads, with other output intervals or verdict: none changes the
-steps it replays, and the checkpoint counts the rows and frames already written); a
+intervals, ``run.energy_tolerance``, ``run.stop_when_decided`` and
+``run.max_added_mass_fraction`` left out (a restart may run a case further or shorter,
+stop it on another rule or added-mass limit, on other threads, with other output
+intervals or verdict: none changes the steps it replays, and the checkpoint counts the
+rows and frames already written); a
 checkpoint stores them and their digest, and
 ``--restart`` refuses a checkpoint written for another case, material, mesh or code,
 naming which.
@@ -31,8 +33,11 @@ from pathlib import Path
 from wovenimpact.errors import InputError
 
 PACKAGE = Path(__file__).resolve().parent
+# [run] keys a restart may change: none changes the steps it replays (when to stop, on
+# how many threads, what to write, the verdict)
 RESTART_FREE = ("end_time", "threads", "field_interval", "history_interval",
-                "checkpoint_interval", "energy_tolerance")  # [run] keys a restart may change
+                "checkpoint_interval", "energy_tolerance", "stop_when_decided",
+                "max_added_mass_fraction")
 
 
 @functools.lru_cache(maxsize=1)

@@ -127,6 +127,29 @@ def test_restart_ends_bitwise_identical_to_an_uninterrupted_run(tmp_path, kind):
     assert sb["provenance"] == sa["provenance"]
 
 
+def test_a_restart_may_change_the_stop_rules_but_not_what_the_steps_compute(tmp_path):
+    """``run.max_added_mass_fraction`` and ``run.stop_when_decided`` only stop a run: a
+    restart that raises them (a run stopped at its added-mass limit, to be continued)
+    replays the same steps, bit for bit; ``run.mass_scaling_fraction`` changes the steps
+    and a restart with another one is refused."""
+    from wovenimpact.errors import InputError
+    from wovenimpact.provenance import restart_parts
+
+    case = write_case(tmp_path, end="12 us")
+    whole, cut = tmp_path / "whole", tmp_path / "cut"
+    full = run_case(case, whole)
+    run_case(case, cut, max_steps=int(0.8 * full["steps"]))
+    with pytest.raises(InputError, match="before a change of the case"):
+        run_case(case, cut, restart=True, overrides=["run.mass_scaling_fraction=0.3"])
+    run_case(case, cut, restart=True, overrides=["run.max_added_mass_fraction=0.5"])
+    assert (whole / "history.csv").read_text() == (cut / "history.csv").read_text()
+    containment = ROOT / "examples" / "containment" / "hybrid_4.toml"
+    parts = restart_parts(*load_case(containment))
+    assert restart_parts(*load_case(containment, [
+        'run.stop_when_decided="1 ms"', "run.max_added_mass_fraction=0.05"])) == parts
+    assert restart_parts(*load_case(containment, ["run.mass_scaling_fraction=0.2"])) != parts
+
+
 def test_restart_refuses_side_files_that_do_not_match_its_checkpoint(tmp_path):
     """A restart trusts nothing beside its checkpoint: a deleted history.csv, a history
     cut short, a deleted fields.pvd (resuming would overwrite the frames), an end time

@@ -379,9 +379,11 @@ class Model:
             h.update(name.encode())
             h.update(str(a.dtype).encode() + str(a.shape).encode())
             h.update(a.tobytes())
+        # not max_added_mass_fraction: a stop rule, which a restart may change
+        # (provenance.RESTART_FREE); it changes no step the run replays
         h.update(repr((self.ramp_time, self.alpha, self.erode_dt_fraction,
                        self.shell_contact, self.release_time, self.erode_inverted,
-                       self.mass_scaling_fraction, self.max_added_mass_fraction)).encode())
+                       self.mass_scaling_fraction)).encode())
         h.update(np.ascontiguousarray(self.release_elems).tobytes())
         return h.hexdigest()
 

@@ -127,6 +127,26 @@ def test_restart_ends_bitwise_identical_to_an_uninterrupted_run(tmp_path, kind):
     assert sb["provenance"] == sa["provenance"]
 
 
+def test_a_run_logged_to_a_file_prints_progress_lines(tmp_path, monkeypatch):
+    """With stderr not a terminal (a batch job's log) the run prints a plain progress
+    line every LOG_EVERY_S of wall time — simulated time against the end time, step,
+    Δt, steps per second, ETA — where a live bar would print nothing until the end."""
+    import re
+
+    import wovenimpact.cli.run as cli_run
+
+    monkeypatch.setattr(cli_run, "LOG_EVERY_S", 0.0)
+    case = write_case(tmp_path, end="8 us")
+    result = CliRunner().invoke(app, ["run", str(case), "--out", str(tmp_path / "o")])
+    assert result.exit_code == 0, result.output
+    found = re.findall(r"case: t = ([\d.]+) / 8\.00 µs \((\d+)%\), step (\d+), Δt ([\d.e+-]+) s",
+                       result.output)
+    assert found, result.output
+    times = [float(t) for t, *_ in found]
+    assert times == sorted(times) and 0.0 < times[-1] < 8.5  # the last step may pass 8 µs
+    assert all(0 <= int(pct) <= 100 for _, pct, *_ in found)
+
+
 def test_a_restart_may_change_the_stop_rules_but_not_what_the_steps_compute(tmp_path):
     """``run.max_added_mass_fraction`` and ``run.stop_when_decided`` only stop a run: a
     restart that raises them (a run stopped at its added-mass limit, to be continued)

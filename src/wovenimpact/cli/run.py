@@ -11,6 +11,8 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from wovenimpact.cli.app import app, console, emit, err_console, fail
 from wovenimpact.errors import InputError, MaterialPointError, SimulationError
 
+LOG_EVERY_S = 60.0  # wall seconds between progress lines when stderr is not a terminal
+
 
 def _bar(quiet: bool):
     """A rich progress bar: simulated time, steps per second and ETA (wall clock)."""
@@ -50,15 +52,19 @@ def run(
         prepare_output_dir(out)
     except InputError as err:
         fail(str(err))
-    bar = _bar(quiet=as_json)
+    # on a terminal a live bar; in a log (a batch job, nohup) a plain line every
+    # LOG_EVERY_S of wall time, which a bar would not give until the run ends
+    lines = not as_json and not err_console.is_terminal
+    bar = _bar(quiet=as_json or lines)
     task = bar.add_task(case.stem, total=1.0, t_us=0.0, end_us=0.0, rate=0.0, eta="?")
-    start = {"wall": time.perf_counter(), "step": None}
+    start = {"wall": time.perf_counter(), "step": None, "logged": time.perf_counter()}
 
     def report(state, end_time):
+        now = time.perf_counter()
         if start["step"] is None:  # the bar appears once the case has compiled
-            start["step"] = state.step
+            start["step"], start["wall"] = state.step, now
             bar.start()
-        wall = time.perf_counter() - start["wall"]
+        wall = now - start["wall"]
         done = state.step - start["step"]
         rate = done / wall if wall > 0 else 0.0
         frac = min(state.t / end_time, 1.0)
@@ -67,6 +73,12 @@ def run(
         eta = "?" if remaining is None else time.strftime("%H:%M:%S", time.gmtime(remaining))
         bar.update(task, completed=frac, t_us=state.t * 1e6, end_us=end_time * 1e6, rate=rate,
                    eta=eta)
+        if lines and now - start["logged"] >= LOG_EVERY_S:
+            start["logged"] = now
+            err_console.print(
+                f"{time.strftime('%H:%M:%S')} {case.stem}: t = {state.t * 1e6:.2f} / "
+                f"{end_time * 1e6:.2f} µs ({frac:.0%}), step {state.step}, Δt {state.dt:.3e} s, "
+                f"{rate:,.1f} steps/s, ETA {eta}", highlight=False, soft_wrap=True)
 
     try:
         summary = run_case(case, out, restart=restart, threads=threads, progress=report,

@@ -243,6 +243,7 @@ def decided_since(h: dict, inner_radius: float) -> tuple[str, float]:
 
 
 EXIT_SPEED_SETTLED = 0.005  # an escaped fragment's speed over the hold, relative
+EXIT_SPEED_WINDOW = 500e-6  # s: the end of a run over which the summary checks it
 
 
 def speed_settled(h: dict, start: float, tol: float = EXIT_SPEED_SETTLED) -> bool:
@@ -255,6 +256,17 @@ def speed_settled(h: dict, start: float, tol: float = EXIT_SPEED_SETTLED) -> boo
     v = np.asarray(h["fragment_speed_m_per_s"], dtype=float)
     window = v[t >= start]
     return bool(window.size) and float(np.max(np.abs(window - v[-1]))) <= tol * abs(v[-1])
+
+
+def exit_speed_settled(h: dict, outcome: str) -> bool | None:
+    """For an escaped fragment, whether its speed settled over the last
+    :data:`EXIT_SPEED_WINDOW` of the history (:func:`speed_settled`): False means the
+    exit speed was still changing when the run ended (run it longer), and a regression
+    of exit speeds must not use it. None for any other outcome."""
+    if outcome != "escaped":
+        return None
+    t = np.asarray(h["time_s"], dtype=float)
+    return speed_settled(h, float(t[-1]) - EXIT_SPEED_WINDOW)
 
 
 def casing_inner_radius(model) -> float:
@@ -276,6 +288,7 @@ def casing_summary(model, state, h: dict) -> dict:
     bulge = np.asarray(h.get("outer_layer_bulge_m", ()), dtype=float)
     return {
         **outcome,
+        "fragment_exit_speed_settled": exit_speed_settled(h, outcome["outcome"]),
         "fragment_mass_kg": float(model.node_mass[nodes].sum()),
         "fragment_initial_speed_m_per_s": float(h["fragment_speed_m_per_s"][0]),
         # the largest over the history rows and the end state (a bulge that springs back

@@ -79,3 +79,11 @@ def test_plies_regression_of_a_containment_study_uses_the_exit_speed_and_layers(
     (tmp_path / "u.csv").write_text("\n".join(lines).replace(",contained,", ",undecided,") + "\n")
     bad = CliRunner().invoke(app, ["ballistics", "plies", str(tmp_path / "u.csv")])
     assert bad.exit_code == 2 and "mesh.casing.layers = 30" in bad.output
+    # an escape whose speed was still falling at the end has no exit speed to fit
+    settled = [lines[0] + ",fragment_exit_speed_settled"] + [
+        f"{line},{'False' if line.startswith('x10,') else 'True'}" for line in lines[1:]]
+    (tmp_path / "s.csv").write_text("\n".join(settled) + "\n")
+    bad = CliRunner().invoke(app, ["ballistics", "plies", str(tmp_path / "s.csv")])
+    text = " ".join(bad.output.split())
+    assert bad.exit_code == 2 and "mesh.casing.layers = 10 (variant x10)" in text
+    assert "still losing speed" in text

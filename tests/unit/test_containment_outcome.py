@@ -378,6 +378,13 @@ def test_an_escape_stops_the_run_only_once_the_fragments_speed_has_settled():
     wobble[6] += 0.02 * tol
     assert read(wobble, np.full(n, 50.0), out) is None
     assert not speed_settled({"time_s": t, "fragment_speed_m_per_s": falling}, t[-1] + 1.0)
+    # the summary's flag: the last 500 µs of an escape, None for any other outcome
+    from wovenimpact.containment import exit_speed_settled
+
+    assert exit_speed_settled({"time_s": t, "fragment_speed_m_per_s": settled}, "escaped")
+    assert not exit_speed_settled({"time_s": t, "fragment_speed_m_per_s": falling}, "escaped")
+    assert exit_speed_settled({"time_s": t, "fragment_speed_m_per_s": falling},
+                              "contained") is None
     # contained (turned back, intact casing outside): stops on the hold, speed or not
     assert read(falling, np.r_[50.0, np.full(n - 1, -5.0)], [1] * n) == "contained"
     assert read(falling, np.full(n, 20.0), [1] * n) is None  # still pushing: undecided

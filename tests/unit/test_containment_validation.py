@@ -42,6 +42,25 @@ def test_regression_uses_escaped_runs_and_finds_their_zero():
     assert res["mass_per_area"](36) == pytest.approx(2.7 + 0.5 * 36)
 
 
+def test_an_escape_whose_speed_was_still_falling_stays_out_of_the_regression():
+    """A run that escaped but ended with its fragment still losing speed
+    (fragment_exit_speed_settled false, as a bool or as results.csv text) has no known
+    exit speed: the regression is that of the other escaped runs; it still counts as
+    having let the fragment through."""
+    rows = ladder()
+    base = cv.ladder_result(rows)["regression"].coefficients
+    for flag in (False, "False"):
+        extra = {**_row(6, "escaped", 300.0, 5.7), cv.SETTLED: flag}
+        res = cv.ladder_result(rows + [extra])
+        assert res["regression"].coefficients == pytest.approx(base, rel=1e-9)
+        assert cv.unsettled(extra)
+    assert not cv.unsettled({**extra, cv.SETTLED: True})
+    assert not cv.unsettled(_row(6, "escaped", 120.0, 5.7))  # an older row, no column
+    fewer = [r for r in rows if r[cv.KEY] != 30]  # then 16 is the last escape below 36
+    assert cv.ladder_result(fewer + [{**_row(33, "escaped", 9.0, 19.2),
+                                      cv.SETTLED: False}])["most_escaped_below"] == 33
+
+
 def test_section_tables_the_ladders_names_undecided_and_counts_the_inner_shell(tmp_path,
                                                                                monkeypatch):
     ladders = {"containment_hybrid": ladder(), "containment_metal": ladder(0.0, -5.0, 130.0,

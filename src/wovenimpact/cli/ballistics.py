@@ -79,6 +79,7 @@ def plies(
         DECIDED,
         quadratic_ply_regression,
         require_decided,
+        require_settled,
     )
 
     try:
@@ -87,6 +88,8 @@ def plies(
         key = key or ("mesh.casing.layers" if casing else "mesh.plies")
         n = [float(v) for v in _column(rows, key, results)]
         require_decided(rows, key, str(results), CONTAINMENT_DECIDED if casing else DECIDED)
+        if casing:
+            require_settled(rows, key, str(results))
         vr = [float(r[EXIT if casing else RESIDUAL]) for r in rows]
         through = [(a, b) for a, b in zip(n, vr) if b > 0]
         reg = quadratic_ply_regression(*zip(*through)) if len(through) >= 3 else None

@@ -60,6 +60,31 @@ def require_decided(rows: list[dict], key: str, source: str, decided=DECIDED) ->
             "'no contact' run never reached the target.")
 
 
+SETTLED = "fragment_exit_speed_settled"
+
+
+def unsettled(row: dict) -> bool:
+    """An escaped casing run whose fragment was still losing speed at its end
+    (``fragment_exit_speed_settled`` false, as a bool or as results.csv text): its exit
+    speed is not known. A row without the column (an older wovenimpact) is not."""
+    return row.get("outcome") == "escaped" and str(row.get(SETTLED, "")).strip().lower() in (
+        "false", "0")
+
+
+def require_settled(rows: list[dict], key: str, source: str) -> None:
+    """Refuse escaped casing runs whose exit speed was still changing at their end
+    (:func:`unsettled`: the fragment still dragged torn layers), by ``key`` and id."""
+    bad = [r for r in rows if unsettled(r)]
+    if bad:
+        names = "; ".join(f"{key} = {r.get(key, '?')} (variant {r.get('id', '?')})"
+                          for r in bad)
+        raise InputError(
+            f"{source}: {len(bad)} escaped run(s) ended with the fragment still losing "
+            f"speed, so their exit speed is not known and cannot enter the fit — {names}. "
+            "Lengthen run.end_time (or keep run.stop_when_decided, which waits for the "
+            "speed to settle) and run the study again into a new output directory.")
+
+
 @dataclass(frozen=True)
 class PlyRegression:
     """V_r(N) = c2 N² + c1 N + c0 fitted to (plies, residual velocity) points.

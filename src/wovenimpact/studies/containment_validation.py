@@ -20,7 +20,7 @@ regression nor the answer; they are listed with a word. ``wovenimpact validate
 --containment`` writes the section alone to docs/validation_containment.md (the ladders
 take hours: they are not part of the chapter-7 report). ``--set`` changes the ladders'
 case (a coarser mesh); ``--runs`` tabulates runs made elsewhere instead
-(:func:`rows_from_runs`), each with its mesh size and code digest.
+(:func:`rows_from_runs`), each with its element count and code digest.
 """
 
 from __future__ import annotations
@@ -30,6 +30,7 @@ import shutil
 from pathlib import Path
 
 from wovenimpact.errors import InputError
+from wovenimpact.studies.ballistics import SETTLED, unsettled
 
 ROOT = Path(__file__).resolve().parents[3]
 KEY = "mesh.casing.layers"
@@ -68,15 +69,17 @@ def _mm(value) -> float | None:
 
 def ladder_result(rows: list[dict]) -> dict:
     """What a ladder's finished rows say: the regression of the escaped runs' exit speed
-    against N (None with fewer than three distinct N), the fewest layers that contained
+    against N (None with fewer than three distinct N; runs whose exit speed had not
+    settled are left out), the fewest layers that contained
     the fragment in a run (None if none did), the most layers below those that let it
     through, the undecided N, and the mass per unit area
     of a casing of N layers interpolated between the runs (a function of N)."""
     from wovenimpact.studies.ballistics import quadratic_ply_regression
 
     done = [r for r in rows if r.get("status") == "done"]
-    escaped = [(float(r[KEY]), float(r["fragment_exit_speed_m_per_s"])) for r in done
-               if r.get("outcome") == "escaped"]
+    through = [r for r in done if r.get("outcome") == "escaped"]
+    escaped = [(float(r[KEY]), float(r["fragment_exit_speed_m_per_s"])) for r in through
+               if not unsettled(r)]
     contained = sorted(int(float(r[KEY])) for r in done if r.get("outcome") == "contained")
     undecided = sorted(int(float(r[KEY])) for r in done
                        if r.get("outcome") not in ("escaped", "contained"))
@@ -92,7 +95,7 @@ def ladder_result(rows: list[dict]) -> dict:
         (n0, m0), (n1, m1) = per_area[0], per_area[-1]
         return m0 + (m1 - m0) * (n - n0) / (n1 - n0) if n1 != n0 else None
 
-    below = [n for n, _ in escaped if not contained or n < contained[0]]
+    below = [float(r[KEY]) for r in through if not contained or float(r[KEY]) < contained[0]]
     return {"regression": regression, "fewest_contained": contained[0] if contained else None,
             "most_escaped_below": int(max(below)) if below else None,
             "undecided": undecided, "mass_per_area": mass_per_area}
@@ -112,8 +115,9 @@ def ladder_lines(name: str, title: str, unit: str, thesis: dict, note: str, rows
             lines.append(f"| {n} | {r.get('status')}: {r.get('error', '')} | | "
                          f"{_fmt(thesis.get(n), '.1f')} | | | | | | | |")
             continue
+        outcome = f"{r['outcome']} (speed still falling)" if unsettled(r) else r["outcome"]
         lines.append(
-            f"| {n} | {r['outcome']} | {_fmt(r['fragment_exit_speed_m_per_s'], '.1f')} | "
+            f"| {n} | {outcome} | {_fmt(r['fragment_exit_speed_m_per_s'], '.1f')} | "
             f"{_fmt(thesis.get(n), '.1f')} | {_fmt(r['casing_mass_kg'], '.3f')} | "
             f"{_fmt(r['casing_mass_per_area_kg_per_m2'], '.2f')} | "
             f"{_fmt(_mm(r.get('max_bulge_m')), '.1f')} | "
@@ -139,6 +143,10 @@ def ladder_lines(name: str, title: str, unit: str, thesis: dict, note: str, rows
             if below == fewest - 1 else
             f"; {below} let it through and {below + 1}–{fewest - 1} are not decided by a "
             f"run: by runs the answer lies between {below + 1} and {fewest} {unit}."))
+    falling = [int(float(r[KEY])) for r in rows if r.get("status") == "done" and unsettled(r)]
+    if falling:
+        lines.append(f"Escaped with the speed still falling at the end (not in the "
+                     f"regression): {', '.join(map(str, falling))} {unit} — run them longer.")
     if result["undecided"]:
         lines.append(f"Undecided (still pushing intact layers at the end time; not used): "
                      f"{', '.join(map(str, result['undecided']))} {unit} — run them longer.")
@@ -273,6 +281,7 @@ def rows_from_runs(paths) -> dict[str, list[dict]]:
     digest. Returns the rows of each ladder, sorted by N, and the unfinished runs."""
     import json
 
+    from wovenimpact.containment import exit_speed_settled
     from wovenimpact.io.checkpoint import latest_checkpoint
     from wovenimpact.io.history import read_csv
 
@@ -297,6 +306,9 @@ def rows_from_runs(paths) -> dict[str, list[dict]]:
         if ladder is None:
             raise InputError(f"--runs {d}: not a containment run (its summary has no casing)")
         name, n = ladder
+        if SETTLED not in summary and (d / "history.csv").exists():  # an older summary
+            summary[SETTLED] = exit_speed_settled(read_csv(d / "history.csv"),
+                                                  summary.get("outcome", ""))
         out[name].append({**summary, "id": d.name, "status": "done", KEY: n,
                           "source_digest": summary.get("provenance", {}).get("source_digest")})
     for rows in out.values():

@@ -31,6 +31,24 @@ def test_regression_that_never_reaches_zero_says_so():
     assert reg.plies_to_stop is None and reg.root is None
 
 
+@pytest.mark.parametrize("c2", [0.0, 1e-17, -1e-17, 1e-12, 1e-6])
+@pytest.mark.parametrize("slope, start", [(-5.0, 130.0), (-1.3, 40.0), (-17.0, 420.0)])
+def test_a_nearly_straight_ladder_has_the_zero_of_its_line(c2, slope, start):
+    """A fit that is a line to rounding (c2 ~ 1e-17 from exact straight-line data) must
+    put the zero where the line has it: (−c1 − √disc)/2c2 cancels every digit there (it
+    read 24.5 for 130 − 5 N, whose zero is 26)."""
+    from wovenimpact.studies.ballistics import _first_zero
+
+    root = _first_zero(c2, slope, start, start=1.0)
+    line = -start / slope
+    # the exact near root moves by c2 line² / |slope| at most (to first order)
+    assert root == pytest.approx(line, rel=1e-9, abs=2 * abs(c2) * line**2 / abs(slope))
+    n = np.array([2.0, 4.0, 6.0, 8.0, 12.0])
+    reg = quadratic_ply_regression(n, start + slope * n)
+    assert reg.root == pytest.approx(line, rel=1e-9)
+    assert reg.plies_to_stop == int(np.ceil(line - 1e-9))
+
+
 def test_lambert_jonas_recovers_known_parameters():
     a, p, vbl = 0.9, 2.3, 85.0
     vs = np.array([70.0, 80.0, 90.0, 100.0, 110.0, 125.0, 140.0])

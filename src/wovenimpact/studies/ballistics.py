@@ -140,8 +140,11 @@ def _first_zero(c2: float, c1: float, c0: float, start: float) -> float | None:
     disc = c1 * c1 - 4 * c2 * c0
     if disc < 0:
         return None
-    s = math.sqrt(disc)
-    roots = sorted(((-c1 - s) / (2 * c2), (-c1 + s) / (2 * c2)))
+    # the cancellation-free form (q = −½(c1 + sign(c1) √disc); roots q/c2 and c0/q):
+    # (−c1 ± √disc)/2c2 loses every digit of the near root when the fit is nearly
+    # linear (c2 ~ 1e-17 from a straight ladder put the zero of 130 − 5 N at 24.5)
+    q = -0.5 * (c1 + math.copysign(math.sqrt(disc), c1))
+    roots = sorted(r for r in (q / c2, c0 / q if q != 0.0 else q / c2) if math.isfinite(r))
     for r in roots:
         slope = 2 * c2 * r + c1
         if r >= start and slope <= 0:

@@ -255,7 +255,8 @@ def speed_settled(h: dict, start: float, tol: float = EXIT_SPEED_SETTLED) -> boo
     t = np.asarray(h["time_s"], dtype=float)
     v = np.asarray(h["fragment_speed_m_per_s"], dtype=float)
     window = v[t >= start]
-    return bool(window.size) and float(np.max(np.abs(window - v[-1]))) <= tol * abs(v[-1])
+    # a Python bool: summary.json carries it (numpy's bool_ is not JSON)
+    return bool(window.size) and bool(np.max(np.abs(window - v[-1])) <= tol * abs(v[-1]))
 
 
 def exit_speed_settled(h: dict, outcome: str) -> bool | None:

@@ -209,6 +209,14 @@ def run_case(
                     max_steps=max_steps, source=source)
 
 
+def _json_scalar(value):
+    """json.dumps's fallback for summary.json: numpy scalars become Python numbers;
+    anything else is still refused (a summary is numbers, strings, lists and dicts)."""
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"summary value of type {type(value).__name__} is not JSON: {value!r}")
+
+
 def run_spec(
     spec,
     base: str | Path,
@@ -318,7 +326,10 @@ def run_spec(
                         title=spec.case.name)
     if "impactor_velocity_m_per_s" in h:
         impactor_plot(h, out / "plots" / "impactor.png", title=spec.case.name)
-    atomic_write_text(out / "summary.json", json.dumps(summary, indent=2) + "\n")
+    # numpy scalars as Python numbers: a summary key computed with numpy must not end an
+    # hour's run with a TypeError after its last step (it did: numpy's bool_)
+    atomic_write_text(out / "summary.json",
+                      json.dumps(summary, indent=2, default=_json_scalar) + "\n")
     write_run_report(out, spec=spec, model_digest=digest, **(source or {}))  # report.html
     return summary
 

@@ -381,8 +381,12 @@ def test_an_escape_stops_the_run_only_once_the_fragments_speed_has_settled():
     # the summary's flag: the last 500 µs of an escape, None for any other outcome
     from wovenimpact.containment import exit_speed_settled
 
-    assert exit_speed_settled({"time_s": t, "fragment_speed_m_per_s": settled}, "escaped")
-    assert not exit_speed_settled({"time_s": t, "fragment_speed_m_per_s": falling}, "escaped")
+    # Python bools (summary.json carries them: numpy's bool_ ended a run's summary with a
+    # TypeError)
+    assert exit_speed_settled({"time_s": t, "fragment_speed_m_per_s": settled},
+                              "escaped") is True
+    assert exit_speed_settled({"time_s": t, "fragment_speed_m_per_s": falling},
+                              "escaped") is False
     assert exit_speed_settled({"time_s": t, "fragment_speed_m_per_s": falling},
                               "contained") is None
     # contained (turned back, intact casing outside): stops on the hold, speed or not
@@ -436,3 +440,19 @@ def test_stop_when_decided_on_a_case_without_a_fragment_is_refused(tmp_path):
     with pytest.raises(InputError, match="run.stop_when_decided"):
         run_case(case, tmp_path / "out", overrides=['run.stop_when_decided="0.1 ms"'])
     assert not (tmp_path / "out" / "history.csv").exists()
+
+
+def test_summary_json_takes_numpy_scalars_and_refuses_anything_else():
+    """runs._json_scalar, summary.json's fallback: numpy's bool_, float64 and int64 are
+    written as Python values (a numpy bool_ once ended a finished containment run with a
+    TypeError before its summary was written); an object that is no number is still
+    refused, naming its type."""
+    import json
+
+    from wovenimpact.runs import _json_scalar
+
+    text = json.dumps({"a": np.bool_(True), "b": np.float64(1.5), "c": np.int64(3)},
+                      default=_json_scalar)
+    assert json.loads(text) == {"a": True, "b": 1.5, "c": 3}
+    with pytest.raises(TypeError, match="object"):
+        json.dumps({"d": object()}, default=_json_scalar)

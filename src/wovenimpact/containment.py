@@ -106,6 +106,7 @@ def fragment_row(model, state) -> dict:
         "fragment_radial_velocity_m_per_s": float(radial),
         "fragment_cm_radius_m": float(r_cm),
         "fragment_max_radius_m": float(r_nodes.max()),
+        "fragment_min_radius_m": float(r_nodes.min()),
         "intact_casing_outside": int(outside),
         "fragment_beyond_casing": int(not covered),
         "outer_layer_bulge_m": outer_layer_bulge(model, state, anchored),
@@ -113,7 +114,8 @@ def fragment_row(model, state) -> dict:
 
 
 CONTAINMENT_COLUMNS = ("fragment_speed_m_per_s", "fragment_radial_velocity_m_per_s",
-                       "fragment_cm_radius_m", "fragment_max_radius_m", "intact_casing_outside",
+                       "fragment_cm_radius_m", "fragment_max_radius_m", "fragment_min_radius_m",
+                       "intact_casing_outside",
                        "fragment_beyond_casing",
                        "outer_layer_bulge_m")
 
@@ -191,11 +193,20 @@ def energy_per_material(model, state) -> dict[str, float]:
     return out
 
 
-def containment_outcome(h: dict, inner_radius: float) -> dict:
+EXIT_SPEED_SETTLED = 0.005  # an escaped fragment's speed over the hold, relative
+EXIT_SPEED_WINDOW = 500e-6  # s: the end of a run over which the summary checks it
+
+
+def containment_outcome(h: dict, inner_radius: float, outer_radius: float = math.inf) -> dict:
     """Outcome of a containment run from its history (geometry first):
 
     - ``escaped``: no intact casing material outside the fragment along its path at the
-      end (it has passed the outermost intact layer) and it still moves outwards;
+      end (it has passed the outermost intact layer) and it still moves outwards; or it
+      is *clear of the casing* — its innermost node beyond ``outer_radius``, the casing's
+      outermost reference radius — moving outwards, and its speed has stayed within
+      :data:`EXIT_SPEED_SETTLED` of its last value over the last
+      :data:`EXIT_SPEED_WINDOW` (strips of a metal casing peeled out beside it, still
+      joined to the casing, do not hold a fragment that nothing slows; theory §8.5);
     - ``contained``: it reached the casing (its outermost node came within 1 % of the
       inner radius) and at the end moves inwards or along the casing (radial velocity
       ≤ 1 % of its initial speed) with intact material outside it;
@@ -207,14 +218,16 @@ def containment_outcome(h: dict, inner_radius: float) -> dict:
     Returns the outcome, ``contained`` (bool) and the exit speed (its speed at the end
     if escaped, else 0)."""
     speed = np.asarray(h["fragment_speed_m_per_s"], dtype=float)
-    outcome = str(row_outcomes(h, inner_radius)[-1])
+    outcome = str(row_outcomes(h, inner_radius, outer_radius)[-1])
     return {"outcome": outcome, "contained": outcome == "contained",
             "fragment_exit_speed_m_per_s": 0.0 if outcome == "contained" else float(speed[-1])}
 
 
-def row_outcomes(h: dict, inner_radius: float) -> np.ndarray:
+def row_outcomes(h: dict, inner_radius: float, outer_radius: float = math.inf) -> np.ndarray:
     """:func:`containment_outcome` of the history up to each row: what the run would
-    have read had it ended there (``arrived`` counts the rows up to that one)."""
+    have read had it ended there (``arrived`` counts the rows up to that one). A history
+    without ``fragment_min_radius_m`` or ``time_s`` (an older run) never reads clear of
+    the casing."""
     speed = np.asarray(h["fragment_speed_m_per_s"], dtype=float)
     radial = np.asarray(h["fragment_radial_velocity_m_per_s"], dtype=float)
     reach = np.asarray(h["fragment_max_radius_m"], dtype=float)
@@ -226,24 +239,42 @@ def row_outcomes(h: dict, inner_radius: float) -> np.ndarray:
     out = np.full(speed.shape, "undecided", dtype=object)
     out[arrived & outside & (radial <= 0.01 * v0)] = "contained"
     out[~outside & (radial > 0.0)] = "escaped"
+    out[clear_and_unslowed(h, outer_radius, outside & (radial > 0.0))] = "escaped"
     # past a sector's cut edge or the casing's end: the model cannot tell
     out[beyond] = "undecided"
     return out
 
 
-def decided_since(h: dict, inner_radius: float) -> tuple[str, float]:
+def clear_and_unslowed(h: dict, outer_radius: float, rows: np.ndarray) -> np.ndarray:
+    """Of the history rows flagged in ``rows``, those at which the fragment is clear of
+    the casing (innermost node beyond ``outer_radius``) and its speed has stayed within
+    :data:`EXIT_SPEED_SETTLED` of that row's over the :data:`EXIT_SPEED_WINDOW` before
+    it (the history must span the window): nothing holds it any more. Geometry first —
+    a fragment still inside the casing's envelope never qualifies, however steady."""
+    out = np.zeros(rows.shape, dtype=bool)
+    if "fragment_min_radius_m" not in h or "time_s" not in h or not math.isfinite(outer_radius):
+        return out
+    t = np.asarray(h["time_s"], dtype=float)
+    v = np.asarray(h["fragment_speed_m_per_s"], dtype=float)
+    inner_node = np.asarray(h["fragment_min_radius_m"], dtype=float)
+    for i in np.flatnonzero(rows & (inner_node > outer_radius)):
+        if t[i] - t[0] < EXIT_SPEED_WINDOW:
+            continue
+        start = int(np.searchsorted(t, t[i] - EXIT_SPEED_WINDOW))
+        out[i] = float(np.max(np.abs(v[start:i + 1] - v[i]))) <= EXIT_SPEED_SETTLED * abs(v[i])
+    return out
+
+
+def decided_since(h: dict, inner_radius: float,
+                  outer_radius: float = math.inf) -> tuple[str, float]:
     """The outcome the history reads at its last row and the time from which every row
     has read it (``run.stop_when_decided`` stops a run once that lasts long enough)."""
-    rows = row_outcomes(h, inner_radius)
+    rows = row_outcomes(h, inner_radius, outer_radius)
     t = np.asarray(h["time_s"], dtype=float)
     if rows.size == 0:
         return "undecided", float("nan")
     changed = np.flatnonzero(rows != rows[-1])
     return str(rows[-1]), float(t[changed[-1] + 1] if changed.size else t[0])
-
-
-EXIT_SPEED_SETTLED = 0.005  # an escaped fragment's speed over the hold, relative
-EXIT_SPEED_WINDOW = 500e-6  # s: the end of a run over which the summary checks it
 
 
 def speed_settled(h: dict, start: float, tol: float = EXIT_SPEED_SETTLED) -> bool:
@@ -276,11 +307,18 @@ def casing_inner_radius(model) -> float:
                for s in layer_sets(model))
 
 
+def casing_outer_radius(model) -> float:
+    """The largest radius of any casing node in the reference configuration (m): a
+    fragment whose every node lies beyond it is clear of the casing."""
+    return max(float(np.max(np.hypot(*model.x0[model.node_sets[s], :2].T)))
+               for s in layer_sets(model))
+
+
 def casing_summary(model, state, h: dict) -> dict:
     """summary.json keys of a containment run (whole model; symmetry is not used)."""
     nodes = model.node_sets[FRAGMENT]
     layers = layer_sets(model)
-    outcome = containment_outcome(h, casing_inner_radius(model))
+    outcome = containment_outcome(h, casing_inner_radius(model), casing_outer_radius(model))
     casing_elems = np.flatnonzero(np.isin(model.quads, np.concatenate(
         [model.node_sets[s] for s in layers])).all(axis=1))
     mass = float(np.sum(model.sections[model.elem_section[casing_elems], SL.C_AREAL_MASS]

@@ -60,6 +60,7 @@ from wovenimpact.quantities import (
 from wovenimpact.containment import (
     CONTAINMENT_COLUMNS,
     casing_inner_radius,
+    casing_outer_radius,
     casing_summary,
     decided_since,
     fragment_row,
@@ -364,12 +365,12 @@ def decision_watch(model, hold: float | None):
         raise InputError(f"run.stop_when_decided = {hold!r} s: only a containment case "
                          "(a blade fragment and casing layers) has an outcome to decide; "
                          "remove it")
-    inner = casing_inner_radius(model)
+    inner, outer = casing_inner_radius(model), casing_outer_radius(model)
     columns = CONTAINMENT_COLUMNS + ("time_s",)
 
     def watch(history: History) -> str | None:
         h = history.arrays(columns)
-        outcome, since = decided_since(h, inner)
+        outcome, since = decided_since(h, inner, outer)
         t_last = h["time_s"][-1]
         if outcome == "undecided" or t_last - since < hold:
             return None

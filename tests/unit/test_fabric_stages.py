@@ -141,3 +141,36 @@ def test_the_shear_energy_is_the_integral_of_the_shear_stress(rows, gamma):
     assert de == pytest.approx(thick * tau, rel=1e-6)
     assert shear(-gamma)[0] == pytest.approx(-tau, rel=1e-15)
     assert g_tan > 0.0
+
+
+@pytest.mark.parametrize("crossover", ["exact", "table"])
+def test_the_stable_step_stiffness_of_a_family_is_per_reference_width_and_zero_when_slack(
+        rows, crossover):
+    """yarn_resultant's k_w, k_f (theory §1.8): at rest they are the bound's own family
+    terms; the warp's stays within 1 % when the element is crushed across it (λ_f = 0.5:
+    the bound per current width doubles, the yarns per reference width do not change);
+    a family shorter than (1 − SLACK_MARGIN) of its rest truss has none, one within the
+    margin keeps its taut term."""
+    from wovenimpact.kernels.fabric import SLACK_MARGIN
+
+    params, exact, table = rows
+    p = exact if crossover == "exact" else table
+    s = initial_state(params)
+
+    def terms(lam_w, lam_f):
+        ex = crossover_equilibrium(p, U0, s, U0, lam_w, lam_f)
+        assert ex[0]
+        out = yarn_resultant(p, U0, ex[13], lam_w, lam_f, 1.0, *ex[4:8], *ex[10:12],
+                             *ex[15:17])
+        return out, np.array(ex[10:12]) / p[0, L.P_LT0]
+
+    (_, _, stiff, k_w, k_f), _ = terms(1.0, 1.0)
+    assert k_w == pytest.approx(stiff, rel=1e-12) and k_f == pytest.approx(stiff, rel=1e-12)
+    (_, _, stiff_t, k_taut, _), _ = terms(1.045, 1.0)
+    (_, _, stiff_c, k_crushed, k_slack), (l_w, l_f) = terms(1.045, 0.5)
+    assert stiff_c > 1.9 * stiff_t  # the bound per current width doubles
+    assert k_crushed == pytest.approx(k_taut, rel=0.01)
+    assert l_f < 1.0 - SLACK_MARGIN and k_slack == 0.0
+    # the fill just inside the margin still counts at its taut term
+    (_, _, _, _, k_near), (_, l_near) = terms(1.0, 0.95)
+    assert 1.0 - SLACK_MARGIN <= l_near < 1.0 and k_near > 0.5 * stiff

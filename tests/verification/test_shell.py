@@ -224,6 +224,67 @@ def test_stable_step_follows_the_formula():
     assert st.dt == pytest.approx(expected, rel=1e-12)
 
 
+def fabric_element_frequency(model, nodes, sx, sy, shear, h=1e-10):
+    """ω_max of a single crossover element whose corners are moved to x = (sx X + shear Y,
+    sy Y) from its reference square, and the stable step it reports there: the tangent
+    K (24 dofs, translations and rotations) by central differences of the element
+    forces, ω² the largest eigenvalue of M⁻¹K with the lumped masses and inertias."""
+    xs = nodes.copy()
+    xs[:, 0] = sx * nodes[:, 0] + shear * nodes[:, 1]
+    xs[:, 1] *= sy
+
+    def forces(v, w, dt):
+        st = initial_state(model)
+        st.v, st.omega, st.dt = v, w, dt
+        st.x = xs + dt * v
+        ws = Workspace.for_model(model, st)
+        element_forces(model, st, ws)
+        return ws.f_int[:, :6].ravel().copy(), ws.elem[0, SL.E_DT]
+
+    k = np.zeros((24, 24))
+    for j in range(24):
+        u = np.zeros((2, 4, 3))
+        u[j % 6 // 3, j // 6, j % 3] = 1.0
+        k[:, j] = (forces(u[0], u[1], h)[0] - forces(-u[0], -u[1], h)[0]) / (2.0 * h)
+    mass = np.concatenate([[m] * 3 + [i] * 3 for m, i in zip(model.node_mass,
+                                                              model.node_inertia)])
+    omega = math.sqrt(float(np.max(np.linalg.eigvals(k / mass[:, None]).real)))
+    return omega, forces(np.zeros((4, 3)), np.zeros((4, 3)), 0.0)[1]
+
+
+def test_a_crushed_fabric_elements_stable_step_follows_its_taut_yarns_not_its_width():
+    """``run.stable_step = "yarn"``: the stable step of a crossover element against its
+    own largest eigenfrequency (theory §4, "Stable step"). Stable: α ω_max Δt_e ≤ 2
+    (α = 0.9) in every state — at rest, with the warp taut, crushed across the taut
+    warp to 0.5 and 0.2, crushed both ways (both families slack, sheared or not),
+    sheared. Not collapsed: the membrane is total-
+    Lagrangian, so the taut warp's wave crosses the element's reference length
+    whatever its width — crushed to half across it, the element keeps the step it had
+    uncrushed (within 1 %; the step was 2.8× smaller when it paired the narrow width
+    with the stiffness per current width), and an element crushed with both families
+    slack keeps at least its undeformed step."""
+    from tests.conftest import reference_fabric
+    fab = reference_fabric()
+    side = 8.0 * fab.warp.half_length
+    nodes = np.array([[0, 0, 0], [side, 0, 0], [side, side, 0], [0, side, 0]], dtype=float)
+    sec = Section(fab, bending_modulus=1e9, transverse_shear_modulus=3.28e9)
+    model = build_model(nodes, [[0, 1, 2, 3]], {"fabric": sec}, [0], stable_step="yarn")
+    states = {"rest": (1.0, 1.0, 0.0), "warp taut": (1.045, 1.0, 0.0),
+              "crushed 0.5": (1.045, 0.5, 0.0), "crushed 0.2": (1.045, 0.2, 0.0),
+              "both slack": (0.5, 0.5, 0.0), "both slack, sheared": (0.5, 0.5, 0.1),
+              "slack, sheared": (0.8, 0.8, 0.2), "sheared": (1.0, 1.0, 0.3),
+              "taut, crushed, sheared": (1.045, 0.3, 0.2)}
+    res = {name: fabric_element_frequency(model, nodes, *f) for name, f in states.items()}
+    for name, (omega, dt_e) in res.items():
+        print(f"\n{name:24s} Δt_e = {dt_e:.3e} s, α ω_max Δt_e = {0.9 * omega * dt_e:.3f}",
+              end="")
+        assert 0.9 * omega * dt_e <= 2.0, name
+    assert res["crushed 0.5"][1] == pytest.approx(res["warp taut"][1], rel=0.01)
+    assert res["both slack"][1] >= res["rest"][1]
+    # and the bound is not loose where the taut warp governs
+    assert 0.9 * res["warp taut"][0] * res["warp taut"][1] > 1.5
+
+
 def test_fabric_strip_pulled_along_the_warp_reproduces_the_single_element_curve():
     """Four crossover elements in a row, pulled slowly along the warp with the fill
     edges free: the warp tension against the displacement per element follows the

@@ -35,6 +35,7 @@ class ShellMesh(NamedTuple):
     gauss_grad: np.ndarray  # (n_elems, 4, 2, 4) the same at the 2×2 Gauss points
     gauss_weight: np.ndarray  # (n_elems, 4) their weights (det J)
     point_width: int  # values per material point state block
+    step_mode: int  # shell_layout STEP_*: the fabric elements' stable step
 
 
 class Motion(NamedTuple):

@@ -88,6 +88,10 @@ REL_TOL = 1e-12  # equilibrium |F_w − F_f| ≤ REL_TOL (F_w + F_f)
 EPS = 2.220446049250313e-16  # machine epsilon of float64
 FINAL_STEP_TOL = 1e-8  # |g| below which one last Newton step is taken unchecked
 SWAP_RATIO = 0.25  # re-solve with the roles swapped if u_b < SWAP_RATIO u_a
+# a yarn family whose truss is shorter than (1 − SLACK_MARGIN) L0 is slack by more than
+# its strain can change in a few steps: its tangent is zero, and it does not count in
+# the stable step (theory §1.8, "Slack families")
+SLACK_MARGIN = 0.1
 
 
 # --- constitutive pieces -------------------------------------------------------
@@ -629,7 +633,14 @@ def yarn_resultant(p, m, use_table, lam_w, lam_f, sin_t, d_w, d_f, t_w, t_f, l_w
 
     Virial N = Σ 2 T_i ℓ_i cosψ_i e_i⊗e_i / A_cell (default); from the table's
     gradient, c_i = λ_i ∂W/∂λ_i / J; or the thesis's σ = ½ Σ T_i/A_i e_i⊗e_i (eq. 6.30).
-    Returns (c_w, c_f, stiffness).
+
+    The stiffness bound is max_i s_i with s_i the family's term (per current length);
+    for the stable step each family's term also comes per *reference* width and length,
+    k_i = s_i λ_j sin θ / λ_i — the membrane is total-Lagrangian, so a family's wave
+    crosses the element's reference length along it at √(k_i/μ) however the element is
+    crushed across it — and counts only while the family is taut or within
+    SLACK_MARGIN of taut (a slack yarn has no tangent; theory §1.8).
+    Returns (c_w, c_f, stiffness, k_w, k_f).
     """
     thick = p[m, P_THICK]
     ell0_w, ell0_f, _, _, lt0_w, lt0_f, ea_w, ea_f, _, _ = yarn_constants(p, m)
@@ -638,28 +649,36 @@ def yarn_resultant(p, m, use_table, lam_w, lam_f, sin_t, d_w, d_f, t_w, t_f, l_w
     if p[m, P_HOMOG] == HOMOG_THESIS:  # eq. (6.30), (6.38): σ = ½ Σ T_i/A_i e_i⊗e_i, × t
         c_w = 0.5 * thick * t_w / p[m, P_AREA]
         c_f = 0.5 * thick * t_f / p[m, P_AREA + 1]
-        stiff = 0.5 * thick * max(
-            ((1.0 - d_w) * ea_w * ell_w / lt0_w + t_w) / p[m, P_AREA],
-            ((1.0 - d_f) * ea_f * ell_f / lt0_f + t_f) / p[m, P_AREA + 1],
-        )
+        yarn_w = (1.0 - d_w) * ea_w * ell_w / lt0_w
+        yarn_f = (1.0 - d_f) * ea_f * ell_f / lt0_f
+        den_w = p[m, P_AREA]
+        den_f = p[m, P_AREA + 1]
+        scale = 0.5 * thick
     elif use_table:  # virial from the table: c_i = λ_i ∂W/∂λ_i / J, J = λ_w λ_f sinθ
         c_w = gw_cross / (lam_f * sin_t)
         c_f = gf_cross / (lam_w * sin_t)
-        stiff = max(
-            (ea_w * ell_w / lt0_w + t_w) / (2.0 * ell_f * sin_t),
-            (ea_f * ell_f / lt0_f + t_f) / (2.0 * ell_w * sin_t),
-        )
+        yarn_w = ea_w * ell_w / lt0_w
+        yarn_f = ea_f * ell_f / lt0_f
+        den_w = 2.0 * ell_f * sin_t
+        den_f = 2.0 * ell_w * sin_t
+        scale = 1.0
     else:  # virial: N = Σ 2 T_i ℓ_i cosψ_i e_i⊗e_i / A_cell
         a_cell = 4.0 * ell_w * ell_f * sin_t
         c_w = 2.0 * t_w * ell_w * (ell_w / l_w) / a_cell
         c_f = 2.0 * t_f * ell_f * (ell_f / l_f) / a_cell
         # ℓ_i ∂N_ii/∂ℓ_i ≤ [E A ℓ_i / L0 + T_i] / (2 ℓ_j sin θ): yarn stretch plus
         # the turning of the truss towards the plane
-        stiff = max(
-            ((1.0 - d_w) * ea_w * ell_w / lt0_w + t_w) / (2.0 * ell_f * sin_t),
-            ((1.0 - d_f) * ea_f * ell_f / lt0_f + t_f) / (2.0 * ell_w * sin_t),
-        )
-    return c_w, c_f, stiff
+        yarn_w = (1.0 - d_w) * ea_w * ell_w / lt0_w
+        yarn_f = (1.0 - d_f) * ea_f * ell_f / lt0_f
+        den_w = 2.0 * ell_f * sin_t
+        den_f = 2.0 * ell_w * sin_t
+        scale = 1.0
+    stiff = scale * max((yarn_w + t_w) / den_w, (yarn_f + t_f) / den_f)
+    taut_w = 1.0 if l_w >= (1.0 - SLACK_MARGIN) * lt0_w else 0.0
+    taut_f = 1.0 if l_f >= (1.0 - SLACK_MARGIN) * lt0_f else 0.0
+    k_w = scale * (taut_w * yarn_w + t_w) / den_w * (lam_f * sin_t / lam_w)
+    k_f = scale * (taut_f * yarn_f + t_f) / den_f * (lam_w * sin_t / lam_f)
+    return c_w, c_f, stiff, k_w, k_f
 
 
 @inline_kernel
@@ -719,9 +738,12 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
             negative-index check at every access.
 
     Returns:
-        (status, stiffness, N_xx, N_yy, N_xy): a STATUS_* code, an upper bound of the
-        membrane tangent stiffness dN/dε (N/m) for the stable time step (theory
-        §1.8), and the membrane resultant in N/m (0 unless the status is OK).
+        (status, stiffness, N_xx, N_yy, N_xy, k_shear, k_w, k_f): a STATUS_* code, an
+        upper bound of the membrane tangent stiffness dN/dε (N/m; the hourglass
+        stiffness of a reduced membrane scales with it), the membrane resultant in N/m
+        (0 unless the status is OK), and the stable step's stiffnesses (theory §1.8):
+        the trellis shear's t dτ/dγ, and each yarn family's per reference width and
+        length, zero while it is slack (:func:`yarn_resultant`).
     """
     for j in range(N_STATE):
         s_out[i, j] = s_in[i, j]
@@ -731,13 +753,13 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
     # thesis's incremental stretches (eq. 6.13–6.16)
     ok, lam_w, lam_f, ewx, ewy, efx, efy, cos_t, sin_t, gamma = yarn_frame(f11, f12, f21, f22)
     if not ok:
-        return STATUS_BAD_KINEMATICS, 0.0, 0.0, 0.0, 0.0
+        return STATUS_BAD_KINEMATICS, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     if p[m, P_FRAME] == FRAME_GREEN_NAGHDI:
         ok, lam_w, lam_f, gamma = green_naghdi_stretches(
             fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in[i, S_LAMBDA],
             s_in[i, S_LAMBDA + 1], s_in[i, S_GAMMA])
         if not ok:
-            return STATUS_BAD_KINEMATICS, 0.0, 0.0, 0.0, 0.0
+            return STATUS_BAD_KINEMATICS, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     dgamma = gamma - s_in[i, S_GAMMA]
     s_out[i, S_LAMBDA] = lam_w
     s_out[i, S_LAMBDA + 1] = lam_f
@@ -745,14 +767,14 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
 
     if s_in[i, S_ALIVE] == 0.0:
         clear_eroded_point(s_out, i)
-        return STATUS_OK, 0.0, 0.0, 0.0, 0.0
+        return STATUS_OK, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
 
     # 2–3. crossover solve, failure check, and one re-solve if a yarn failed
     (ok, iters, h_w, h_f, d_w, d_f, t_w, t_f, ext_w, ext_f, l_w, l_f, f_c, use_table,
      w_cross, gw_cross, gf_cross) = crossover_equilibrium(p, m, s_in, i, lam_w, lam_f)
     s_out[i, S_ITER] = iters
     if not ok:
-        return STATUS_NOT_CONVERGED, 0.0, 0.0, 0.0, 0.0
+        return STATUS_NOT_CONVERGED, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
     s_out[i, S_H] = h_w
     s_out[i, S_H + 1] = h_f
     s_out[i, S_DAMAGE] = d_w
@@ -767,12 +789,12 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
         s_out[i, S_DAMAGE + 1] = 1.0
     if d_w >= 1.0 and d_f >= 1.0:
         clear_eroded_point(s_out, i)
-        return STATUS_OK, 0.0, 0.0, 0.0, 0.0
+        return STATUS_OK, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
 
     # 4a. yarn membrane resultant (theory §1.5), with the extensions L − L0 and
     # lengths L of the final heights from the solve above
-    c_w, c_f, stiff = yarn_resultant(p, m, use_table, lam_w, lam_f, sin_t, d_w, d_f, t_w, t_f,
-                                     l_w, l_f, gw_cross, gf_cross)
+    c_w, c_f, stiff, k_w, k_f = yarn_resultant(p, m, use_table, lam_w, lam_f, sin_t, d_w, d_f,
+                                               t_w, t_f, l_w, l_f, gw_cross, gf_cross)
     n_xx = c_w * ewx * ewx + c_f * efx * efx
     n_yy = c_w * ewy * ewy + c_f * efy * efy
     n_xy = c_w * ewx * ewy + c_f * efx * efy
@@ -786,12 +808,17 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
     n_xx += cs * (2.0 * ewx * efx - cos_t * (ewx * ewx + efx * efx))
     n_yy += cs * (2.0 * ewy * efy - cos_t * (ewy * ewy + efy * efy))
     n_xy += cs * (ewx * efy + ewy * efx - cos_t * (ewx * ewy + efx * efy))
+    # the stable step's isotropic part (theory §1.8): the shear tangent and the shear
+    # resultant's own (geometric) stiffness |N_s| = t|τ|/(J sinθ), counted twice — a
+    # shear strain takes both in-plane gradients, Σ_I |∇N_I|² = 2/L² on a square where a
+    # yarn family's takes one, and the step pairs it with the element's L_e
+    k_shear = 2.0 * (thick * g_tan + abs(cs))
     stiff += thick * g_tan
 
     # 5. stored energy per unit reference area
     s_out[i, S_ENERGY] = stored_energy(p, m, use_table, w_cross, e_shear, d_w, d_f, ext_w,
                                        ext_f, h_w, h_f, f_c)
-    return STATUS_OK, stiff, n_xx, n_yy, n_xy
+    return STATUS_OK, stiff, n_xx, n_yy, n_xy, k_shear, k_w, k_f
 
 
 @kernel
@@ -816,7 +843,7 @@ def fabric_update_point(p, f_old, f_new, s_in, s_out, n_out):
     p_table = p.reshape((1, p.shape[0]))
     row_in = s_in.reshape((1, s_in.shape[0]))
     row_out = s_out.reshape((1, s_out.shape[0]))
-    status, stiff, n_xx, n_yy, n_xy = fabric_point(
+    status, stiff, n_xx, n_yy, n_xy, _, _, _ = fabric_point(
         p_table, 0, f_old[0, 0], f_old[0, 1], f_old[1, 0], f_old[1, 1],
         f_new[0, 0], f_new[0, 1], f_new[1, 0], f_new[1, 1], row_in, row_out, 0,
     )
@@ -842,7 +869,7 @@ def fabric_update_for_points(p, f_old, f_new, state_in, state_out, n_out, stiff_
     """
     p_table = p.reshape((1, p.shape[0]))  # a view: the row may carry a 1.6 MB table
     for i in prange(f_new.shape[0]):
-        status, stiff, n_xx, n_yy, n_xy = fabric_point(
+        status, stiff, n_xx, n_yy, n_xy, _, _, _ = fabric_point(
             p_table, 0, f_old[i, 0, 0], f_old[i, 0, 1], f_old[i, 1, 0], f_old[i, 1, 1],
             f_new[i, 0, 0], f_new[i, 0, 1], f_new[i, 1, 0], f_new[i, 1, 1],
             state_in, state_out, np.uint64(i),

@@ -83,6 +83,7 @@ from wovenimpact.kernels.shell_layout import (
     MAT_J2,
     MEMBRANE_FULL,
     N_ELEM_STATE,
+    STEP_YARN,
 )
 
 
@@ -240,31 +241,36 @@ def point_response(kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, 
     same columns); elastic points have none.
 
     Returns:
-        (status, alive, C_m, W, N_xx, N_yy, N_xy): 0 if the point updated; False once
-        the point has eroded; its membrane tangent bound (N/m); stored energy per
-        reference area (J/m²); the resultant N (force per current length of the whole
-        section).
+        (status, alive, C_m, W, N_xx, N_yy, N_xy, C_s, k_w, k_f): 0 if the point
+        updated; False once the point has eroded; its membrane tangent bound (N/m);
+        stored energy per reference area (J/m²); the resultant N (force per current
+        length of the whole section); the stable step's stiffnesses (theory §4,
+        "Stable step"): C_s the isotropic part (C_m itself, or a fabric's trellis shear
+        alone) and k_w, k_f a fabric's yarn families per reference width and length
+        (zero for other materials).
     """
     if kind == MAT_FABRIC:
-        st, c, a, b, c12 = fabric_point(
+        st, c, a, b, c12, c_s, k_w, k_f = fabric_point(
             mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, rows_in, rows_out, row
         )
         if st != 0:
-            return st, False, 0.0, 0.0, 0.0, 0.0, 0.0
-        return 0, rows_out[row, FL.S_ALIVE] != 0.0, c, rows_out[row, FL.S_ENERGY], a, b, c12
+            return st, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        return (0, rows_out[row, FL.S_ALIVE] != 0.0, c, rows_out[row, FL.S_ENERGY], a, b, c12,
+                c_s, k_w, k_f)
     if kind == MAT_J2:
         st, c, a, b, c12 = j2_point(
             mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, dt, thick, rows_in,
             rows_out, row,
         )
         if st != 0:
-            return st, False, 0.0, 0.0, 0.0, 0.0, 0.0
-        return 0, rows_out[row, FL.S_ALIVE] != 0.0, c, rows_out[row, FL.S_ENERGY], a, b, c12
+            return st, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+        return (0, rows_out[row, FL.S_ALIVE] != 0.0, c, rows_out[row, FL.S_ENERGY], a, b, c12,
+                c, 0.0, 0.0)
     energy, c, a, b, c12 = elastic_membrane(
         g11, g12, g21, g22, mat_params[m, ELASTIC_MODULUS], mat_params[m, ELASTIC_POISSON],
         thick
     )
-    return 0, True, c, energy, a, b, c12
+    return 0, True, c, energy, a, b, c12, c, 0.0, 0.0
 
 
 @inline_kernel
@@ -281,14 +287,16 @@ def section_response(
     material). Point k's state is row ``row0 + k`` of the material rows.
 
     Returns:
-        (status, n_alive, C_m, W, N_xx, N_yy, N_xy, M_xx, M_yy, M_xy): status 0 if
-        every point updated (else the first failure's code); the points not eroded;
-        the largest membrane tangent; stored energy per reference area Σ w_k W_k.
+        (status, n_alive, C_m, W, N_xx, N_yy, N_xy, M_xx, M_yy, M_xy, C_s, k_w, k_f):
+        status 0 if every point updated (else the first failure's code); the points not
+        eroded; the largest membrane tangent; stored energy per reference area
+        Σ w_k W_k; the largest of each stable-step stiffness (:func:`point_response`).
     """
     n_xx = n_yy = n_xy = 0.0
     mxx = myy = mxy = 0.0
     w_sum = 0.0
     c_max = 0.0
+    cs_max = kw_max = kf_max = 0.0
     alive = 0
     h = thick / (n_pts - 1) if n_pts > 1 else 0.0
     for k in range(n_pts):
@@ -301,14 +309,14 @@ def section_response(
                 3.0 * (n_pts - 1))
         g11, g12, g21, g22 = through_thickness_f(z, k_x, k_y, k_xy2, f11, f12, f21, f22)
         if g11 * g22 - g12 * g21 <= 0.0:
-            return EL_INVERTED, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+            return EL_INVERTED, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
         o11, o12, o21, o22 = through_thickness_f(z, ko_x, ko_y, ko_xy2, fo11, fo12, fo21, fo22)
-        st, live, c, energy, a, b, c12 = point_response(
+        st, live, c, energy, a, b, c12, c_s, k_w, k_f = point_response(
             kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, dt, thick,
             rows_in, rows_out, row0 + np.uint64(k),
         )
         if st != 0:
-            return EL_MATERIAL, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+            return EL_MATERIAL, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
         if live:
             alive += 1
         n_xx += w * a
@@ -319,7 +327,10 @@ def section_response(
         mxy += w * z * c12
         w_sum += w * energy
         c_max = max(c_max, c)
-    return 0, alive, c_max, w_sum, n_xx, n_yy, n_xy, mxx, myy, mxy
+        cs_max = max(cs_max, c_s)
+        kw_max = max(kw_max, k_w)
+        kf_max = max(kf_max, k_f)
+    return 0, alive, c_max, w_sum, n_xx, n_yy, n_xy, mxx, myy, mxy, cs_max, kw_max, kf_max
 
 
 @inline_kernel
@@ -359,13 +370,15 @@ def full_membrane(
     yarn damage is shared by the element's points (:func:`sync_yarn_damage`).
 
     Returns:
-        (status, eroded, C_m, U, N̄_xx, N̄_yy, N̄_xy, M̄_xx, M̄_yy, M̄_xy, (f̂x_I), (f̂y_I)):
-        eroded once a point's whole section has eroded; C_m the largest tangent; U the
-        stored energy (J); N̄, M̄ the area averages; the in-plane corner forces.
+        (status, eroded, C_m, U, N̄_xx, N̄_yy, N̄_xy, M̄_xx, M̄_yy, M̄_xy, (f̂x_I), (f̂y_I),
+        C_s, k_w, k_f): eroded once a point's whole section has eroded; C_m the largest
+        tangent; U the stored energy (J); N̄, M̄ the area averages; the in-plane corner
+        forces; the largest of each stable-step stiffness (:func:`point_response`).
     """
     fx = (0.0, 0.0, 0.0, 0.0)
     fy = (0.0, 0.0, 0.0, 0.0)
     u = c_max = 0.0
+    cs_max = kw_max = kf_max = 0.0
     n_xx = n_yy = n_xy = m_xx = m_yy = m_xy = 0.0
     eroded = False
     for g in range(4):
@@ -380,16 +393,16 @@ def full_membrane(
         det = f11 * f22 - f12 * f21
         if not (det > 0.0):
             st = EL_NAN if not math.isfinite(det) else EL_INVERTED
-            return st, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, fx, fy
+            return st, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, fx, fy, 0.0, 0.0, 0.0
         col = E_FG + 4 * g
-        st, n_alive, c, w, a, b, c12, ma, mb, mc = section_response(
+        st, n_alive, c, w, a, b, c12, ma, mb, mc, c_s, k_w, k_f = section_response(
             n_pts, thick, kind, mat_params, m,
             el_in[e, col], el_in[e, col + 1], el_in[e, col + 2], el_in[e, col + 3],
             f11, f12, f21, f22, ko_x, ko_y, ko_xy2, k_x, k_y, k_xy2, dt,
             rows_in, rows_out, row0 + np.uint64(g * n_pts),
         )
         if st != 0:
-            return st, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, fx, fy
+            return st, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, fx, fy, 0.0, 0.0, 0.0
         el_out[e, col] = f11
         el_out[e, col + 1] = f12
         el_out[e, col + 2] = f21
@@ -399,6 +412,9 @@ def full_membrane(
         wg = gauss_weight[e, g]
         u += wg * w
         c_max = max(c_max, c)
+        cs_max = max(cs_max, c_s)
+        kw_max = max(kw_max, k_w)
+        kf_max = max(kf_max, k_f)
         n_xx += wg * a
         n_yy += wg * b
         n_xy += wg * c12
@@ -414,7 +430,7 @@ def full_membrane(
         sync_yarn_damage(rows_out, row0, n_pts)
     inv = 1.0 / a0
     return (0, eroded, c_max, u, n_xx * inv, n_yy * inv, n_xy * inv, m_xx * inv, m_yy * inv,
-            m_xy * inv, fx, fy)
+            m_xy * inv, fx, fy, cs_max, kw_max, kf_max)
 
 
 @inline_kernel
@@ -645,6 +661,48 @@ def element_stable_step(px, py, pz, area, c_memb, kgt, mu, a0, thick, d_b, bb):
 
 
 @inline_kernel
+def family_stable_step(k, k_shear, mu, g):
+    """A fabric yarn family's stable step in the total-Lagrangian membrane (theory §4,
+    "Stable step"): the family's wave crosses the element's reference length along it,
+    L0 = 1/√(Σ_I (∂N_I/∂X_i)²) at the centre (the side of a square along the yarns), at
+    √((k + k_s)/μ) with k its stiffness per reference width and length (N/m), k_s the
+    trellis shear's (added, as the single bound of the undeformed element adds it),
+    μ the areal mass: Δt = √(μ/((k + k_s) Σ_I (∂N_I/∂X_i)²)). Infinite for k = 0 (a
+    slack family, or not a fabric): it does not limit the step."""
+    if not (k > 0.0):
+        return math.inf
+    s = g[0] * g[0] + g[1] * g[1] + g[2] * g[2] + g[3] * g[3]
+    return math.sqrt(mu / ((k + k_shear) * s))
+
+
+KINEMATIC_FRACTION = 0.05  # of its length a corner pair may close in one step
+
+
+@inline_kernel
+def kinematic_step(px, py, pz, vx, vy, vz):
+    """The step in which no two corners of the element (sides and diagonals) close by
+    more than KINEMATIC_FRACTION of their distance: Δt ≤ η |Δx|²/max(0, −Δx·Δv)
+    (theory §4, "Stable step"). A wave-speed bound comes from the state at the step's
+    start, and an element crushed within a few steps (a fabric cell under a punch's
+    edge, its yarns slack, from 0.3 to 0.04 of its size in 1 µs) outruns it; corners
+    that move apart, or across their line (a struck node leaving its neighbours
+    normal to the plate), do not limit the step."""
+    rate = 0.0
+    for i in range(4):
+        for j in range(i + 1, 4):
+            dx = px[j] - px[i]
+            dy = py[j] - py[i]
+            dz = pz[j] - pz[i]
+            closing = -(dx * (vx[j] - vx[i]) + dy * (vy[j] - vy[i]) + dz * (vz[j] - vz[i]))
+            d2 = dx * dx + dy * dy + dz * dz
+            if closing > rate * d2:
+                rate = closing / d2
+    if not (rate > 0.0):
+        return math.inf
+    return KINEMATIC_FRACTION / rate
+
+
+@inline_kernel
 def carry_state(e, el_in, el_out, rows_in, rows_out, row0, n_rows):
     """Copy element e's state and its section's n_rows material point rows (from row0)
     from the start-of-step tables to the end-of-step ones; the step then updates the
@@ -749,7 +807,8 @@ def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
     n_pts = int(sections[sec, C_POINTS])
     integrated = n_pts > 1
     if int(sections[sec, C_INPLANE]) == MEMBRANE_FULL:
-        status, eroded, c_memb, w_memb, n11, n22, n12, mi_xx, mi_yy, mi_xy, mf_x, mf_y = (
+        (status, eroded, c_memb, w_memb, n11, n22, n12, mi_xx, mi_yy, mi_xy, mf_x, mf_y,
+         c_step, k_warp, k_fill) = (
             full_membrane(
                 e, lx, ly, gauss_grad, gauss_weight, a0, n_pts, thick, kind, mat_params, m,
                 el_in, el_out, el_in[e, E_KAPPA], el_in[e, E_KAPPA + 1], el_in[e, E_KAPPA + 2],
@@ -758,7 +817,8 @@ def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
         )
         full = True
     else:
-        status, n_alive, c_memb, w_memb, n11, n22, n12, mi_xx, mi_yy, mi_xy = section_response(
+        (status, n_alive, c_memb, w_memb, n11, n22, n12, mi_xx, mi_yy, mi_xy, c_step, k_warp,
+         k_fill) = section_response(
             n_pts, thick, kind, mat_params, m,
             el_in[e, E_F], el_in[e, E_F + 1], el_in[e, E_F + 2], el_in[e, E_F + 3],
             f11, f12, f21, f22, el_in[e, E_KAPPA], el_in[e, E_KAPPA + 1],
@@ -816,7 +876,15 @@ def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
                          mxx, myy, mxy, qx, qy)
 
     # 7. stable step
-    dt_e = element_stable_step(px, py, pz, area, c_memb, kgt, mu, a0, thick, d_b, bb)
+    if mesh.step_mode == STEP_YARN:
+        # (k_warp, k_fill: the yarn families' stiffnesses; k_w above is the w hourglass
+        # mode's)
+        dt_e = min(element_stable_step(px, py, pz, area, c_step, kgt, mu, a0, thick, d_b, bb),
+                   family_stable_step(k_warp, c_step, mu, g1),
+                   family_stable_step(k_fill, c_step, mu, g2),
+                   kinematic_step(px, py, pz, vx_, vy_, vz_))
+    else:
+        dt_e = element_stable_step(px, py, pz, area, c_memb, kgt, mu, a0, thick, d_b, bb)
     el_out[e, E_DT] = dt_e
     if not math.isfinite(fsum + dt_e):
         return EL_NAN, 0

@@ -401,6 +401,7 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         erode_inverted=spec.run.erode_inverted,
         mass_scaling_fraction=spec.run.mass_scaling_fraction,
         max_added_mass_fraction=spec.run.max_added_mass_fraction,
+        stable_step=spec.run.stable_step,
     )
     v = np.zeros((mesh.n_nodes, 3))
     w = np.zeros((mesh.n_nodes, 3))

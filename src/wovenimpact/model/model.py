@@ -318,6 +318,8 @@ class Model:
             (kernels.mass_scaling; 0: off).
         max_added_mass_fraction: a run whose added mass exceeds this fraction of the
             model's mass stops (mass scaling is then no longer a small perturbation).
+        stable_step: "isotropic" or "yarn", the fabric elements' stable step (theory
+            §4, "Stable step"; the shell kernel reads it as ``STEP_*``).
         elem_mass: (n_elems,) mass of each element, μ A0 (kg).
     """
 
@@ -359,6 +361,7 @@ class Model:
     material_names: tuple = ()
     mass_scaling_fraction: float = 0.0
     max_added_mass_fraction: float = 0.02
+    stable_step: str = "isotropic"
     elem_mass: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
@@ -384,6 +387,8 @@ class Model:
         h.update(repr((self.ramp_time, self.alpha, self.erode_dt_fraction,
                        self.shell_contact, self.release_time, self.erode_inverted,
                        self.mass_scaling_fraction)).encode())
+        if self.stable_step != "isotropic":  # (the default leaves older digests as they were)
+            h.update(self.stable_step.encode())
         h.update(np.ascontiguousarray(self.release_elems).tobytes())
         return h.hexdigest()
 
@@ -506,6 +511,7 @@ def build_model(
     erode_inverted: bool = False,
     mass_scaling_fraction: float = 0.0,
     max_added_mass_fraction: float = 0.02,
+    stable_step: str = "isotropic",
 ) -> Model:
     """Assemble a :class:`Model` from a mesh, named sections and constraints.
 
@@ -529,6 +535,7 @@ def build_model(
             of the first one, erode_dt_fraction < f < 1 (0: never, the default).
         max_added_mass_fraction: stop once the added mass exceeds this fraction of the
             model's mass, 0 < f ≤ 1; default 0.02.
+        stable_step: "isotropic" (default) or "yarn" (theory §4, "Stable step").
     """
     x0 = np.ascontiguousarray(nodes, dtype=float)
     q = np.ascontiguousarray(quads, dtype=np.int64)
@@ -554,6 +561,9 @@ def build_model(
         raise InputError(
             f"max_added_mass_fraction = {max_added_mass_fraction!r}: valid 0 < f ≤ 1"
         )
+    if stable_step not in SL.STABLE_STEPS:
+        raise InputError(
+            f"stable_step = {stable_step!r}: valid {' or '.join(SL.STABLE_STEPS)}")
     names = list(sections)
     # materials: one table row per distinct material object
     mats: list = []
@@ -649,4 +659,5 @@ def build_model(
         section_names=tuple(names), material_names=tuple(getattr(m, "name", "") for m in mats),
         mass_scaling_fraction=float(mass_scaling_fraction),
         max_added_mass_fraction=float(max_added_mass_fraction), elem_mass=m_el,
+        stable_step=str(stable_step),
     )

@@ -312,7 +312,7 @@ class RunSpec(BaseModel):
     # the fabric elements' stable step (docs/theory.md §4, "Stable step"): "isotropic",
     # the element's shortest width with the stiffest yarn family per current width
     # (default), or "yarn": each taut family over the element's reference length along
-    # it, slack families left out, with a kinematic limit — 3.7× fewer steps in a
+    # it, slack families left out, with a kinematic limit — 5.6× fewer steps in a
     # containment run, an energy error up to 1 % in small-plate perforation (not yet
     # the default)
     stable_step: Literal["isotropic", "yarn"] = "isotropic"

@@ -143,6 +143,12 @@ def test_a_report_from_given_runs_sorts_them_into_ladders_and_names_what_is_unfi
             "5–9 are not decided by a run: by runs the answer lies between 5 and 10 plies."
             in text)
     assert not (tmp_path / "w").exists()  # nothing ran
+    # one layer count between the last escape and the first containment
+    _run_dir(runs, "m8", 8, ("aluminium",), "escaped", 36.3, 11.1)
+    _run_dir(runs, "m10", 10, ("aluminium",), "contained", 0.0, 13.9)
+    text = "\n".join(cv.containment_section(tmp_path / "w", tmp_path / "f", runs=[runs]))
+    assert ("Fewest layers run that contained the fragment: **10**; 8 let it through and 9 "
+            "is not decided by a run: by runs the answer is 9 or 10 layers." in text)
     (runs / "plate").mkdir()
     (runs / "plate" / "summary.json").write_text('{"outcome": "stopped"}')
     with pytest.raises(InputError, match="not a containment run"):

@@ -141,6 +141,9 @@ def ladder_lines(name: str, title: str, unit: str, thesis: dict, note: str, rows
             "." if below is None else
             f"; {below} let it through, so by runs the answer is **{fewest}** {unit}."
             if below == fewest - 1 else
+            f"; {below} let it through and {below + 1} is not decided by a run: by runs "
+            f"the answer is {below + 1} or {fewest} {unit}."
+            if below == fewest - 2 else
             f"; {below} let it through and {below + 1}–{fewest - 1} are not decided by a "
             f"run: by runs the answer lies between {below + 1} and {fewest} {unit}."))
     falling = [int(float(r[KEY])) for r in rows if r.get("status") == "done" and unsettled(r)]

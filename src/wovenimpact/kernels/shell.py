@@ -24,7 +24,9 @@ positions x^n and the half-step velocities v^{n−1/2}, ω^{n−1/2}:
    nodal values;
 5. the element's stable step L_e / c_e, L_e = A / max edge (eq. 4.9–4.11), c_e from
    the current membrane tangent and the transverse-shear wave speed, and no more than
-   the rotational bound 2 √(I/k_θ) of its corners' spins.
+   the rotational bound 2 √(I/k_θ) of its corners' spins; with ``run.stable_step =
+   "yarn"`` a fabric's yarn families instead each over the element's reference length
+   along them, and a kinematic limit (``family_stable_step``, ``kinematic_step``).
 
 ``shell_force`` is one element; ``internal_force_for_shells`` loops over all of them
 in parallel, each writing only its own rows, so results do not depend on threads.

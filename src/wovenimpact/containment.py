@@ -258,10 +258,10 @@ def clear_and_unslowed(h: dict, outer_radius: float, rows: np.ndarray) -> np.nda
     v = np.asarray(h["fragment_speed_m_per_s"], dtype=float)
     inner_node = np.asarray(h["fragment_min_radius_m"], dtype=float)
     for i in np.flatnonzero(rows & (inner_node > outer_radius)):
-        if t[i] - t[0] < EXIT_SPEED_WINDOW:
-            continue
-        start = int(np.searchsorted(t, t[i] - EXIT_SPEED_WINDOW))
-        out[i] = float(np.max(np.abs(v[start:i + 1] - v[i]))) <= EXIT_SPEED_SETTLED * abs(v[i])
+        # the history up to row i, read by the one rule of a settled speed
+        prefix = {"time_s": t[:i + 1], "fragment_speed_m_per_s": v[:i + 1]}
+        out[i] = (t[i] - t[0] >= EXIT_SPEED_WINDOW
+                  and speed_settled(prefix, t[i] - EXIT_SPEED_WINDOW))
     return out
 
 

@@ -64,11 +64,12 @@ C_INPLANE = 9
 N_SECTION = 10
 
 MEMBRANE_REDUCED = 1
+MEMBRANE_FULL = 4
+
 # the fabric elements' stable step (run.stable_step; theory §4, "Stable step")
 STEP_ISOTROPIC = 0  # L_e / c_e with the largest membrane tangent per current length
 STEP_YARN = 1  # each taut yarn family over its reference length, plus a kinematic limit
 STABLE_STEPS = {"isotropic": STEP_ISOTROPIC, "yarn": STEP_YARN}  # run.stable_step's words
-MEMBRANE_FULL = 4
 
 # material kinds and the elastic parameter vector (a row of Model.mat_params)
 MAT_ELASTIC = 0

@@ -17,7 +17,9 @@ from wovenimpact.kernels.shell import (
     corotational_frame,
     element_stable_step,
     hourglass_resultants,
+    family_stable_step,
     hourglass_vectors,
+    kinematic_step,
     midpoint_frame,
     midpoint_rates,
 )
@@ -182,3 +184,36 @@ def test_the_stable_step_of_a_square_is_its_side_over_the_wave_speed():
     assert dt == pytest.approx(2.0 * math.sqrt(inertia / (a * (0.25 * kgt + d_b * bb))),
                                rel=1e-14)
     assert dt < side / math.sqrt(c_memb / mu)
+
+
+def test_the_kinematic_step_lets_no_corner_pair_close_more_than_its_fraction():
+    """kinematic_step (run.stable_step = "yarn"): Δt = η |Δx|²/(−Δx·Δv) of the pair
+    closing fastest relative to its length; corners moving apart, moving across their
+    line (a struck node leaving its neighbours normal to the plate) or moving as a rigid
+    translation do not limit the step."""
+    from wovenimpact.kernels.shell import KINEMATIC_FRACTION
+
+    side = 0.005
+    px, py, pz = (0.0, side, side, 0.0), (0.0, 0.0, side, side), (0.0,) * 4
+    still = (0.0,) * 4
+    # corner 1 runs at 100 m/s towards corner 0 along their side (length 5 mm)
+    dt = kinematic_step(px, py, pz, (0.0, -100.0, 0.0, 0.0), still, still)
+    assert dt == pytest.approx(KINEMATIC_FRACTION * side / 100.0, rel=1e-14)
+    # the same pair opening, a corner leaving normal to the plate, a rigid translation
+    assert kinematic_step(px, py, pz, (0.0, 100.0, 0.0, 0.0), still, still) == math.inf
+    assert kinematic_step(px, py, pz, still, still, (0.0, 0.0, 300.0, 0.0)) == math.inf
+    assert kinematic_step(px, py, pz, (7.0,) * 4, (-3.0,) * 4, (1.0,) * 4) == math.inf
+    # and along a diagonal: corner 2 towards corner 0, |Δx|² = 2 side²
+    dt = kinematic_step(px, py, pz, (0.0, 0.0, -50.0, 0.0), (0.0, 0.0, -50.0, 0.0), still)
+    closing = 2.0 * side * 50.0  # −Δx·Δv
+    assert dt == pytest.approx(KINEMATIC_FRACTION * 2.0 * side**2 / closing, rel=1e-14)
+
+
+def test_a_yarn_familys_step_is_its_reference_length_over_its_wave_speed():
+    """family_stable_step: a square's side along the yarns over √((k + k_s)/μ), from the
+    reference gradients at its centre; a slack family (k = 0) does not limit the step."""
+    side, k, k_s, mu = 0.004, 1.5e7, 4e4, 0.4775
+    g = (-0.5 / side, 0.5 / side, 0.5 / side, -0.5 / side)  # ∂N_I/∂X of a square
+    assert family_stable_step(k, k_s, mu, g) == pytest.approx(
+        side / math.sqrt((k + k_s) / mu), rel=1e-14)
+    assert family_stable_step(0.0, k_s, mu, g) == math.inf

@@ -92,7 +92,8 @@ class ShellContact:
 
     Candidate reuse (Verlet lists): ``forces`` searches with every node given a skin
     σ_p and keeps those candidates while no node has moved farther than its skin since
-    that search and no segment or node has left the surfaces
+    that search and no segment or node has joined the surfaces (one that left them,
+    eroded, is passed over by the narrow phase)
     (:func:`~wovenimpact.kernels.contact_broad.candidates_still_valid`); they then hold
     every pair that could act (the narrow phase repeats the box test of a fresh search
     and keeps the closest segment per ply and side, so the same pairs give the same
@@ -233,7 +234,7 @@ class ShellContact:
             self._search(x, self.no_skin)
             segment_geometry(x, self.quads, self.seg_on, self.seg_geo)
             initial_overlap(x, self.quads, self.ply, self.h_node, self.h_seg, self.margin,
-                            self.seg_geo, self.pair_ptr, self.pair_seg, self.geo,
+                            self.seg_geo, self.seg_on, self.pair_ptr, self.pair_seg, self.geo,
                             self.pair_on, self.overlap)
 
     @property
@@ -327,7 +328,7 @@ class ShellContact:
         penalty_forces(
             x, v, self.quads, self.ply, self.node_mass, self.h_node, self.h_seg, self.margin,
             self.overlap, self.beta, self.damping, self.friction, float(dt), self.seg_geo,
-            self.pair_ptr, self.pair_seg,
+            self.seg_on, self.node_on, self.pair_ptr, self.pair_seg,
             self.geo, self.pair_on, self.pair_f, self.pair_w, self.pair_e, self.node_f,
         )
         energy, n_active = assemble_contact_forces(

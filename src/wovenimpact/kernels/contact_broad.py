@@ -373,14 +373,19 @@ def candidates_still_valid(x, x_search, sigma, node_on, node_on_search, seg_on,
                            seg_on_search):
     """Whether the candidates of a search at x_search with node skins σ still hold every
     pair the narrow phase could make act at x (Verlet-list reuse, module docstring):
-    every node within its skin of where it was, |x_p − x_search,p| ≤ σ_p, and the masks
-    unchanged (an eroded segment or a deactivated node leaves the lists). Serial with
-    an early exit: one pass over the nodes at most."""
+    every node still on within its skin of where it was, |x_p − x_search,p| ≤ σ_p, and
+    no segment or node joined the surfaces since. One that left them (an eroded
+    segment, a node left without a live element) keeps its candidates: the narrow phase
+    passes over pairs whose node or segment is off, so the lists still hold every pair
+    a fresh search would list. Serial with an early exit: one pass over the nodes at
+    most."""
     for e in range(seg_on.shape[0]):
-        if seg_on[e] != seg_on_search[e]:
+        if seg_on[e] != 0 and seg_on_search[e] == 0:
             return False
     for p in range(x.shape[0]):
-        if node_on[p] != node_on_search[p]:
+        if node_on[p] == 0:
+            continue
+        if node_on_search[p] == 0:
             return False
         dx = x[p, 0] - x_search[p, 0]
         dy = x[p, 1] - x_search[p, 1]

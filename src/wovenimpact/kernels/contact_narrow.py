@@ -76,10 +76,13 @@ GN_ITERATIONS = 12
 
 
 # columns of the per-segment table of ``segment_geometry``: the raw box (b_min, b_max),
-# the bilinear form x(ξ, η) = x̄ + ξ a + η b + ξη c (module docstring), the centre normal
-# n̄ = a × b / |a × b| and the warp |n̄ · c| (the plane bound of ``evaluate_node_pairs``)
-SG_BOX, SG_MID, SG_A, SG_B, SG_C, SG_NORMAL, SG_WARP = 0, 6, 9, 12, 15, 18, 21
-N_SEG_GEO = 22
+# the centre x̄ of the bilinear form x(ξ, η) = x̄ + ξ a + η b + ξη c (module docstring),
+# the centre normal n̄ = a × b / |a × b| and the warp |n̄ · c| (the plane bound of
+# ``evaluate_node_pairs``), then a, b, c. The box and plane tests, which pass over most
+# candidates, read the first 13 columns only; rows of 24 (192 B, three cache lines of a
+# page-aligned table) put those in two lines, the projection's a, b, c in the third.
+SG_BOX, SG_MID, SG_NORMAL, SG_WARP, SG_A, SG_B, SG_C = 0, 6, 9, 12, 13, 16, 19
+N_SEG_GEO = 24
 
 
 @loop_kernel
@@ -205,8 +208,8 @@ def shape_functions(xi, eta):
 
 
 @kernel
-def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, pair_ptr, pair_seg,
-                        geo, keep):
+def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, seg_on, pair_ptr,
+                        pair_seg, geo, keep):
     """Project node p on each of its candidate segments and keep the closest per group.
 
     Writes, for k in pair_ptr[p] … pair_ptr[p + 1] − 1: geo[k] = (ξ, η, d, n_x, n_y,
@@ -225,6 +228,8 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, pair_ptr, 
     on plies of one thickness the closest pair of its group, if it was that one, could
     not either, so the forces are unchanged — the projection is spared (on the flagship
     case, 6 % of the candidates at 20 µs, 22 % at 100 µs, beside the box test's 73–76 %).
+    So is a candidate whose segment is off (``seg_on`` 0: eroded since the search that
+    listed it; its row of ``seg`` is stale): a fresh search would not list it either.
     """
     px, py, pz = x[p, 0], x[p, 1], x[p, 2]
     k0, k1 = pair_ptr[p], pair_ptr[p + 1]
@@ -232,7 +237,8 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, pair_ptr, 
         s = pair_seg[k]
         r = h_node[p] + h_seg[s] + margin
         lo, hi = SG_BOX, SG_BOX + 3
-        if not (seg[s, lo] - r <= px <= seg[s, hi] + r
+        if not (seg_on[s] != 0
+                and seg[s, lo] - r <= px <= seg[s, hi] + r
                 and seg[s, lo + 1] - r <= py <= seg[s, hi + 1] + r
                 and seg[s, lo + 2] - r <= pz <= seg[s, hi + 2] + r
                 and abs(seg[s, SG_NORMAL] * (px - seg[s, SG_MID])
@@ -285,7 +291,7 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, pair_ptr, 
 @loop_kernel
 def penalty_forces(
     x, v, quads, ply, node_mass, h_node, h_seg, margin, overlap, beta, zeta, mu, dt,
-    seg, pair_ptr, pair_seg, geo, pair_on, pair_f, pair_w, pair_e, node_f,
+    seg, seg_on, node_on, pair_ptr, pair_seg, geo, pair_on, pair_f, pair_w, pair_e, node_f,
 ):
     """Penalty (and friction) force of every candidate pair (module docstring).
 
@@ -298,6 +304,9 @@ def penalty_forces(
             coefficient μ (0: frictionless).
         dt: the time step the forces are for (s), > 0.
         seg: (n_elems, N_SEG_GEO) the segments' table at x (:func:`segment_geometry`).
+        seg_on, node_on: (n_elems,), (n_nodes,) int8: the segments and nodes taking part
+            now; the candidates may be of a search when more did (Verlet reuse): pairs
+            of a node or segment that is off no longer act.
         pair_ptr, pair_seg: candidates (contact_broad.query_candidates).
         geo: (capacity, N_GEO), pair_on: (capacity,) int8: scratch / written.
         pair_f: (capacity, 3) written for the active pairs (pair_on ≠ 0): force on the
@@ -312,9 +321,13 @@ def penalty_forces(
     for p in prange(n_nodes):
         fx = fy = fz = 0.0
         k0, k1 = pair_ptr[p], pair_ptr[p + 1]
-        if k1 > k0:
-            evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, pair_ptr,
-                                pair_seg, geo, pair_on)
+        if node_on[p] == 0:
+            for k in range(k0, k1):
+                pair_on[k] = 0
+            k1 = k0
+        elif k1 > k0:
+            evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, seg_on,
+                                pair_ptr, pair_seg, geo, pair_on)
         for k in range(k0, k1):
             if pair_on[k] == 0:
                 continue
@@ -357,8 +370,8 @@ def penalty_forces(
 
 
 @loop_kernel
-def initial_overlap(x, quads, ply, h_node, h_seg, margin, seg, pair_ptr, pair_seg, geo,
-                    keep, overlap):
+def initial_overlap(x, quads, ply, h_node, h_seg, margin, seg, seg_on, pair_ptr, pair_seg,
+                    geo, keep, overlap):
     """Initial-overlap allowance o_p = max(0, max over kept pairs of h_p + h_s − d).
 
     With it the gap g = d − (h_p + h_s − o_p) of every kept pair is ≥ 0 in the
@@ -368,7 +381,8 @@ def initial_overlap(x, quads, ply, h_node, h_seg, margin, seg, pair_ptr, pair_se
 
     Args:
         x: (n_nodes, 3) initial positions; margin: the search margin (m);
-        seg: the segments' table at x (:func:`segment_geometry`).
+        seg: the segments' table at x (:func:`segment_geometry`); seg_on: the
+            segments taking part.
         pair_ptr, pair_seg: candidates at x.
         geo, keep: scratch as in ``penalty_forces``.
         overlap: (n_nodes,) written (m).
@@ -377,8 +391,8 @@ def initial_overlap(x, quads, ply, h_node, h_seg, margin, seg, pair_ptr, pair_se
         o = 0.0
         k0, k1 = pair_ptr[p], pair_ptr[p + 1]
         if k1 > k0:
-            evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, pair_ptr,
-                                pair_seg, geo, keep)
+            evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, seg_on,
+                                pair_ptr, pair_seg, geo, keep)
             for k in range(k0, k1):
                 if keep[k] != 0:
                     o = max(o, h_node[p] + h_seg[pair_seg[k]] - geo[k, GEO_DIST])

@@ -109,6 +109,34 @@ def test_table_accuracy_holds_over_the_property_test_materials(scale):
         assert np.nanmax(e) < TOL, (key, np.nanmax(e))
 
 
+def test_the_undeformed_state_and_its_neighbourhood_are_tabulated():
+    """The undeformed state λ = (1, 1) lies on the onset of contact, whose cells are
+    solved exactly; the cluster of knots 1 ± REST_STEPS makes the cells around it small
+    enough that the heights are unique there to the tolerance, so a fabric at rest (most
+    of every model, most of the time) is evaluated from the table: exactly the unloaded
+    crossover at the knot (1, 1), the target accuracy within 1e-6 of it and over the
+    cluster's span. Fails when the rest cells are marked exact (before the cluster)."""
+    params = reference_fabric()
+    row = table_row(params)
+    out = np.empty((1, 6))
+    crossover_from_table_for_points(row, np.array([1.0]), np.array([1.0]), out)
+    inside, w, gw, gf, hw, hf = out[0]
+    assert inside == 1.0 and w == 0.0 and gw == 0.0 and gf == 0.0
+    assert hw == pytest.approx(params.warp.h0, rel=1e-12)
+    assert hf == pytest.approx(params.fill.h0, rel=1e-12)
+    rng = np.random.default_rng(7)
+    near = 1.0 + rng.uniform(-1e-6, 1e-6, (2, 20_000))
+    out = np.empty((near.shape[1], 6))
+    crossover_from_table_for_points(row, near[0].copy(), near[1].copy(), out)
+    assert out[:, 0].all()  # every state within 1e-6 of rest: the table
+    span = 1.0 + rng.uniform(-FT.REST_STEPS[-1], FT.REST_STEPS[-1], (2, 20_000))
+    for lam in (near, span):
+        err = FT.table_errors(params, row, lam[0], lam[1])
+        err.pop("contact")
+        for key, e in err.items():
+            assert np.nanmax(e) < TOL, (key, np.nanmax(e))
+
+
 def intact(state):
     return (state[:, L.S_DAMAGE] == 0) & (state[:, L.S_DAMAGE + 1] == 0)
 

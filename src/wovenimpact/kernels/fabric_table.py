@@ -60,8 +60,10 @@ def knot_interval(p, m, start, n, buckets, nb, inv_width, x):
 
     O(1): the bucket map p[m, buckets : buckets + nb] (uniform buckets of width
     1/inv_width from k_0) gives the interval of the bucket's left edge; a bucket is
-    narrower than any knot interval, so at most one step forward remains. (A bisection
-    over 124 knots cost ~55 ns per axis here, its branches unpredictable.)
+    half the fine knot spacing, so at most one step forward remains, except in the
+    cluster of knots around λ = 1 (materials/fabric_table.REST_STEPS), where a point steps
+    through a few. (A bisection over 124 knots cost ~55 ns per axis here, its branches
+    unpredictable.)
     """
     k0 = p[m, start]
     if not (k0 <= x <= p[m, start + _U(n - 1)]):

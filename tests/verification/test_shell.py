@@ -285,6 +285,43 @@ def test_a_crushed_fabric_elements_stable_step_follows_its_taut_yarns_not_its_wi
     assert 0.9 * res["warp taut"][0] * res["warp taut"][1] > 1.5
 
 
+@pytest.mark.parametrize("stable_step", ["isotropic", "yarn"])
+def test_erosion_on_the_stable_step_reads_the_isotropic_bound_under_either_option(stable_step):
+    """An element erodes when its isotropic step L_e/c_e falls below the erosion step
+    (``run.erode_dt_fraction`` of the first step), whichever step the run takes: the
+    yarn option changes the step, not which elements erode. Crushed to 0.1 across its
+    taut warp, the element's isotropic bound is ~10× below its yarn-family step; with
+    the erosion step between the two it erodes under both options, below both it lives
+    under both. (Under the yarn option it read its own yarn step before, and kept
+    cells the default eroded; theory §4.)"""
+    from tests.conftest import reference_fabric
+    fab = reference_fabric()
+    side = 8.0 * fab.warp.half_length
+    nodes = np.array([[0, 0, 0], [side, 0, 0], [side, side, 0], [0, side, 0]], dtype=float)
+    sec = Section(fab, bending_modulus=1e9, transverse_shear_modulus=3.28e9)
+    model = build_model(nodes, [[0, 1, 2, 3]], {"fabric": sec}, [0], stable_step=stable_step)
+    iso = build_model(nodes, [[0, 1, 2, 3]], {"fabric": sec}, [0])
+    yarn = build_model(nodes, [[0, 1, 2, 3]], {"fabric": sec}, [0], stable_step="yarn")
+    crushed = nodes.copy()
+    crushed[:, 0] *= 1.045
+    crushed[:, 1] *= 0.1
+
+    def stage(m, dt_erode):
+        st = initial_state(m)
+        st.x = crushed.copy()
+        st.dt_first = dt_erode * m.alpha / m.erode_dt_fraction
+        ws = Workspace.for_model(m, st)
+        element_forces(m, st, ws)
+        return ws.elem[0, SL.E_ALIVE], ws.elem[0, SL.E_DT]
+
+    _, dt_iso = stage(iso, 0.0)
+    _, dt_yarn = stage(yarn, 0.0)
+    assert dt_yarn > 5.0 * dt_iso  # the two bounds are far apart here
+    between = math.sqrt(dt_iso * dt_yarn)
+    assert stage(model, between)[0] == 0.0  # eroded
+    assert stage(model, 0.5 * dt_iso)[0] == 1.0  # alive
+
+
 def test_fabric_strip_pulled_along_the_warp_reproduces_the_single_element_curve():
     """Four crossover elements in a row, pulled slowly along the warp with the fill
     edges free: the warp tension against the displacement per element follows the

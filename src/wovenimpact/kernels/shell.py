@@ -476,10 +476,10 @@ def corner_values(a, c0, c1, c2, c3):
 @inline_kernel
 def element_failed(e, el_out, blocks, measure):
     """Element e has a degenerate geometry (``measure``: an area or a Jacobian ≤ 0 or
-    not finite): no force, no stable step; returns (EL_NAN or EL_INVERTED, 0)."""
+    not finite): no force, no stable step; returns (EL_NAN or EL_INVERTED, 0, ∞)."""
     el_out[e, E_DT] = 0.0
     clear_block(blocks, e)
-    return (EL_NAN if not math.isfinite(measure) else EL_INVERTED), 0
+    return (EL_NAN if not math.isfinite(measure) else EL_INVERTED), 0, math.inf
 
 
 @inline_kernel
@@ -682,23 +682,24 @@ KINEMATIC_FRACTION = 0.05  # of its length a corner pair may close in one step
 
 @inline_kernel
 def kinematic_step(px, py, pz, vx, vy, vz):
-    """The step in which no two corners of the element (sides and diagonals) close by
-    more than KINEMATIC_FRACTION of their distance: Δt ≤ η |Δx|²/max(0, −Δx·Δv)
+    """The step in which no two corners of the element (sides and diagonals) close or
+    open by more than KINEMATIC_FRACTION of their distance: Δt ≤ η |Δx|²/|Δx·Δv|
     (theory §4, "Stable step"). A wave-speed bound comes from the state at the step's
     start, and an element crushed within a few steps (a fabric cell under a punch's
-    edge, its yarns slack, from 0.3 to 0.04 of its size in 1 µs) outruns it; corners
-    that move apart, or across their line (a struck node leaving its neighbours
-    normal to the plate), do not limit the step."""
+    edge, its yarns slack, from 0.3 to 0.04 of its size in 1 µs) outruns it; so does a
+    slack family (left out of the wave bound) pulled taut within one step. Corners
+    moving across their line (a struck node leaving its neighbours normal to the
+    plate) do not limit the step."""
     rate = 0.0
     for i in range(4):
         for j in range(i + 1, 4):
             dx = px[j] - px[i]
             dy = py[j] - py[i]
             dz = pz[j] - pz[i]
-            closing = -(dx * (vx[j] - vx[i]) + dy * (vy[j] - vy[i]) + dz * (vz[j] - vz[i]))
+            change = abs(dx * (vx[j] - vx[i]) + dy * (vy[j] - vy[i]) + dz * (vz[j] - vz[i]))
             d2 = dx * dx + dy * dy + dz * dz
-            if closing > rate * d2:
-                rate = closing / d2
+            if change > rate * d2:
+                rate = change / d2
     if not (rate > 0.0):
         return math.inf
     return KINEMATIC_FRACTION / rate
@@ -738,7 +739,11 @@ def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
             (global, N·m) per corner, the internal (resisting) forces.
 
     Returns:
-        (status, eroded_now): an EL_* code, and 1 if the element eroded this step.
+        (status, eroded_now, dt_erosion): an EL_* code, 1 if the element eroded this
+        step, and the step the caller's erosion test (``dt_erode``) reads: the
+        element's isotropic bound L_e/c_e (``element_stable_step``), also when the run's
+        step is the yarn families' — erosion is a model decision, and must not change
+        with the step's option (theory §4, stable step) — ∞ where it does not apply.
     """
     x, v, omega = motion.x, motion.v, motion.omega
     quads, area0, ref_grad = mesh.quads, mesh.area0, mesh.ref_grad
@@ -757,7 +762,7 @@ def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
             carry_state(e, el_in, el_out, rows_in, rows_out, row0, n_rows)
         el_out[e, E_DT] = math.inf
         clear_block(blocks, e)
-        return EL_OK, 0
+        return EL_OK, 0, math.inf
     carry_state(e, el_in, el_out, rows_in, rows_out, row0, n_rows)
 
     # 1. corotational frames at x^n (forces) and at x^{n−1/2} = x^n − ½Δt v (rates:
@@ -836,7 +841,7 @@ def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
         el_out[e, E_N + 2] = 0.0
         el_out[e, E_DT] = 0.0
         clear_block(blocks, e)
-        return status, 0
+        return status, 0, math.inf
     if eroded:
         # no force from now on; its stored energy is booked by the caller
         el_out[e, E_U_MEMB] = w_memb
@@ -845,7 +850,7 @@ def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
         for j in range(3):
             el_out[e, E_N + j] = 0.0
         clear_block(blocks, e)
-        return EL_OK, 1
+        return EL_OK, 1, math.inf
     el_out[e, E_N] = n11
     el_out[e, E_N + 1] = n22
     el_out[e, E_N + 2] = n12
@@ -877,7 +882,8 @@ def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
     fsum = corner_forces(e, blocks, frame, mf_x, mf_y, fzs, gam, hg0, hg1, hg2, hg3, hg4,
                          mxx, myy, mxy, qx, qy)
 
-    # 7. stable step
+    # 7. stable step; the isotropic bound is also the erosion test's
+    dt_iso = element_stable_step(px, py, pz, area, c_memb, kgt, mu, a0, thick, d_b, bb)
     if mesh.step_mode == STEP_YARN:
         # (k_warp, k_fill: the yarn families' stiffnesses; k_w above is the w hourglass
         # mode's)
@@ -886,11 +892,11 @@ def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
                    family_stable_step(k_fill, c_step, mu, g2),
                    kinematic_step(px, py, pz, vx_, vy_, vz_))
     else:
-        dt_e = element_stable_step(px, py, pz, area, c_memb, kgt, mu, a0, thick, d_b, bb)
+        dt_e = dt_iso
     el_out[e, E_DT] = dt_e
     if not math.isfinite(fsum + dt_e):
-        return EL_NAN, 0
-    return EL_OK, 0
+        return EL_NAN, 0, math.inf
+    return EL_OK, 0, dt_iso
 
 
 @loop_kernel
@@ -904,7 +910,8 @@ def internal_force_for_shells(mesh, motion, dt, tables, results, dt_erode, erode
     (n_elems,); alive (n_elems,) uint8: 1 for an element alive at the end of the step, a
     compact copy of ``el_out[:, E_ALIVE]`` for the node kernels); dt_erode: an element
     whose own stable step L_e/c_e falls below it is eroded (crushed or collapsed
-    elements, e.g. fabric with one yarn family broken; 0 disables); erode_inverted: an
+    elements, e.g. fabric with one yarn family broken; 0 disables; the isotropic
+    step L_e/c_e also under the yarn step option); erode_inverted: an
     element inverted (non-positive area or Jacobian) is eroded instead of stopping the
     run.
 
@@ -943,7 +950,8 @@ def internal_force_for_shells(mesh, motion, dt, tables, results, dt_erode, erode
         point_blocks = 1
     rows = ElementTables(tables.el_in, el_out, rows_in, rows_out)
     for e in prange(ne):
-        st, er = shell_force(np.uint64(e), mesh, motion, dt, rows, point_blocks, blocks)
+        st, er, dt_check = shell_force(np.uint64(e), mesh, motion, dt, rows, point_blocks,
+                                       blocks)
         if st == EL_INVERTED and erode_inverted:
             # crushed through itself (LS-DYNA's erosion on a negative Jacobian): it goes,
             # with the energies it held at the start of the step
@@ -952,7 +960,7 @@ def internal_force_for_shells(mesh, motion, dt, tables, results, dt_erode, erode
             clear_block(blocks, e)
             st = EL_OK
             er = 1
-        elif st == EL_OK and er == 0 and el_out[e, E_DT] < dt_erode:
+        elif st == EL_OK and er == 0 and dt_check < dt_erode:
             el_out[e, E_ALIVE] = 0.0
             el_out[e, E_DT] = math.inf
             clear_block(blocks, e)

@@ -435,7 +435,8 @@ def test_set_overrides_change_the_case_and_bad_ones_are_named(tmp_path):
     assert ke0(out) == pytest.approx(ke0(base) / 4.0, rel=1e-12)  # half the speed
     for bad, words in (("impactor.velocity=100 m/s", "has no 'impactor'"),
                        ("run.end_time=-1 us", "run.end_time"),
-                       ("run.end_time", "expected KEY=VALUE")):
+                       ("run.end_time", "expected KEY=VALUE"),
+                       ("run.end_time.unit=s", "'run.end_time' is a value")):
         result = CliRunner().invoke(app, ["run", str(case), "--out", str(out), "--set", bad])
         assert result.exit_code == 2 and words in result.output, result.output
 

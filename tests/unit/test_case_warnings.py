@@ -106,3 +106,19 @@ def test_a_boundary_on_an_empty_node_set_is_warned_of():
     with pytest.warns(InputWarning, match=r"casing\.cut_edges' holds no node \(a full casing "
                                           r"ring has no cut edges\)"):
         compile_case(spec, base)
+
+
+def test_a_material_given_as_a_path_takes_set_overrides_and_a_value_is_no_table():
+    """``--set materials.NAME.set.KEY=V`` on a case whose material is ``NAME = "path"``
+    (the short form of ``{file = "path"}``) sets the override; a key under a value is an
+    InputError naming it, not a TypeError traceback."""
+    from wovenimpact.errors import InputError
+    from wovenimpact.spec.fields import set_dotted
+
+    doc = {"materials": {"kevlar": "k.toml"}, "run": {"end_time": "1 ms"}}
+    set_dotted(doc, "materials.kevlar.set.options.erode_intact_crush", 0.1, label="--set")
+    assert doc["materials"]["kevlar"] == {"file": "k.toml",
+                                          "set": {"options": {"erode_intact_crush": 0.1}}}
+    for key in ("run.end_time.unit", "run.end_time.unit.name"):
+        with pytest.raises(InputError, match=r"'run.end_time' is a value \('1 ms'\), not a table"):
+            set_dotted(doc, key, "s", label="--set")

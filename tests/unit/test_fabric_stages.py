@@ -125,6 +125,19 @@ def test_the_sliver_rule_needs_a_broken_family():
     assert not sliver_erodes(p, U0, 1.0, 0.0, 5.0, 0.01)  # both tests disabled
 
 
+def test_the_intact_crush_rule_erodes_a_cell_crushed_both_ways_only_when_asked():
+    """erode_intact_crush (off by default): any point erodes once λ_w λ_f < the limit —
+    a cell crushed both ways — but not one crushed across one family only, nor any
+    point with the option off (the default, and the shipped Kevlar)."""
+    p = np.zeros((1, L.N_PARAM))
+    assert not sliver_erodes(p, U0, 0.0, 0.0, 0.2, 0.2)  # off: never
+    p[0, L.P_ERODE_INTACT] = 0.1
+    assert sliver_erodes(p, U0, 0.0, 0.0, 0.3, 0.3)  # 0.09 < 0.1
+    assert not sliver_erodes(p, U0, 0.0, 0.0, 0.35, 0.35)  # 0.1225
+    assert not sliver_erodes(p, U0, 0.0, 0.0, 1.04, 0.12)  # one way (a casing fold): 0.125
+    assert reference_fabric().to_array()[L.P_ERODE_INTACT] == 0.0
+
+
 @pytest.mark.parametrize("gamma", [0.05, 0.4, 0.7])
 def test_the_shear_energy_is_the_integral_of_the_shear_stress(rows, gamma):
     """True law: d(e_shear)/dγ = t τ (central differences), and τ is odd in γ."""

@@ -53,6 +53,7 @@ from wovenimpact.kernels.fabric_layout import (
     P_E,
     P_ELL0,
     P_ERODE_CRUSH,
+    P_ERODE_INTACT,
     P_ERODE_STRETCH,
     P_FAILURE,
     P_FRAME,
@@ -617,12 +618,14 @@ def sliver_erodes(p, m, d_w, d_f, lam_w, lam_f):
     """Theory §1.4: a point with a family broken erodes once it is a sliver — the broken
     family stretched beyond P_ERODE_STRETCH (held by nothing across the break), or either
     family crushed below P_ERODE_CRUSH (slack intact yarns, or intact yarns bunched with
-    nothing holding them apart); 0 disables either test."""
+    nothing holding them apart); any point, intact or not, once crushed both ways to
+    λ_w λ_f below P_ERODE_INTACT (off by default); 0 disables each test."""
     lim = p[m, P_ERODE_STRETCH]
     crush = p[m, P_ERODE_CRUSH]
+    intact = p[m, P_ERODE_INTACT]
     return (lim > 0.0 and ((d_w >= 1.0 and lam_w > lim) or (d_f >= 1.0 and lam_f > lim))) or (
         crush > 0.0 and (d_w >= 1.0 or d_f >= 1.0) and min(lam_w, lam_f) < crush
-    )
+    ) or (intact > 0.0 and lam_w * lam_f < intact)
 
 
 @inline_kernel

@@ -46,7 +46,8 @@ P_TAB_IBW = 36  # 1 / bucket width along λ_w
 P_TAB_IBF = 37  # 1 / bucket width along λ_f
 P_TAB_DATA = 38  # index in the row of the first knot's data (= s + n_w + n_f + m_w + m_f)
 P_ERODE_CRUSH = 39  # with a family broken, erode once either is crushed below this (—), 0: never
-N_PARAM = 40
+P_ERODE_INTACT = 40  # intact too: erode once λ_w λ_f falls below this (—), 0: never (default)
+N_PARAM = 41
 
 CROSSOVER_EXACT = 0
 CROSSOVER_TABLE = 1

@@ -64,6 +64,10 @@ class FabricOptions:
     # ... or either family crushed below this stretch (0: never): the point is then a
     # sliver (slack intact yarns, or intact yarns bunched) whose step shrinks like λ
     erode_broken_crush: float = 0.5
+    # ... and, intact or not, once the cell is crushed both ways to λ_w λ_f below this
+    # (0: never, the default; theory §1.4): yarns cannot pile into a fraction of their
+    # cell, and the shell has no wrinkle below its element size
+    erode_intact_crush: float = 0.0
     # crossover evaluation (theory §1.9): "table" interpolates the tabulated stored
     # energy while both families are intact and inside the table (fibre frame only),
     # "exact" always runs the height solve (the reference)
@@ -195,6 +199,7 @@ class FabricParameters:
         p[L.P_AREAL_MASS] = self.areal_mass
         p[L.P_ERODE_STRETCH] = o.erode_broken_stretch
         p[L.P_ERODE_CRUSH] = o.erode_broken_crush
+        p[L.P_ERODE_INTACT] = o.erode_intact_crush
         p[L.P_TAB_START] = L.N_PARAM
         if o.crossover == "table" and o.frame == "fibre":
             from wovenimpact.materials.fabric_table import with_table

@@ -151,6 +151,13 @@ def set_dotted(doc: dict, key: str, value: Any, label: str = "parameters") -> No
         overrides = "set" in parts[:i] or (part == "set" and parts[0] == "materials")
         if isinstance(node, dict) and part not in node and overrides:
             node[part] = {}
+        if (i == 1 and parts[0] == "materials" and parts[2:3] == ["set"]
+                and isinstance(node, dict) and isinstance(node.get(part), str)):
+            node[part] = {"file": node[part]}  # `name = "path"` is `name = {file = "path"}`
+        if not isinstance(node, (dict, list)):
+            where = ".".join(parts[:i])
+            raise InputError(f"{label} {key!r}: {where!r} is a value ({node!r}), not a "
+                             "table; valid: a key under a table of the base case")
         try:
             node = node[int(part)] if isinstance(node, list) else node[part]
         except (KeyError, IndexError, ValueError):
@@ -165,7 +172,8 @@ def set_dotted(doc: dict, key: str, value: Any, label: str = "parameters") -> No
     elif isinstance(node, dict):
         node[last] = value
     else:
-        raise InputError(f"{label} {key!r}: {'.'.join(parts[:-1])!r} is not a table")
+        raise InputError(f"{label} {key!r}: {'.'.join(parts[:-1])!r} is a value ({node!r}), "
+                         "not a table; valid: a key under a table of the base case")
 
 
 def parse_override(text: str) -> tuple[str, Any]:

@@ -107,6 +107,8 @@ class OptionsSpec(BaseModel):
     erode_broken_stretch: quantity("dimensionless", ge=0, example="2.0") = 2.0
     # ... or, with a family broken, either family crushed below this (0: never; < 1)
     erode_broken_crush: quantity("dimensionless", ge=0, lt=1, example="0.5") = 0.5
+    # ... and, intact or not, once λ_w λ_f falls below this (0: never, the default; < 1)
+    erode_intact_crush: quantity("dimensionless", ge=0, lt=1, example="0.1") = 0.0
     # crossover evaluation (docs/theory.md §1.9): tabulated stored energy or exact solve
     crossover: Literal["table", "exact"] = FabricOptions.crossover
 
@@ -323,6 +325,7 @@ def _fabric_parameters(
         softening_strain=o.softening_strain if o.failure == "progressive" else 0.0,
         erode_broken_stretch=o.erode_broken_stretch,
         erode_broken_crush=o.erode_broken_crush,
+        erode_intact_crush=o.erode_intact_crush,
         crossover=o.crossover,
     )
     return FabricParameters(

@@ -38,7 +38,8 @@ COARSE = 5e-3  # knot spacing away from the non-smooth places (λ)
 FINE = 1e-3  # knot spacing around the onset of contact and the knee
 # knots 1 ± REST_STEPS (and 1) along each family: cells shrinking geometrically onto the
 # undeformed state λ = (1, 1), where the onset of contact passes (theory §1.9, "rest
-# cells"); the lookup's buckets stay FINE / 2 wide, so a point there steps through them
+# cells"); the lookup's buckets keep the width of the knots outside the cluster, so a
+# point inside it steps through a few knots
 REST_STEPS = 1e-7 * 2.0 ** np.arange(12)  # 1e-7 … 2.05e-4
 
 

@@ -155,9 +155,7 @@ def set_dotted(doc: dict, key: str, value: Any, label: str = "parameters") -> No
                 and isinstance(node, dict) and isinstance(node.get(part), str)):
             node[part] = {"file": node[part]}  # `name = "path"` is `name = {file = "path"}`
         if not isinstance(node, (dict, list)):
-            where = ".".join(parts[:i])
-            raise InputError(f"{label} {key!r}: {where!r} is a value ({node!r}), not a "
-                             "table; valid: a key under a table of the base case")
+            raise _not_a_table(label, key, parts[:i], node)
         try:
             node = node[int(part)] if isinstance(node, list) else node[part]
         except (KeyError, IndexError, ValueError):
@@ -172,8 +170,13 @@ def set_dotted(doc: dict, key: str, value: Any, label: str = "parameters") -> No
     elif isinstance(node, dict):
         node[last] = value
     else:
-        raise InputError(f"{label} {key!r}: {'.'.join(parts[:-1])!r} is a value ({node!r}), "
-                         "not a table; valid: a key under a table of the base case")
+        raise _not_a_table(label, key, parts[:-1], node)
+
+
+def _not_a_table(label: str, key: str, path: list[str], node: Any) -> InputError:
+    """The error of a dotted ``key`` that goes on under ``path``, a plain value."""
+    return InputError(f"{label} {key!r}: {'.'.join(path)!r} is a value ({node!r}), not a "
+                      "table; valid: a key under a table of the base case")
 
 
 def parse_override(text: str) -> tuple[str, Any]:

@@ -313,8 +313,9 @@ class RunSpec(BaseModel):
     # the element's shortest width with the stiffest yarn family per current width
     # (default), or "yarn": each taut family over the element's reference length along
     # it, slack families left out, with a kinematic limit — 2.4–5.6× fewer steps in the
-    # hybrid casings of theory §4, but an energy error up to 1.1 % in small-plate
-    # perforation (not yet the default)
+    # hybrid casings of theory §4, but an energy error up to 0.8 % in small-plate
+    # perforation (0.28 % with the material option erode_intact_crush = 0.1; the
+    # default's up to 0.2 %); not yet the default
     stable_step: Literal["isotropic", "yarn"] = "isotropic"
     # the run stops once the added mass exceeds this fraction of the model's mass
     max_added_mass_fraction: quantity("dimensionless", gt=0, le=1, example="0.02") = 0.02

@@ -2,7 +2,10 @@
 
 A diagnostic (not a test): compiles CASE (with ``KEY=VALUE`` overrides), steps it to
 T_START, then times N steps with ``Workspace.profile`` on and prints ms per step and
-ns per element-cycle, each stage's share, and the shell contact's candidate count.
+ns per element-cycle, each stage's share, and the shell contact's candidate count; then,
+at the final state, the shell contact's parts timed alone (best of 10): the search's
+binning and query, and the narrow phase with how many candidates it projected and how
+many act (docs/theory.md §6, "Where the contact time goes").
 
 Usage: ``python benchmarks/stage_profile.py CASE T_START N [KEY=VALUE ...]``, e.g.
 ``NUMBA_NUM_THREADS=1 python benchmarks/stage_profile.py
@@ -13,6 +16,8 @@ from __future__ import annotations
 
 import sys
 import time
+
+import numpy as np
 
 from wovenimpact.model.compile import compile_case
 from wovenimpact.solver.explicit import Workspace, step
@@ -44,6 +49,51 @@ def main(argv: list[str]) -> None:
     shells = ws.contact.shells
     if shells is not None:
         print(f"shell contact: {shells.n_pairs} candidates, {shells.searches} searches")
+        contact_parts(shells, state)
+
+
+def best_ms(f, repeats: int = 10):
+    """Best wall time of ``repeats`` calls of f (ms) and its last result."""
+    best, out = float("inf"), None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        out = f()
+        best = min(best, time.perf_counter() - t0)
+    return best * 1e3, out
+
+
+def contact_parts(sc, state) -> None:
+    """The shell contact's search and narrow phase at ``state``, each timed alone."""
+    from wovenimpact.kernels import contact_broad as B
+    from wovenimpact.kernels.contact_narrow import GEO_SIDE, penalty_forces, segment_geometry
+
+    x = np.ascontiguousarray(state.x)
+    sigma = sc.sigma.copy()
+    t_all, n = best_ms(lambda: sc._search(x, sigma))
+    t_box, _ = best_ms(lambda: B.segment_boxes(x, sc.quads, sc.seg_on, sc.h_seg, sigma,
+                                                sc.margin, sc.seg_box, sc.seg_plane))
+    edge = B.cell_edge(sc.seg_on, sc.seg_box)
+    t_bin, entries = best_ms(lambda: B.bin_segments(
+        sc.seg_on, sc.seg_box, sc.ply, 1.0 / edge, sc.bucket_ptr, sc.entry_seg, sc.entry_cell,
+        sc.entry_box, sc.entry_ply))
+    t_query, _ = best_ms(lambda: B.query_candidates(
+        x, sc.quads, sc.ply, sc.node_ply, sc.node_on, sc.h_node, sigma, sc.self_contact,
+        sc.node_ptr, sc.node_elem, sc.seg_plane, edge, sc.bucket_ptr, sc.entry_seg,
+        sc.entry_cell, sc.entry_box, sc.entry_ply, sc.slots, sc.pair_ptr, sc.pair_seg))
+    nodes = int((sc.node_on != 0).sum())
+    print(f"  one search {t_all:.2f} ms: boxes {t_box:.2f}, binning {t_bin:.2f} ({entries} "
+          f"entries, cell {edge * 1e3:.2f} mm), query {t_query:.2f} ({n} candidates, "
+          f"{t_query / max(nodes, 1) * 1e6:.0f} ns per node)")
+    segment_geometry(x, sc.quads, sc.seg_on, sc.seg_geo)
+    args = (x, state.v, sc.quads, sc.ply, sc.node_mass, sc.h_node, sc.h_seg, sc.margin,
+            sc.overlap, sc.beta, sc.damping, sc.friction, float(state.dt), sc.seg_geo,
+            sc.seg_on, sc.node_on, sc.pair_ptr, sc.pair_seg, sc.geo, sc.pair_on, sc.pair_f,
+            sc.pair_w, sc.pair_e, sc.node_f)
+    t_pen, _ = best_ms(lambda: penalty_forces(*args))
+    projected = int((sc.geo[:n, GEO_SIDE] != 0).sum())
+    acting = int((sc.pair_on[:n] != 0).sum())
+    print(f"  narrow phase {t_pen:.2f} ms: {n} candidates ({t_pen / max(n, 1) * 1e6:.1f} ns "
+          f"each), {projected} projected, {acting} acting")
 
 
 if __name__ == "__main__":

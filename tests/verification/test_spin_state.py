@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 
+from wovenimpact.errors import InputError
 from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.model.casing import blade_mesh, casing_mesh, circumferential_directions
@@ -260,3 +261,49 @@ def test_a_sector_of_360_degrees_read_through_radians_is_the_full_ring():
     mesh = casing_mesh([0.25], 0.15, 5e-3, sector=sector)
     assert mesh.node_sets["cut_edges"].size == 0
     assert mesh.n_elems == casing_mesh([0.25], 0.15, 5e-3).n_elems
+
+
+def _segments_within(mesh, layer_nodes, layer_elems, reach):
+    """For each node of one layer, how many segments of another layer have it in their
+    box inflated by ``reach`` (the narrow phase's box test: what it projects)."""
+    box = mesh.nodes[mesh.quads[layer_elems]]
+    lo, hi = box.min(axis=1) - reach, box.max(axis=1) + reach
+    p = mesh.nodes[layer_nodes]
+    inside = np.all((p[:, None, :] >= lo[None]) & (p[:, None, :] <= hi[None]), axis=2)
+    return inside.sum(axis=1)
+
+
+def test_offset_layers_put_a_node_over_an_edge_middle_not_a_corner_of_four():
+    """casing_mesh(offset_layers=True) on a graded full ring: the even layers keep the
+    node columns of the plain ring, each odd layer's columns sit at the mean angle of two
+    neighbouring ones (the last pair wrapping round), every node on its radius, the same
+    elements. An inner node of layer 1 then lies in the 1 mm-inflated boxes of two
+    elements of layer 0 (the two sharing the edge it faces), against four on the plain
+    ring (the four sharing the corner it faces). (1 mm: over the middle of a 21 mm chord a
+    node is 0.5 mm + the sagitta 0.22 mm from it.) A sector refuses the option."""
+    radii, size = [0.25, 0.2505, 0.251], 7e-3
+    kw = dict(fine_sector=150.0, coarse_size=21e-3, centre_angle=175.0)
+    plain = casing_mesh(radii, 0.15, size, **kw)
+    mesh = casing_mesh(radii, 0.15, size, offset_layers=True, **kw)
+    assert np.array_equal(mesh.quads, plain.quads)
+
+    def columns(m, k):
+        n = m.node_sets[f"layer{k}"]
+        return np.unique(np.round(np.mod(np.arctan2(m.nodes[n, 1], m.nodes[n, 0]), 2 * math.pi), 12))
+
+    for k in (0, 2):
+        assert np.array_equal(columns(mesh, k), columns(plain, k))
+    t0 = columns(plain, 0)
+    wrapped = np.append(t0, t0[0] + 2 * math.pi)
+    mid = np.sort(np.round(np.mod(0.5 * (wrapped[1:] + wrapped[:-1]), 2 * math.pi), 12))
+    assert np.allclose(columns(mesh, 1), mid, atol=1e-11)
+    for k, r in enumerate(radii):
+        n = mesh.node_sets[f"layer{k}"]
+        assert np.allclose(np.hypot(mesh.nodes[n, 0], mesh.nodes[n, 1]), r, rtol=1e-12)
+    for m, expect in ((plain, 4), (mesh, 2)):
+        n1 = m.node_sets["layer1"]
+        inner = n1[np.abs(m.nodes[n1, 2]) < 0.075 - size]  # away from the clamped ends
+        count = _segments_within(m, inner, m.elem_sets["layer0"], 1e-3)
+        assert np.all(count == expect)
+    with pytest.raises(InputError, match="offset_layers needs the full ring"):
+        casing_mesh(radii, 0.15, size, sector=120.0, offset_layers=True)

@@ -37,6 +37,7 @@ def casing_mesh(
     centre_angle: float = 0.0,
     fine_sector: float | None = None,
     coarse_size: float | None = None,
+    offset_layers: bool = False,
 ) -> Mesh:
     """Coaxial cylindrical layers about the z axis, z ∈ [−length/2, length/2].
 
@@ -53,6 +54,12 @@ def casing_mesh(
             ``centre_angle`` (the impact zone), growing by about 20 % per element
             to ``coarse_size`` outside it; axially ``element_size`` everywhere. Both
             or neither.
+        offset_layers: on a full ring, every second layer's node columns sit half-way
+            between those of the layer inside it (the angle of each column the mean of
+            two neighbouring ones), so a node of one layer faces the middle of an
+            element edge of the next instead of a corner shared by four of its elements
+            (docs/theory.md §8, "Offset layers"). A sector keeps its cut edges radial:
+            InputError.
 
     Elements are counter-clockwise about the outward normal (first edge along the
     circumference, second along +z). Node sets: ``ends`` (z = ±length/2, every layer),
@@ -81,6 +88,11 @@ def casing_mesh(
         theta = t0 + graded_angles(radii[0], span, element_size, fine_sector, coarse_size)
         n_t = theta.size - 1
     n_tn = n_t if full else n_t + 1  # node columns around
+    if offset_layers and not full:
+        raise InputError(f"casing.offset_layers needs the full ring (sector = {sector:.6g}°): "
+                         "a sector's cut edges are radial lines through every layer")
+    # the offset columns: the mean angle of each pair of neighbours (the last pair wraps)
+    theta_offset = 0.5 * (theta[:n_tn] + theta[1:n_tn + 1]) if offset_layers else None
     theta = theta[:n_tn]
     z = np.linspace(-0.5 * length, 0.5 * length, n_z + 1)
     per_layer = n_tn * (n_z + 1)
@@ -90,7 +102,8 @@ def casing_mesh(
     jj, kk = np.meshgrid(np.arange(n_t), np.arange(n_z), indexing="ij")
     jj, kk = jj.ravel(), kk.ravel()
     for layer, r in enumerate(radii):
-        tt, zz = np.meshgrid(theta, z, indexing="ij")
+        tt, zz = np.meshgrid(theta if layer % 2 == 0 or theta_offset is None else theta_offset,
+                             z, indexing="ij")
         nodes.append(np.stack([r * np.cos(tt).ravel(), r * np.sin(tt).ravel(), zz.ravel()],
                               axis=1))
         base = layer * per_layer

@@ -256,7 +256,7 @@ def containment_mesh(m, sections) -> tuple[Mesh, list[str], np.ndarray]:
             radii, c.length, m.element_size, sector=math.degrees(c.sector),
             centre_angle=math.degrees(c.centre_angle),
             fine_sector=None if c.fine_sector is None else math.degrees(c.fine_sector),
-            coarse_size=c.coarse_element_size)
+            coarse_size=c.coarse_element_size, offset_layers=c.offset_layers)
         blade = blade_mesh(b.root_radius, b.tip_radius, b.crack_radius, b.root_chord,
                            b.tip_chord, m.element_size, angle=math.degrees(b.angle),
                            stagger=math.degrees(b.stagger))

@@ -30,8 +30,9 @@ Schema (see README and examples/cases/)::
     [[boundary]]      nodes = SET, type = clamped | pinned | symmetry_x | symmetry_y |
                       symmetry_z | velocity (with dof and velocity)
                       | kind = "containment": element_size, [mesh.casing] (inner_radius,
-                      length, sector, centre_angle, inner_section, layer_section, layers,
-                      layer_spacing), [mesh.blade] (section, root/crack/tip_radius,
+                      length, sector, centre_angle, fine_sector, coarse_element_size,
+                      inner_section, layer_section, layers, layer_spacing,
+                      offset_layers), [mesh.blade] (section, root/crack/tip_radius,
                       root/tip_chord, angle, stagger)
     [spin]            rate, release_time, relaxation_tolerance (containment cases)
     [amplitude]       ramp_time (smooth step of prescribed velocities, thesis Fig. 8-3)
@@ -192,6 +193,9 @@ class CasingSpec(BaseModel):
     layer_section: str = Field(min_length=1)
     layers: int = Field(ge=1, le=200)
     layer_spacing: Length | None = None
+    # every second layer turned by half an element about the axis (full ring only): a
+    # node faces an element edge of the next layer, not a corner of four (theory §8)
+    offset_layers: bool = False
 
     @model_validator(mode="after")
     def _grading_needs_both(self):

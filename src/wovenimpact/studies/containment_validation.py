@@ -247,7 +247,13 @@ def intro_lines() -> list[str]:
             "spin state and release: docs/theory.md §8) against the full casing ring, "
             "graded: `element_size` within 150° about the impact zone, growing to the coarse "
             "size around the rest. The thesis's numbers are trends to compare with, not "
-            "targets; nothing is tuned to them.", ""]
+            "targets; nothing is tuned to them.", "",
+            "Why ours differ (docs/theory.md §8.6, sensitivity runs, not tuning): two inputs "
+            "the thesis does not print each move the exit speed by more than the gap — how "
+            "the blade meets the casing (our flat blade's chord lies along the axis, face-on "
+            "to its flight; turned 45° or 60° about its span it cuts instead of slapping and "
+            "the casing takes far less) and the hybrid casing's inner aluminium shell (ours "
+            "1 mm).", ""]
 
 
 def runs_lines(ladders: dict[str, list[dict]], unfinished: list[str]) -> list[str]:

@@ -155,6 +155,22 @@ def test_a_report_from_given_runs_sorts_them_into_ladders_and_names_what_is_unfi
         cv.rows_from_runs([runs])
 
 
+def test_two_runs_of_one_ladder_at_the_same_count_are_refused(tmp_path):
+    """``--runs`` given a sensitivity run beside the ladder's (the same 4 layers, another
+    blade) would put two points at one N in the table and the regression: refused,
+    naming both folders."""
+    from wovenimpact.errors import InputError
+
+    runs = tmp_path / "runs"
+    _run_dir(runs, "m4", 4, ("aluminium",), "escaped", 96.7, 5.6)
+    _run_dir(runs, "m8", 8, ("aluminium",), "escaped", 36.3, 11.1)
+    assert [r[cv.KEY] for r in cv.rows_from_runs([runs])[0]["containment_metal"]] == [4, 8]
+    _run_dir(tmp_path / "sens", "m4_stagger45", 4, ("aluminium",), "escaped", 122.0, 5.6)
+    with pytest.raises(InputError, match=r"two finished runs of the containment_metal "
+                       r"ladder at 4 layers: .*m4 and .*m4_stagger45"):
+        cv.rows_from_runs([runs, tmp_path / "sens"])
+
+
 def test_validate_containment_from_runs_names_its_command_and_set_needs_containment(tmp_path):
     """The report made from ``--runs`` says the command that made it; ``--set`` or
     ``--runs`` without ``--containment`` is refused (the chapter-7 studies run their own

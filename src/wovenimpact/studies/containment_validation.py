@@ -287,7 +287,10 @@ def rows_from_runs(paths) -> dict[str, list[dict]]:
     path is a run (it holds summary.json) or a folder of runs. A run cut short (a
     checkpoint, no summary) cannot say which ladder it belongs to: it is listed apart,
     with the time it reached. Every row carries its elements and its code's source
-    digest. Returns the rows of each ladder, sorted by N, and the unfinished runs."""
+    digest. Two finished runs of one ladder at the same N are refused (InputError naming
+    both): a summary does not say which other input differs (a sensitivity run: another
+    blade stagger, shell or mesh), and a ladder must have one point per N. Returns the
+    rows of each ladder, sorted by N, and the unfinished runs."""
     import json
 
     from wovenimpact.containment import exit_speed_settled
@@ -318,9 +321,17 @@ def rows_from_runs(paths) -> dict[str, list[dict]]:
         if SETTLED not in summary and (d / "history.csv").exists():  # an older summary
             summary[SETTLED] = exit_speed_settled(read_csv(d / "history.csv"),
                                                   summary.get("outcome", ""))
-        out[name].append({**summary, "id": d.name, "status": "done", KEY: n,
+        out[name].append({**summary, "id": d.name, "path": str(d), "status": "done", KEY: n,
                           "source_digest": summary.get("provenance", {}).get("source_digest")})
-    for rows in out.values():
+    for name, rows in out.items():
         rows.sort(key=lambda r: float(r[KEY]))
+        for a, b in zip(rows, rows[1:]):
+            if a[KEY] == b[KEY]:
+                unit = next(u for n, _, u, _, _ in LADDERS if n == name)
+                raise InputError(
+                    f"--runs: two finished runs of the {name} ladder at {a[KEY]} {unit}: "
+                    f"{a['path']} and {b['path']}; a ladder takes one run per number of "
+                    f"{unit} — pass the folders of one ladder (a run with another blade, "
+                    "shell or mesh belongs to another report)")
     return out, unfinished
 

@@ -98,3 +98,19 @@ def test_any_case_value_gives_a_clean_error_or_a_sane_run(doc):
             return
     event("accepted and run")
     sane_steps(compiled)  # accepted: it must run (a SimulationError fails the test)
+
+
+def test_an_unknown_key_under_a_mesh_kind_lists_the_keys_of_that_kind():
+    """pydantic puts the tagged union's tag in the error path (mesh.containment.blade.x);
+    the message names mesh.blade.x and lists the blade's keys, not an empty list."""
+    import pytest
+
+    from wovenimpact.spec.case import load_case
+
+    case = Path(__file__).resolve().parents[2] / "examples" / "containment" / "hybrid_4.toml"
+    with pytest.raises(InputError) as err:
+        load_case(case, ["mesh.blade.twistt=3 deg", "mesh.sizee=3"])
+    msg = str(err.value)
+    assert "mesh.blade.twistt: unknown key 'twistt'" in msg
+    assert "one of the keys section, root_radius" in msg and "tip_curve" in msg
+    assert "mesh.sizee: unknown key 'sizee' (got 3; valid: one of the keys kind, element_size" in msg

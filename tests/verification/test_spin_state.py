@@ -165,12 +165,16 @@ def test_released_fragment_flies_straight_at_omega_r_cm():
     assert np.allclose(np.hypot(st.x[root, 0], st.x[root, 1]), 0.05, rtol=1e-3)
 
 
-@pytest.mark.parametrize("size", ["7.5 mm", "10 mm"])
-def test_the_default_blade_relaxes_with_coarse_elements(size):
+@pytest.mark.parametrize("size, blade", [
+    ("7.5 mm", {}), ("10 mm", {}),
+    ("7.5 mm", {"stagger": "20 deg", "twist": "35 deg", "tip_curve": "10 mm"}),
+])
+def test_the_default_blade_relaxes_with_coarse_elements(size, blade):
     """The default blade of the containment examples, 4.98 mm of titanium, relaxes to its
     spin state with 7.5 and 10 mm elements (at the full stable step the relaxation
     stalled on them: a mode at the stability limit made the kinetic energy peak every
-    other step); compiling the case raises if it does not converge."""
+    other step); compiling the case raises if it does not converge. So does a twisted
+    blade with a curved tip, and its fragment too starts at ω r_cm (0.1 %)."""
     from pathlib import Path
 
     from wovenimpact.model.compile import compile_case
@@ -180,6 +184,8 @@ def test_the_default_blade_relaxes_with_coarse_elements(size):
     path = Path(__file__).resolve().parents[2] / "examples" / "containment" / "hybrid_4.toml"
     doc = read_toml(path, "case file")
     set_dotted(doc, "mesh.element_size", size)
+    for key, value in blade.items():
+        set_dotted(doc, f"mesh.blade.{key}", value)
     set_dotted(doc, "mesh.casing.sector", "30 deg")  # the casing does not take part
     for key in ("fine_sector", "coarse_element_size"):  # nor its grading
         doc["mesh"]["casing"].pop(key, None)
@@ -308,3 +314,90 @@ def test_offset_layers_put_a_node_over_an_edge_middle_not_a_corner_of_four():
         assert np.all(count == expect)
     with pytest.raises(InputError, match="offset_layers needs the full ring"):
         casing_mesh(radii, 0.15, size, sector=120.0, offset_layers=True)
+
+
+def chord_rows(mesh):
+    """The blade's nodes as (stations, chordwise) rows: blade_mesh numbers them station by
+    station, leading to trailing edge (the root set is the first station)."""
+    return mesh.nodes.reshape(-1, mesh.node_sets["root"].size, 3)
+
+
+def test_a_twisted_blade_turns_its_chord_linearly_along_the_span():
+    """stagger 20°, twist 30°, along +y (angle 90°): every station's chord is a straight
+    line through the radial axis, turned from the axial direction towards the
+    tangential one by 20° + 30° (r − r_root)/(r_tip − r_root) (1e-9 rad), its length
+    the tapered chord; a zero twist gives the flat blade of the stagger alone."""
+    kw = dict(angle=90.0, stagger=20.0)
+    mesh = blade_mesh(0.04, 0.245, 0.06, 0.08, 0.04, 5e-3, twist=30.0, **kw)
+    rows = chord_rows(mesh)
+    lead, trail = rows[:, 0], rows[:, -1]
+    r = 0.5 * (lead[:, 1] + trail[:, 1])  # radial = +y
+    chord = trail - lead
+    tangential = -chord[:, 0]  # e_t = (−sin a, cos a, 0) = −x at 90°
+    turned = np.degrees(np.arctan2(tangential, chord[:, 2]))
+    span = (r - 0.04) / (0.245 - 0.04)
+    assert np.allclose(np.radians(turned), np.radians(20.0 + 30.0 * span), atol=1e-9, rtol=0)
+    assert np.allclose(np.linalg.norm(chord, axis=1), 0.08 - 0.04 * span, rtol=1e-12)
+    # each chord is straight and centred on the radial axis
+    mid = rows.mean(axis=1)
+    assert np.allclose(mid[:, [0, 2]], 0.0, atol=1e-15)
+    off = rows - lead[:, None, :]
+    assert np.allclose(np.cross(off, chord[:, None, :]), 0.0, atol=1e-15)
+    flat = blade_mesh(0.04, 0.245, 0.06, 0.08, 0.04, 5e-3, **kw)
+    untwisted = blade_mesh(0.04, 0.245, 0.06, 0.08, 0.04, 5e-3, twist=0.0, **kw)
+    assert np.array_equal(flat.nodes, untwisted.nodes)
+
+
+def test_a_curved_tip_is_a_circular_arc_and_leaves_the_hub_and_crack_line_alone():
+    """tip_curve 10 mm on a 40 mm tip chord: the tip row lies on the circular arc through
+    the mid-chord point at r_tip and the corners 10 mm inboard (1e-12 m), the hub part
+    and the crack line are those of the straight-tipped blade bit for bit, and the
+    fragment's stations stay in order along every chordwise line (no folded element)."""
+    args = (0.04, 0.245, 0.06, 0.08, 0.04, 5e-3)
+    straight = blade_mesh(*args)
+    curved = blade_mesh(*args, tip_curve=0.01)
+    rows = chord_rows(curved)
+    r = rows[..., 0]  # radial = +x at angle 0
+    w = rows[..., 2]  # chordwise = z at no stagger
+    d, c = 0.01, 0.04
+    rho = (c * c / 4 + d * d) / (2 * d)
+    centre = 0.245 - rho
+    assert np.allclose((r[-1] - centre) ** 2 + w[-1] ** 2, rho**2, atol=1e-12, rtol=0)
+    assert r[-1, 0] == pytest.approx(0.235, abs=1e-12) and r[-1, -1] == pytest.approx(0.235)
+    assert r[-1, r.shape[1] // 2] == pytest.approx(0.245, abs=1e-12)
+    hub = np.hypot(straight.nodes[:, 0], straight.nodes[:, 1]) <= 0.06 + 1e-12
+    assert np.array_equal(curved.nodes[hub], straight.nodes[hub])
+    assert np.all(np.diff(r, axis=0) > 0.0)
+    assert np.all(curved.area_vectors()[:, 1] < 0.0) == np.all(straight.area_vectors()[:, 1] < 0.0)
+
+
+@pytest.mark.parametrize("kwargs, field", [
+    ({"tip_curve": 0.2}, "tip_curve"),
+    ({"tip_curve": -0.001}, "tip_curve"),
+    ({"stagger": 60.0, "twist": 40.0}, "stagger \\+ twist"),
+    ({"stagger": 95.0}, "stagger"),
+])
+def test_a_blade_refuses_what_it_cannot_build(kwargs, field):
+    with pytest.raises(InputError, match=field):
+        blade_mesh(0.04, 0.245, 0.06, 0.08, 0.04, 5e-3, **kwargs)
+
+
+def test_a_blade_whose_staggered_corners_reach_the_casing_is_refused():
+    """A 200 mm tip chord turned 90° reaches r = √(245² + 100²) mm, beyond the 250 mm
+    casing although tip_radius is inside it: the case is refused, naming the reach."""
+    from pathlib import Path
+
+    from wovenimpact.model.compile import compile_case
+    from wovenimpact.spec.case import case_from_dict
+    from wovenimpact.spec.fields import read_toml, set_dotted
+
+    path = Path(__file__).resolve().parents[2] / "examples" / "containment" / "hybrid_4.toml"
+    doc = read_toml(path, "case file")
+    for key, value in (("mesh.element_size", "20 mm"), ("mesh.casing.sector", "30 deg"),
+                       ("mesh.blade.tip_chord", "200 mm"), ("mesh.blade.root_chord", "200 mm"),
+                       ("mesh.blade.stagger", "90 deg")):
+        set_dotted(doc, key, value)
+    for key in ("fine_sector", "coarse_element_size"):
+        doc["mesh"]["casing"].pop(key, None)
+    with pytest.raises(InputError, match=r"farthest node lies at r = 0\.264"):
+        compile_case(case_from_dict(doc, source=str(path)), path.parent)

@@ -207,11 +207,26 @@ def blade_mesh(
     element_size: float,
     angle: float = 0.0,
     stagger: float = 0.0,
+    twist: float = 0.0,
+    tip_curve: float = 0.0,
 ) -> Mesh:
-    """A flat tapered blade from ``root_radius`` to ``tip_radius`` along the radial
+    """A tapered blade from ``root_radius`` to ``tip_radius`` along the radial
     direction at ``angle`` (degrees from +x), its chord along z (linear taper from
     ``root_chord`` to ``tip_chord``), turned by ``stagger`` (degrees) about its radial
     axis; it spins about the z axis.
+
+    Twisted planform: the stagger grows linearly along the span, s(r) = stagger +
+    twist (r − r_root)/(r_tip − r_root) (degrees; 0: a flat blade); each radial
+    station is a straight chord through the radial axis, so the surface between two
+    stations is a ruled (slightly warped) one.
+
+    Curved tip (the thesis's ch. 8.2: its blade's outer edge is a curve, so that no
+    sharp corner strikes the casing first): the tip edge is a circular arc in the
+    chord's coordinate u ∈ [−½, ½] whose mid-chord point lies at ``tip_radius`` and
+    whose corners lie ``tip_curve`` (m) inboard of it,
+    r_tip(u) = r_tip − ρ + √(ρ² − (u c_tip)²), ρ = (c_tip²/4 + d²)/(2d); the fragment's
+    stations between the crack line and the tip are spaced in proportion along each
+    chordwise line, so the crack line stays straight (0: a straight tip).
 
     The radial divisions put a node row exactly at ``crack_radius``; the row of
     elements just outboard of it is the element set ``release`` (eroded at release:
@@ -225,6 +240,14 @@ def blade_mesh(
     for label, c in (("root_chord", root_chord), ("tip_chord", tip_chord)):
         if not (math.isfinite(c) and c > 0.0):
             raise InputError(f"blade {label} = {c!r} m must be > 0")
+    if not (math.isfinite(tip_curve) and 0.0 <= tip_curve <= 0.5 * (tip_radius - crack_radius)):
+        raise InputError(f"blade tip_curve = {tip_curve!r} m: need 0 ≤ tip_curve ≤ half the "
+                         f"fragment's span, (tip_radius − crack_radius)/2 = "
+                         f"{0.5 * (tip_radius - crack_radius):g} m")
+    for label, a in (("stagger", stagger), ("stagger + twist", stagger + twist)):
+        if not (math.isfinite(a) and abs(a) <= 90.0 + 1e-9):  # "90 deg" read through radians
+            raise InputError(f"blade {label} = {a!r} deg must lie within [−90, 90] deg (the "
+                             "chord turned from the axial direction towards the tangential)")
     n_in = _divisions(crack_radius - root_radius, element_size, "blade hub length")
     n_out = _divisions(tip_radius - crack_radius, element_size, "blade fragment length")
     n_c = _divisions(min(root_chord, tip_chord), element_size, "blade chord")
@@ -232,12 +255,26 @@ def blade_mesh(
                         np.linspace(crack_radius, tip_radius, n_out + 1)[1:]])
     u = np.linspace(-0.5, 0.5, n_c + 1)
     rr, uu = np.meshgrid(r, u, indexing="ij")
-    chord = root_chord + (rr - root_radius) / (tip_radius - root_radius) * (tip_chord - root_chord)
-    a, s = math.radians(angle), math.radians(stagger)
+    span = (rr - root_radius) / (tip_radius - root_radius)
+    chord = root_chord + span * (tip_chord - root_chord)
+    rad = rr.copy()
+    if tip_curve > 0.0:
+        rho = (0.25 * tip_chord**2 + tip_curve**2) / (2.0 * tip_curve)
+        r_tip = tip_radius - rho + np.sqrt(rho**2 - (u * tip_chord) ** 2)
+        frag = rr > crack_radius
+        xi = (rr - crack_radius) / (tip_radius - crack_radius)
+        rad[frag] = (crack_radius + xi * (r_tip[None, :] - crack_radius))[frag]
+    a = math.radians(angle)
     e_r = np.array([math.cos(a), math.sin(a), 0.0])
     e_t = np.array([-math.sin(a), math.cos(a), 0.0])
-    e_c = math.cos(s) * np.array([0.0, 0.0, 1.0]) + math.sin(s) * e_t  # chord direction
-    nodes = rr.ravel()[:, None] * e_r + (uu * chord).ravel()[:, None] * e_c
+    e_z = np.array([0.0, 0.0, 1.0])
+    if twist == 0.0:  # one chord direction
+        s = math.radians(stagger)
+        e_c = math.cos(s) * e_z + math.sin(s) * e_t
+    else:  # the chord direction of each station
+        s = np.radians(stagger + twist * span).ravel()[:, None]
+        e_c = np.cos(s) * e_z + np.sin(s) * e_t
+    nodes = rad.ravel()[:, None] * e_r + (uu * chord).ravel()[:, None] * e_c
     n_r = len(r) - 1
     ii, jj = np.meshgrid(np.arange(n_r), np.arange(n_c), indexing="ij")
     ii, jj = ii.ravel(), jj.ravel()

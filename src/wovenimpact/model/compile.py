@@ -259,9 +259,17 @@ def containment_mesh(m, sections) -> tuple[Mesh, list[str], np.ndarray]:
             coarse_size=c.coarse_element_size, offset_layers=c.offset_layers)
         blade = blade_mesh(b.root_radius, b.tip_radius, b.crack_radius, b.root_chord,
                            b.tip_chord, m.element_size, angle=math.degrees(b.angle),
-                           stagger=math.degrees(b.stagger))
+                           stagger=math.degrees(b.stagger), twist=math.degrees(b.twist),
+                           tip_curve=b.tip_curve)
     except InputError as err:
         raise InputError(f"mesh: {err}") from None
+    # a staggered chord reaches beyond tip_radius at its corners (√(r² + (c/2 sin s)²))
+    reach = float(np.hypot(blade.nodes[:, 0], blade.nodes[:, 1]).max())
+    if not reach < c.inner_radius:
+        raise InputError(f"mesh.blade: the blade's farthest node lies at r = {reach:g} m, not "
+                         f"inside the casing (mesh.casing.inner_radius = {c.inner_radius:g} "
+                         "m); a staggered chord's corners reach beyond tip_radius: lower "
+                         "tip_radius, tip_chord or the stagger, or give a tip_curve")
     mesh = join(casing, blade, prefixes=("casing.", "blade."))
     elem_sections = [names[k] for k in casing.ply] + [b.section] * blade.n_elems
     e_r = np.array([math.cos(b.angle), math.sin(b.angle), 0.0])

@@ -33,7 +33,7 @@ Schema (see README and examples/cases/)::
                       length, sector, centre_angle, fine_sector, coarse_element_size,
                       inner_section, layer_section, layers, layer_spacing,
                       offset_layers), [mesh.blade] (section, root/crack/tip_radius,
-                      root/tip_chord, angle, stagger)
+                      root/tip_chord, angle, stagger, twist, tip_curve)
     [spin]            rate, release_time, relaxation_tolerance (containment cases)
     [amplitude]       ramp_time (smooth step of prescribed velocities, thesis Fig. 8-3)
     [[initial_velocity]]  nodes = SET, velocity = [vx, vy, vz] and/or
@@ -212,7 +212,12 @@ class BladeSpec(BaseModel):
     60 mm (the released fragment is the airfoil outboard of it: 0.237 kg of titanium
     4.98 mm thick, centre of mass at r = 142.9 mm, so ω r_cm = 149.6 m/s at 1047 rad/s),
     tip 245 mm (5 mm inside a 250 mm casing), chords 80 mm at the root and 40 mm at the
-    tip, radial along ``angle`` (from +x), no stagger.
+    tip, radial along ``angle`` (from +x), no stagger, no twist, a straight tip.
+
+    ``stagger``: the chord turned from the axial direction towards the tangential one
+    at the root; ``twist``: how much more it is turned at the tip (linear along the
+    span); ``tip_curve``: the depth of a curved tip edge (a circular arc whose corners
+    lie this far inboard of its mid-chord point; the thesis's blade has one).
     """
 
     model_config = STRICT
@@ -224,6 +229,8 @@ class BladeSpec(BaseModel):
     tip_chord: Length = 0.04
     angle: quantity("angle", example="90 deg") = 0.0
     stagger: quantity("angle", example="30 deg") = 0.0
+    twist: quantity("angle", example="25 deg") = 0.0
+    tip_curve: quantity("length", ge=0, example="10 mm") = 0.0
 
 
 class ContainmentMeshSpec(BaseModel):

@@ -256,13 +256,41 @@ def _submodel(annotation: Any) -> type[BaseModel] | None:
     return None
 
 
+def _union_members(annotation: Any) -> list[type[BaseModel]]:
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return [annotation]
+    if typing.get_origin(annotation) in (typing.Union, types.UnionType):
+        return [m for arg in typing.get_args(annotation) for m in _union_members(arg)]
+    return []
+
+
 def _model_at(root: type[BaseModel], loc: tuple) -> type[BaseModel] | None:
+    """The model at ``loc`` below root. A tagged union (``Field(discriminator=...)``)
+    puts its member's tag in pydantic's error path (``mesh.containment.blade.x``): the
+    tag selects that member."""
     model: type[BaseModel] | None = root
+    members: list[type[BaseModel]] = []
     for part in loc:
+        tagged = [m for m in members if _tag_of(m, discriminator) == part] if members else []
+        if tagged:
+            model, members = tagged[0], []
+            continue
         if model is None or isinstance(part, int) or part not in model.model_fields:
             return None
-        model = _submodel(model.model_fields[part].annotation)
+        info = model.model_fields[part]
+        model = _submodel(info.annotation)
+        discriminator = info.discriminator if isinstance(info.discriminator, str) else None
+        members = _union_members(info.annotation) if discriminator else []
     return model
+
+
+def _tag_of(model: type[BaseModel], discriminator: str | None) -> Any:
+    """The Literal value of a tagged-union member's discriminator field (or None)."""
+    info = model.model_fields.get(discriminator) if discriminator else None
+    if info is None or typing.get_origin(info.annotation) is not typing.Literal:
+        return None
+    args = typing.get_args(info.annotation)
+    return args[0] if len(args) == 1 else None
 
 
 def _valid_for(root: type[BaseModel], loc: tuple) -> str:

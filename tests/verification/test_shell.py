@@ -389,8 +389,12 @@ def test_hourglass_energy_stays_small_in_an_impulsively_loaded_plate():
 
 def test_steps_are_bitwise_identical_with_one_or_two_threads():
     """The same Model and State give bitwise the same State after 30 steps of a
-    fabric plate under impact-like loading, with one thread or two."""
+    fabric plate under impact-like loading, with one thread or two, and with the
+    element loop handed out in chunks of 256 (the default), 7 or in one share per
+    thread (0)."""
     import numba
+
+    from wovenimpact.solver import explicit
 
     from tests.conftest import reference_fabric
     from wovenimpact.jit import set_threads
@@ -409,9 +413,10 @@ def test_steps_are_bitwise_identical_with_one_or_two_threads():
     results = []
     before = numba.get_num_threads()
     try:
-        for threads in (1, 2):
+        for threads, chunk in ((1, 256), (2, 256), (2, 7), (2, 0)):
             set_threads(threads)
             assert numba.get_num_threads() == threads
+            explicit.ELEMENT_CHUNK = chunk
             st = initial_state(model, velocity=v0)
             ws = Workspace.for_model(model, st)
             for _ in range(30):
@@ -419,7 +424,9 @@ def test_steps_are_bitwise_identical_with_one_or_two_threads():
             results.append(st)
     finally:
         set_threads(before)
-    assert len(results) == 2 and results[1].equals(results[0])
+        explicit.ELEMENT_CHUNK = 256
+    assert model.n_elems > 2 * 7  # chunks of 7 split the loop
+    assert len(results) == 4 and all(r.equals(results[0]) for r in results[1:])
     assert results[0].mat[:, FL.S_TENSION].max() > 0.0  # yarn tensions were exercised
 
 

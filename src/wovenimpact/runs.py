@@ -549,9 +549,9 @@ COMMON_SUMMARY_KEYS = (
 
 def summary_keys(spec) -> tuple[str, ...]:
     """The keys summary.json will have for a case (the metrics a study may ask for)."""
-    from wovenimpact.spec.case import ContainmentMeshSpec
+    from wovenimpact.spec.case import is_containment_spec
 
-    extra = (CONTAINMENT_SUMMARY_KEYS if isinstance(spec.mesh, ContainmentMeshSpec)
+    extra = (CONTAINMENT_SUMMARY_KEYS if is_containment_spec(spec)
              else IMPACT_SUMMARY_KEYS if spec.impactor is not None else ())
     return tuple(dict.fromkeys(COMMON_SUMMARY_KEYS + extra))
 

@@ -113,4 +113,5 @@ def test_an_unknown_key_under_a_mesh_kind_lists_the_keys_of_that_kind():
     msg = str(err.value)
     assert "mesh.blade.twistt: unknown key 'twistt'" in msg
     assert "one of the keys section, root_radius" in msg and "tip_curve" in msg
-    assert "mesh.sizee: unknown key 'sizee' (got 3; valid: one of the keys kind, element_size" in msg
+    assert ("mesh.sizee: unknown key 'sizee' (got 3; valid: one of the keys kind, "
+            "element_size") in msg

@@ -295,6 +295,74 @@ def section_thickness(section: Section, key: str) -> float:
     return float(t)
 
 
+def containment_sets(mesh: Mesh, sets, file: str) -> None:
+    """Give an imported mesh the set names of a generated containment mesh (theory §8.1):
+    ``blade.blade``, ``blade.release`` (element sets), ``blade.root``, ``blade.fragment``
+    (node sets) and ``casing.layer{k}`` (node sets, and element sets where the file's set
+    is one), from the file's sets that ``[mesh.containment]`` names (``sets``:
+    spec.case.ContainmentSetsSpec). Refuses a missing or empty set, a root, release or
+    fragment outside the blade, and a release set that does not separate the fragment
+    from the hub part (an element outside it with nodes on both sides would keep them
+    joined)."""
+    key = "mesh.containment"
+
+    def elems(name: str, field: str) -> np.ndarray:
+        if name not in mesh.elem_sets:
+            raise InputError(f"{key}.{field}: {name!r} is not an element set of {file}; "
+                             f"element sets there: {sorted(mesh.elem_sets)}")
+        idx = np.unique(np.asarray(mesh.elem_sets[name], dtype=np.int64))
+        if idx.size == 0:
+            raise InputError(f"{key}.{field}: element set {name!r} of {file} is empty")
+        return idx
+
+    def nodes(name: str, field: str) -> np.ndarray:
+        if name in mesh.node_sets:
+            idx = np.unique(np.asarray(mesh.node_sets[name], dtype=np.int64))
+        elif name in mesh.elem_sets:
+            idx = np.unique(mesh.quads[np.asarray(mesh.elem_sets[name], dtype=np.int64)])
+        else:
+            raise InputError(f"{key}.{field}: {name!r} is neither a node set nor an element "
+                             f"set of {file}; node sets there: {sorted(mesh.node_sets)}")
+        if idx.size == 0:
+            raise InputError(f"{key}.{field}: set {name!r} of {file} holds no node")
+        return idx
+
+    blade = elems(sets.blade, "blade")
+    release = elems(sets.release, "release")
+    blade_nodes = np.unique(mesh.quads[blade])
+    root = nodes(sets.root, "root")
+    fragment = nodes(sets.fragment, "fragment")
+    for field, idx, within in (("release", release, blade), ("root", root, blade_nodes),
+                               ("fragment", fragment, blade_nodes)):
+        out = idx[~np.isin(idx, within)]
+        if out.size:
+            raise InputError(f"{key}.{field}: {out.size} of its entries (first: {out[0]}) are "
+                             f"not in the blade {sets.blade!r}")
+    kept = blade[~np.isin(blade, release)]
+    on_fragment = np.isin(mesh.quads[kept], fragment)
+    joined = kept[on_fragment.any(axis=1) & ~on_fragment.all(axis=1)]
+    if joined.size:
+        raise InputError(f"{key}.release: element {joined[0]} of the blade, not in "
+                         f"{sets.release!r}, has nodes on both sides of the fragment "
+                         f"{sets.fragment!r}: the release set must hold every element joining "
+                         "the fragment to the hub part")
+    if np.isin(root, fragment).any():
+        raise InputError(f"{key}.root: the root nodes must lie on the hub part, not on the "
+                         f"fragment {sets.fragment!r}")
+    mesh.elem_sets["blade.blade"] = blade
+    mesh.elem_sets["blade.release"] = release
+    mesh.node_sets["blade.root"] = root
+    mesh.node_sets["blade.fragment"] = fragment
+    for k, name in enumerate(sets.casing_layers):
+        layer = nodes(name, f"casing_layers[{k}]")
+        if np.isin(layer, blade_nodes).any():
+            raise InputError(f"{key}.casing_layers[{k}]: set {name!r} shares nodes with the "
+                             "blade")
+        mesh.node_sets[f"casing.layer{k}"] = layer
+        if name in mesh.elem_sets:
+            mesh.elem_sets[f"casing.layer{k}"] = np.asarray(mesh.elem_sets[name], dtype=np.int64)
+
+
 def spin_blade(model: Model, state: State, mesh: Mesh, section: Section, omega, tol,
                warp) -> None:
     """The blade's steady spin state (solver.relaxation) written into ``state``: the
@@ -351,6 +419,16 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         mesh, elem_sections = make_mesh(spec, base, sections)
         if isinstance(warp, str):  # "circumferential" (an imported casing)
             warp = circumferential_directions(mesh, spec.mesh.axis)
+        if getattr(spec.mesh, "containment", None) is not None:
+            containment_sets(mesh, spec.mesh.containment, spec.mesh.file)
+            # the blade's warp is radial, as a generated blade's (it lies in the plane of
+            # the axis, normal to the casing's hoop direction)
+            warp = np.array(np.broadcast_to(np.asarray(warp, dtype=float),
+                                            (mesh.n_elems, 3)))
+            blade = mesh.elem_sets["blade.blade"]
+            c = mesh.nodes[mesh.quads[blade]].mean(axis=1)
+            radial = np.c_[c[:, :2], np.zeros(len(c))]
+            warp[blade] = radial / np.linalg.norm(radial, axis=1)[:, None]
     bcs = BoundaryConditions(mesh.n_nodes, ramp_time=spec.amplitude.ramp_time)
     for i, b in enumerate(spec.boundary):
         nodes = node_set(mesh, b.nodes, f"boundary[{i}].nodes")
@@ -368,10 +446,7 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         else:
             bcs.prescribe(nodes, DOFS.index(b.dof), b.velocity)
     spin = None if spec.spin is None else np.array([0.0, 0.0, spec.spin.rate])
-    if spin is not None:
-        if not isinstance(spec.mesh, ContainmentMeshSpec):
-            raise InputError("spin: only a containment mesh (mesh.kind = 'containment') has a "
-                             "blade to spin")
+    if spin is not None:  # a containment mesh (spec.case.check_references)
         bcs.rotate(mesh.node_sets["blade.root"], spin)
     accel = None if spec.body_force is None else spec.body_force.acceleration
     bodies = []
@@ -434,7 +509,11 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     state = initial_state(model, velocity=v, angular_velocity=w)
     check_case(spec, model, state, mesh, sections)  # model.sanity: before the expensive parts
     if spin is not None:
-        spin_blade(model, state, mesh, sections[spec.mesh.blade.section], spin,
+        blade = {elem_sections[e] for e in mesh.elem_sets["blade.blade"]}
+        if len(blade) != 1:
+            raise InputError(f"mesh.containment.blade: the blade's elements have sections "
+                             f"{sorted(blade)}; its spin state needs one section")
+        spin_blade(model, state, mesh, sections[blade.pop()], spin,
                    spec.spin.relaxation_tolerance, warp)
     for i, er in enumerate(spec.initial_erosion):
         erode_at_start(model, state, er, f"initial_erosion[{i}]")

@@ -420,9 +420,11 @@ def material_frame_gradients(x0, quads, warp_direction):
     norm1 = np.linalg.norm(e1, axis=1)
     bad = np.flatnonzero(norm1 < 1e-8)
     if bad.size:
+        e = int(bad[0])
         raise InputError(
-            f"warp_direction {np.asarray(warp_direction).tolist()} is normal to element "
-            f"{int(bad[0])}; give a direction lying in the fabric plane"
+            f"warp_direction {w[e].tolist()} is normal to element {e} (nodes "
+            f"{quads[e].tolist()}){f' and {bad.size - 1} more' if bad.size > 1 else ''}; "
+            "give a direction lying in the fabric plane"
         )
     e1 /= norm1[:, None]
     e2 = np.cross(e3, e1)

@@ -26,14 +26,16 @@ Schema (see README and examples/cases/)::
     [mesh]            kind = "plate": side, element_size, plies, spacing, quarter,
                       section, warp_direction   | kind = "abaqus" | "gmsh": file,
                       sections = {ELSET = SECTION}, length_unit?, warp_direction?
-                      (vector | "circumferential"), axis?
-    [[boundary]]      nodes = SET, type = clamped | pinned | symmetry_x | symmetry_y |
-                      symmetry_z | velocity (with dof and velocity)
+                      (vector | "circumferential"), axis?, [mesh.containment]? (blade,
+                      root, release, fragment, casing_layers: the file's sets of a
+                      casing and fan blade of the user's own geometry)
                       | kind = "containment": element_size, [mesh.casing] (inner_radius,
                       length, sector, centre_angle, fine_sector, coarse_element_size,
                       inner_section, layer_section, layers, layer_spacing,
                       offset_layers), [mesh.blade] (section, root/crack/tip_radius,
                       root/tip_chord, angle, stagger, twist, tip_curve)
+    [[boundary]]      nodes = SET, type = clamped | pinned | symmetry_x | symmetry_y |
+                      symmetry_z | velocity (with dof and velocity)
     [spin]            rate, release_time, relaxation_tolerance (containment cases)
     [amplitude]       ramp_time (smooth step of prescribed velocities, thesis Fig. 8-3)
     [[initial_velocity]]  nodes = SET, velocity = [vx, vy, vz] and/or
@@ -147,13 +149,31 @@ class PlateMeshSpec(BaseModel):
     warp_direction: Direction = (1.0, 0.0, 0.0)
 
 
+class ContainmentSetsSpec(BaseModel):
+    """``[mesh.containment]`` of an imported mesh: the file's sets that make it a
+    containment model (a casing and a fan blade of the user's own geometry, turning about
+    the z axis through the origin; theory §8.1). ``blade``: element set of the whole
+    blade (relaxed to its spin state); ``root``: node set turned rigidly about the axis;
+    ``release``: element set eroded at ``spin.release_time``, which must separate the
+    fragment from the hub part; ``fragment``: node set of the released fragment;
+    ``casing_layers``: one node or element set per casing layer, innermost first."""
+
+    model_config = STRICT
+    blade: str = Field(min_length=1)
+    root: str = Field(min_length=1)
+    release: str = Field(min_length=1)
+    fragment: str = Field(min_length=1)
+    casing_layers: list[str] = Field(min_length=1)
+
+
 class ImportedMeshSpec(BaseModel):
     """``[mesh] kind = "abaqus"`` (an ``.inp`` file) or ``"gmsh"`` (a ``.msh`` file):
     nodes, shell elements and sets read through meshio. ``length_unit`` is the length
     of one coordinate unit of the file ("1 mm" for a mesh drawn in millimetres; default
     1 m). ``warp_direction`` is a vector projected on each element, or
     ``"circumferential"``: the hoop direction about ``axis`` (through the origin), the
-    warp of a fabric wrapped on a cylinder (a casing)."""
+    warp of a fabric wrapped on a cylinder (a casing). ``[mesh.containment]`` names the
+    sets of a containment model (:class:`ContainmentSetsSpec`)."""
 
     model_config = STRICT
     kind: Literal["abaqus", "gmsh"]
@@ -162,6 +182,7 @@ class ImportedMeshSpec(BaseModel):
     length_unit: quantity("length", gt=0, example="1 mm") = 1.0
     warp_direction: Direction | Literal["circumferential"] = (1.0, 0.0, 0.0)
     axis: Direction = (0.0, 0.0, 1.0)
+    containment: ContainmentSetsSpec | None = None
 
 
 AbaqusMeshSpec = ImportedMeshSpec  # the name of the table before gmsh files were read
@@ -458,6 +479,13 @@ def mesh_sections(mesh) -> list[tuple[str, str]]:
     return out
 
 
+def is_containment_spec(spec: CaseSpec) -> bool:
+    """A generated containment mesh, or an imported one naming its containment sets."""
+    m = spec.mesh
+    return isinstance(m, ContainmentMeshSpec) or (
+        isinstance(m, ImportedMeshSpec) and m.containment is not None)
+
+
 def check_references(spec: CaseSpec) -> list[Problem]:
     """Cross-references a schema cannot see: section → material, mesh → section."""
     problems = []
@@ -468,9 +496,19 @@ def check_references(spec: CaseSpec) -> list[Problem]:
     for key, s in mesh_sections(spec.mesh):
         if s not in spec.sections:
             problems.append(Problem(key, "names no section", s, f"one of {sorted(spec.sections)}"))
-    if isinstance(spec.mesh, ContainmentMeshSpec) and spec.spin is None:
+    if is_containment_spec(spec) and spec.spin is None:
         problems.append(Problem("spin", "is missing", valid="a [spin] table (rate, "
                                 "release_time) for a containment case"))
+    if spec.spin is not None and not is_containment_spec(spec):
+        problems.append(Problem("spin", "needs a blade to turn", valid="mesh.kind = "
+                                "'containment', or an imported mesh with a "
+                                "[mesh.containment] table naming its blade's sets"))
+    if isinstance(spec.mesh, ImportedMeshSpec) and spec.mesh.containment is not None and (
+            tuple(spec.mesh.axis) != (0.0, 0.0, 1.0)):
+        problems.append(Problem("mesh.axis", "must be the z axis for a containment model",
+                                list(spec.mesh.axis), "[0, 0, 1]: the blade turns and the "
+                                "casing's radii are measured about the z axis through the "
+                                "origin; place the model so"))
     plate = isinstance(spec.mesh, PlateMeshSpec)
     if plate and spec.mesh.ply_sections is not None and (
             len(spec.mesh.ply_sections) != spec.mesh.plies):

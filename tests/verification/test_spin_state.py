@@ -395,7 +395,8 @@ def test_a_blade_whose_staggered_corners_reach_the_casing_is_refused():
     doc = read_toml(path, "case file")
     for key, value in (("mesh.element_size", "20 mm"), ("mesh.casing.sector", "30 deg"),
                        ("mesh.blade.tip_chord", "200 mm"), ("mesh.blade.root_chord", "200 mm"),
-                       ("mesh.blade.stagger", "90 deg")):
+                       ("mesh.blade.stagger", "90 deg"), ("mesh.blade.twist", "0 deg"),
+                       ("mesh.blade.tip_curve", "0 mm")):
         set_dotted(doc, key, value)
     for key in ("fine_sector", "coarse_element_size"):
         doc["mesh"]["casing"].pop(key, None)

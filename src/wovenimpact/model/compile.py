@@ -272,10 +272,19 @@ def containment_mesh(m, sections) -> tuple[Mesh, list[str], np.ndarray]:
                          "tip_radius, tip_chord or the stagger, or give a tip_curve")
     mesh = join(casing, blade, prefixes=("casing.", "blade."))
     elem_sections = [names[k] for k in casing.ply] + [b.section] * blade.n_elems
-    e_r = np.array([math.cos(b.angle), math.sin(b.angle), 0.0])
     warp = np.concatenate([circumferential_directions(casing),
-                           np.tile(e_r, (blade.n_elems, 1))])
+                           radial_directions(blade, np.arange(blade.n_elems))])
     return mesh, elem_sections, warp
+
+
+def radial_directions(mesh: Mesh, elems: np.ndarray) -> np.ndarray:
+    """(len(elems), 3) unit radial direction (x, y, 0)/|…| at each element's centroid: a
+    blade's warp direction (it lies in the blade; the casing's hoop direction is normal
+    to a blade in the plane of the axis). The warp of an isotropic blade only frames its
+    element; one rule for generated and imported blades keeps their runs alike."""
+    c = mesh.nodes[mesh.quads[elems]].mean(axis=1)
+    radial = np.c_[c[:, :2], np.zeros(len(c))]
+    return radial / np.linalg.norm(radial, axis=1)[:, None]
 
 
 def stack_plies(mesh: Mesh, thicknesses: list[float]) -> None:
@@ -426,9 +435,7 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
             warp = np.array(np.broadcast_to(np.asarray(warp, dtype=float),
                                             (mesh.n_elems, 3)))
             blade = mesh.elem_sets["blade.blade"]
-            c = mesh.nodes[mesh.quads[blade]].mean(axis=1)
-            radial = np.c_[c[:, :2], np.zeros(len(c))]
-            warp[blade] = radial / np.linalg.norm(radial, axis=1)[:, None]
+            warp[blade] = radial_directions(mesh, blade)
     bcs = BoundaryConditions(mesh.n_nodes, ramp_time=spec.amplitude.ramp_time)
     for i, b in enumerate(spec.boundary):
         nodes = node_set(mesh, b.nodes, f"boundary[{i}].nodes")

@@ -226,19 +226,27 @@ class CasingSpec(BaseModel):
         return self
 
 
-class BladeSpec(BaseModel):
-    """``[mesh.blade]``: a flat tapered blade in the plane of the z axis (model.casing).
+DEFAULT_STAGGER = math.radians(30.0)  # the default blade's root chord, from the axis
+DEFAULT_TWIST = math.radians(30.0)  # and its tip's 30° more: 60° from the axis
 
-    Defaults (MODEL.md §7: the thesis's blade is not in its text): root 40 mm, split at
-    60 mm (the released fragment is the airfoil outboard of it: 0.237 kg of titanium
-    4.98 mm thick, centre of mass at r = 142.9 mm, so ω r_cm = 149.6 m/s at 1047 rad/s),
-    tip 245 mm (5 mm inside a 250 mm casing), chords 80 mm at the root and 40 mm at the
-    tip, radial along ``angle`` (from +x), no stagger, no twist, a straight tip.
+
+class BladeSpec(BaseModel):
+    """``[mesh.blade]``: a tapered, twisted blade about the z axis (model.casing).
+
+    Defaults (MODEL.md §7: the thesis's blade is not in its text; theory §8.1): root 40
+    mm, split at 60 mm, tip 245 mm (5 mm inside a 250 mm casing), chords 80 mm at the
+    root and 40 mm at the tip, radial along ``angle`` (from +x); a fan blade's twist —
+    the chord turned 30° from the axial direction at the root and 60° at the tip — and
+    a curved tip edge whose corners lie 10 mm inboard. Of 4.98 mm of titanium, the
+    released fragment (the airfoil outboard of the crack) weighs 0.226 kg, its centre of
+    mass at r = 142.6 mm moving at 149.3 m/s at 1047 rad/s (5 mm elements).
 
     ``stagger``: the chord turned from the axial direction towards the tangential one
     at the root; ``twist``: how much more it is turned at the tip (linear along the
     span); ``tip_curve``: the depth of a curved tip edge (a circular arc whose corners
-    lie this far inboard of its mid-chord point; the thesis's blade has one).
+    lie this far inboard of its mid-chord point; the thesis's blade has one). A flat
+    blade flying face-on (``stagger``, ``twist`` and ``tip_curve`` 0) loads more of the
+    casing and makes it look stronger (theory §8.6).
     """
 
     model_config = STRICT
@@ -249,9 +257,9 @@ class BladeSpec(BaseModel):
     root_chord: Length = 0.08
     tip_chord: Length = 0.04
     angle: quantity("angle", example="90 deg") = 0.0
-    stagger: quantity("angle", example="30 deg") = 0.0
-    twist: quantity("angle", example="25 deg") = 0.0
-    tip_curve: quantity("length", ge=0, example="10 mm") = 0.0
+    stagger: quantity("angle", example="30 deg") = DEFAULT_STAGGER
+    twist: quantity("angle", example="25 deg") = DEFAULT_TWIST
+    tip_curve: quantity("length", ge=0, example="10 mm") = 0.01
 
 
 class ContainmentMeshSpec(BaseModel):

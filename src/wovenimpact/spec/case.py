@@ -237,9 +237,9 @@ class BladeSpec(BaseModel):
     mm, split at 60 mm, tip 245 mm (5 mm inside a 250 mm casing), chords 80 mm at the
     root and 40 mm at the tip, radial along ``angle`` (from +x); a fan blade's twist —
     the chord turned 30° from the axial direction at the root and 60° at the tip — and
-    a curved tip edge whose corners lie 10 mm inboard. Of 4.98 mm of titanium, the
-    released fragment (the airfoil outboard of the crack) weighs 0.226 kg, its centre of
-    mass at r = 142.6 mm moving at 149.3 m/s at 1047 rad/s (5 mm elements).
+    a curved tip edge whose corners lie 5 mm inboard. Of 4.98 mm of titanium, the
+    released fragment (the airfoil outboard of the crack) weighs 0.229 kg, its centre of
+    mass at r = 143.5 mm moving at 150.2 m/s at 1047 rad/s (5 mm elements).
 
     ``stagger``: the chord turned from the axial direction towards the tangential one
     at the root; ``twist``: how much more it is turned at the tip (linear along the
@@ -259,7 +259,7 @@ class BladeSpec(BaseModel):
     angle: quantity("angle", example="90 deg") = 0.0
     stagger: quantity("angle", example="30 deg") = DEFAULT_STAGGER
     twist: quantity("angle", example="25 deg") = DEFAULT_TWIST
-    tip_curve: quantity("length", ge=0, example="10 mm") = 0.01
+    tip_curve: quantity("length", ge=0, example="10 mm") = 0.005
 
 
 class ContainmentMeshSpec(BaseModel):

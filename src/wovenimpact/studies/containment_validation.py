@@ -253,7 +253,7 @@ def intro_lines() -> list[str]:
             "the blade meets the casing (the default blade is a fan blade's, its chord 30° "
             "from the axis at the root and 60° at the tip, with a curved tip; a flat blade "
             "flying face-on loads far more of the casing: 4-ply hybrid casing 102.75 m/s "
-            "face-on against 128.34 with the default blade) and the hybrid casing's inner "
+            "face-on against 128.34 with the twisted blade) and the hybrid casing's inner "
             "aluminium shell (ours 1 mm).", ""]
 
 

@@ -5,7 +5,9 @@ T_START, then times N steps with ``Workspace.profile`` on and prints ms per step
 ns per element-cycle, each stage's share, and the shell contact's candidate count; then,
 at the final state, the shell contact's parts timed alone (best of 10): the search's
 binning and query, and the narrow phase with how many candidates it projected and how
-many act (docs/theory.md §6, "Where the contact time goes").
+many act, and the rest of a step's shell contact (masks, the reuse test, the segment
+geometry, the assembly and the contact power) (docs/theory.md §6, "Where the contact
+time goes").
 
 Usage: ``python benchmarks/stage_profile.py CASE T_START N [KEY=VALUE ...]``, e.g.
 ``NUMBA_NUM_THREADS=1 python benchmarks/stage_profile.py
@@ -19,12 +21,14 @@ import time
 
 import numpy as np
 
+from wovenimpact.jit import configure_threading
 from wovenimpact.model.compile import compile_case
 from wovenimpact.solver.explicit import Workspace, step
 from wovenimpact.spec.case import load_case
 
 
 def main(argv: list[str]) -> None:
+    configure_threading()  # the CLI's threading layer and wait policy (wovenimpact.jit)
     case, t_start, n_steps, *overrides = argv
     spec, base = load_case(case, overrides)
     compiled = compile_case(spec, base)
@@ -65,7 +69,14 @@ def best_ms(f, repeats: int = 10):
 def contact_parts(sc, state) -> None:
     """The shell contact's search and narrow phase at ``state``, each timed alone."""
     from wovenimpact.kernels import contact_broad as B
-    from wovenimpact.kernels.contact_narrow import GEO_SIDE, penalty_forces, segment_geometry
+    from wovenimpact.kernels.contact_narrow import (
+        GEO_SIDE,
+        assemble_contact_forces,
+        penalty_forces,
+        segment_geometry,
+    )
+    from wovenimpact.kernels.integrate import force_pair_power
+    from wovenimpact.kernels.shell_layout import E_ALIVE
 
     x = np.ascontiguousarray(state.x)
     sigma = sc.sigma.copy()
@@ -94,6 +105,21 @@ def contact_parts(sc, state) -> None:
     acting = int((sc.pair_on[:n] != 0).sum())
     print(f"  narrow phase {t_pen:.2f} ms: {n} candidates ({t_pen / max(n, 1) * 1e6:.1f} ns "
           f"each), {projected} projected, {acting} acting")
+    # the rest of a step's shell contact (ShellContact.forces), each timed alone
+    alive = state.elem[:, E_ALIVE].copy()
+    t_mask, _ = best_ms(lambda: B.contact_masks(alive, sc.elem_part, state.node_active,
+                                                sc.node_part, sc.seg_on, sc.node_on))
+    t_valid, _ = best_ms(lambda: B.candidates_still_valid(
+        x, sc.x_search, sc.sigma, sc.node_on, sc.node_on_search, sc.seg_on, sc.seg_on_search))
+    t_geo, _ = best_ms(lambda: segment_geometry(x, sc.quads, sc.seg_on, sc.seg_geo))
+    out = np.zeros((x.shape[0], 3))
+    t_asm, _ = best_ms(lambda: assemble_contact_forces(
+        sc.quads, sc.pair_ptr, sc.pair_seg, sc.pair_on, sc.pair_f, sc.pair_w, sc.pair_e,
+        sc.node_f, sc.seg_ptr, sc.seg_entry, sc.cursor, out, True))
+    work = np.zeros(x.shape[0])
+    t_pow, _ = best_ms(lambda: force_pair_power(out, out, state.v, float(state.dt), work))
+    print(f"  per step besides: masks {t_mask:.2f}, reuse test {t_valid:.2f}, segment "
+          f"geometry {t_geo:.2f}, assembly {t_asm:.2f}, contact power {t_pow:.2f} ms")
 
 
 if __name__ == "__main__":

@@ -245,18 +245,8 @@ def _problem(e: dict, root: type[BaseModel]) -> Problem:
     return Problem(path, msg, got, _valid_for(root, loc))
 
 
-def _submodel(annotation: Any) -> type[BaseModel] | None:
-    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
-        return annotation
-    if typing.get_origin(annotation) in (typing.Union, types.UnionType):
-        for arg in typing.get_args(annotation):
-            found = _submodel(arg)
-            if found is not None:
-                return found
-    return None
-
-
 def _union_members(annotation: Any) -> list[type[BaseModel]]:
+    """The models an annotation admits: itself, or the members of a union, in order."""
     if isinstance(annotation, type) and issubclass(annotation, BaseModel):
         return [annotation]
     if typing.get_origin(annotation) in (typing.Union, types.UnionType):
@@ -264,12 +254,19 @@ def _union_members(annotation: Any) -> list[type[BaseModel]]:
     return []
 
 
+def _submodel(annotation: Any) -> type[BaseModel] | None:
+    """The first model an annotation admits (None if it admits none)."""
+    members = _union_members(annotation)
+    return members[0] if members else None
+
+
 def _model_at(root: type[BaseModel], loc: tuple) -> type[BaseModel] | None:
     """The model at ``loc`` below root. A tagged union (``Field(discriminator=...)``)
     puts its member's tag in pydantic's error path (``mesh.containment.blade.x``): the
     tag selects that member."""
     model: type[BaseModel] | None = root
-    members: list[type[BaseModel]] = []
+    members: list[type[BaseModel]] = []  # a tagged union's members, while its tag may follow
+    discriminator: str | None = None
     for part in loc:
         tagged = [m for m in members if _tag_of(m, discriminator) == part] if members else []
         if tagged:

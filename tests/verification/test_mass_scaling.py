@@ -79,6 +79,37 @@ def test_a_crushed_element_gets_the_mass_that_restores_its_step_and_the_balance_
     assert len(dts) < len(dt_plain)
 
 
+def test_the_kinematic_bound_of_the_yarn_step_gets_no_mass():
+    """Under ``run.stable_step = "yarn"`` an element's step is also bounded by how fast
+    its corners close (``kinematic_step``); no added mass raises that bound, so mass
+    scaling must leave it out. A soft strip (c ≈ 260 m/s) whose end is driven at 40 m/s
+    closes its last element at 0.4 % of its length per µs: the kinematic bound,
+    η L/v = 12.5 µs, lies far below f Δt₁ while the element's wave bound stays above it
+    (crushed to 70 % only). Scaling the kinematic bound would add mass at every step
+    without raising it (before the fix: mass × 5.8 on that element by 56 µs)."""
+    nodes, quads = rect_grid(4, 1, 0.04, 0.01)
+    bc = BoundaryConditions(len(nodes), ramp_time=5e-6)
+    bc.fix(np.flatnonzero(nodes[:, 0] <= 0.03 + 1e-12))
+    bc.prescribe(np.flatnonzero(np.isclose(nodes[:, 0], 0.04)), 0, -40.0)
+    f = 0.6
+    model = build_model(nodes, quads,
+                        {"s": Section(elastic(modulus=60e6, density=1000.0), thickness=1e-3)},
+                        np.zeros(len(quads), int), bcs=bc, erode_dt_fraction=0.05,
+                        mass_scaling_fraction=f, max_added_mass_fraction=1.0,
+                        stable_step="yarn")
+    st, ws, dts = run_to(model, 75e-6)
+    wave0 = st.dt_first / model.alpha
+    # the element's wave bound never needed mass: it stayed above the target
+    assert run_to.dt_crushed > f * wave0
+    # the step followed the kinematic bound, well below the target, without mass
+    assert dts.min() < 0.5 * f * st.dt_first
+    assert not np.any(st.mass_ratio)
+    assert not np.any(st.added_mass)
+    # the bound is the driven element's alone (the held ones do not move)
+    assert np.isfinite(st.elem[3, SL.E_DT_KIN])
+    assert np.all(np.isinf(st.elem[:3, SL.E_DT_KIN]))
+
+
 def test_a_restart_rebuilds_the_scaled_masses_bit_for_bit():
     model = crushed_strip(0.8)
     st, ws, _ = run_to(model, 100e-6)

@@ -27,18 +27,23 @@ from wovenimpact.jit import kernel, loop_kernel
 
 
 @kernel
-def scale_element_masses(elem, col_dt, alive, ratio, dt_target):
+def scale_element_masses(elem, col_dt, col_kin, alive, ratio, dt_target):
     """Raise r_e of the live elements whose scaled step Δt_e √(1 + r_e) is below
     ``dt_target`` (same units as ``elem[:, col_dt]``: L_e/c_e, before the factor α).
+    ``elem[:, col_kin]`` is each element's kinematic bound (∞ where there is none): it
+    depends on the motion alone, so it gets no mass (mass added for it would not raise
+    the step) but still bounds the step.
 
-    Returns (number of elements raised, min over live elements of Δt_e √(1 + r_e)).
-    Elements with a step of 0 or inf (failed, eroded) are left alone.
+    Returns (number of elements raised, min over live elements of Δt_e √(1 + r_e) and
+    of their kinematic bounds). Elements with a step of 0 or inf (failed, eroded) are
+    left alone.
     """
     raised = 0
     dt_min = math.inf
     for e in range(elem.shape[0]):
         if alive[e] == 0:
             continue
+        dt_min = min(dt_min, elem[e, col_kin])
         d = elem[e, col_dt]
         if not (d > 0.0) or not math.isfinite(d):
             dt_min = min(dt_min, d)

@@ -65,6 +65,7 @@ from wovenimpact.kernels.shell_layout import (
     C_THICK,
     E_ALIVE,
     E_DT,
+    E_DT_KIN,
     E_F,
     E_FG,
     E_HG,
@@ -478,6 +479,7 @@ def element_failed(e, el_out, blocks, measure):
     """Element e has a degenerate geometry (``measure``: an area or a Jacobian ≤ 0 or
     not finite): no force, no stable step; returns (EL_NAN or EL_INVERTED, 0, ∞)."""
     el_out[e, E_DT] = 0.0
+    el_out[e, E_DT_KIN] = math.inf
     clear_block(blocks, e)
     return (EL_NAN if not math.isfinite(measure) else EL_INVERTED), 0, math.inf
 
@@ -761,6 +763,7 @@ def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
         if el_out[e, E_ALIVE] != 0.0:
             carry_state(e, el_in, el_out, rows_in, rows_out, row0, n_rows)
         el_out[e, E_DT] = math.inf
+        el_out[e, E_DT_KIN] = math.inf
         clear_block(blocks, e)
         return EL_OK, 0, math.inf
     carry_state(e, el_in, el_out, rows_in, rows_out, row0, n_rows)
@@ -840,6 +843,7 @@ def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
         el_out[e, E_N + 1] = 0.0
         el_out[e, E_N + 2] = 0.0
         el_out[e, E_DT] = 0.0
+        el_out[e, E_DT_KIN] = math.inf
         clear_block(blocks, e)
         return status, 0, math.inf
     if eroded:
@@ -847,6 +851,7 @@ def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
         el_out[e, E_U_MEMB] = w_memb
         el_out[e, E_ALIVE] = 0.0
         el_out[e, E_DT] = math.inf
+        el_out[e, E_DT_KIN] = math.inf
         for j in range(3):
             el_out[e, E_N + j] = 0.0
         clear_block(blocks, e)
@@ -886,14 +891,16 @@ def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
     dt_iso = element_stable_step(px, py, pz, area, c_memb, kgt, mu, a0, thick, d_b, bb)
     if mesh.step_mode == STEP_YARN:
         # (k_warp, k_fill: the yarn families' stiffnesses; k_w above is the w hourglass
-        # mode's)
+        # mode's); the kinematic bound is kept apart: mass scaling cannot raise it
         dt_e = min(element_stable_step(px, py, pz, area, c_step, kgt, mu, a0, thick, d_b, bb),
                    family_stable_step(k_warp, c_step, mu, g1),
-                   family_stable_step(k_fill, c_step, mu, g2),
-                   kinematic_step(px, py, pz, vx_, vy_, vz_))
+                   family_stable_step(k_fill, c_step, mu, g2))
+        dt_kin = kinematic_step(px, py, pz, vx_, vy_, vz_)
     else:
         dt_e = dt_iso
+        dt_kin = math.inf
     el_out[e, E_DT] = dt_e
+    el_out[e, E_DT_KIN] = dt_kin
     if not math.isfinite(fsum + dt_e):
         return EL_NAN, 0, math.inf
     return EL_OK, 0, dt_iso
@@ -918,7 +925,8 @@ def internal_force_for_shells(mesh, motion, dt, tables, results, dt_erode, erode
     Returns:
         (n_failed, n_eroded, dt_min): elements with a non-OK status, elements
         eroded this step (integer counts: exact, so the same for any thread count),
-        and min_e ``el_out[e, E_DT]`` (inf if every element is eroded; a minimum is
+        and min_e of ``el_out[e, E_DT]`` and ``el_out[e, E_DT_KIN]`` (inf if every
+        element is eroded; a minimum is
         exact in any order, so also the same for any thread count; meaningful only
         when n_failed is 0).
     """
@@ -957,18 +965,21 @@ def internal_force_for_shells(mesh, motion, dt, tables, results, dt_erode, erode
             # with the energies it held at the start of the step
             el_out[e, E_ALIVE] = 0.0
             el_out[e, E_DT] = math.inf
+            el_out[e, E_DT_KIN] = math.inf
             clear_block(blocks, e)
             st = EL_OK
             er = 1
         elif st == EL_OK and er == 0 and dt_check < dt_erode:
             el_out[e, E_ALIVE] = 0.0
             el_out[e, E_DT] = math.inf
+            el_out[e, E_DT_KIN] = math.inf
             clear_block(blocks, e)
             er = 1
         status[e] = st
         eroded_now[e] = er
         alive[e] = 1 if el_out[e, E_ALIVE] != 0.0 else 0
-        dt_min = min(dt_min, el_out[e, E_DT])
+        dt_own = min(el_out[e, E_DT], el_out[e, E_DT_KIN])
+        dt_min = min(dt_min, dt_own)
         if st != EL_OK:
             n_failed += 1
         n_eroded += er

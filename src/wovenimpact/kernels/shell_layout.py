@@ -34,7 +34,11 @@ Per-element state (``State.elem``, one row per element):
 - ``E_HG``: hourglass generalised forces (membrane x, y; w; θx, θy).
 - ``E_U_MEMB``: membrane stored energy (J); ``E_U_BEND``: bending + transverse shear
   energy (J); ``E_U_HG``: hourglass energy (J).
-- ``E_DT``: the element's stable time step L_e / c_e (s), before the factor α.
+- ``E_DT``: the element's stable time step L_e / c_e (s), before the factor α: its wave
+  bound, the one mass scaling raises (c_e ∝ 1/√μ).
+- ``E_DT_KIN``: the element's kinematic step under ``run.stable_step = "yarn"`` (s,
+  before α; ``kinematic_step``), ∞ otherwise. It bounds the step beside ``E_DT`` but
+  depends on the motion alone: no added mass raises it, so mass scaling leaves it out.
 - ``E_ALIVE``: 1.0 alive, 0.0 eroded.
 - ``E_KAPPA``: total curvatures κ_x, κ_y, 2κ_xy (1/m), accumulated from the rates (used
   by integrated sections).
@@ -92,7 +96,8 @@ E_DT = 20
 E_ALIVE = 21
 E_KAPPA = 22
 E_FG = 25
-N_ELEM_STATE = 41
+E_DT_KIN = 41
+N_ELEM_STATE = 42
 
 # per-element status codes written by the force kernel
 EL_OK = 0

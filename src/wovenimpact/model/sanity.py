@@ -52,11 +52,11 @@ def _text(seconds: float) -> str:
 def first_step(model, state) -> tuple[float, int]:
     """Δt₁ = α min_e L_e/c_e at the initial state and the governing element (one pass of
     the element kernel; nothing in ``state`` changes)."""
-    from wovenimpact.solver.explicit import Workspace, shell_forces
+    from wovenimpact.solver.explicit import Workspace, element_steps, shell_forces
 
     ws = Workspace.for_model(model, state)
     shell_forces(model, state, ws)
-    dt_el = ws.elem[:, SL.E_DT]
+    dt_el = element_steps(ws.elem)
     e = int(np.argmin(dt_el))
     return model.alpha * float(dt_el[e]), e
 

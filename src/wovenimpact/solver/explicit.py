@@ -186,7 +186,8 @@ def scale_masses(model, state: State, ws: Workspace) -> None:
     if model.mass_scaling_fraction <= 0.0 or state.dt_first <= 0.0:
         return
     target = model.mass_scaling_fraction * state.dt_first / model.alpha
-    raised, ws.dt_min = scale_element_masses(ws.elem, SL.E_DT, ws.alive, state.mass_ratio, target)
+    raised, ws.dt_min = scale_element_masses(ws.elem, SL.E_DT, SL.E_DT_KIN, ws.alive,
+                                              state.mass_ratio, target)
     if not raised:
         return
     scaled_node_masses(model.node_ptr, model.node_elem, state.mass_ratio, model.elem_mass,
@@ -215,20 +216,29 @@ def stable_step(model, state: State, ws: Workspace, dt_cap: float) -> float:
     scale_masses(model, state, ws)
     dt = min(model.alpha * ws.dt_min, dt_cap)
     if not math.isfinite(dt) or dt <= 0.0:
-        dt_el = ws.elem[:, SL.E_DT]
+        dt_el = element_steps(ws.elem)
         e = int(np.argmin(dt_el))
         raise SimulationError(
             f"no stable time step at t = {state.t:.6e} s (element {e}: {dt_el[e]!r}); "
             "every element eroded, or a non-finite state"
         )
     if state.dt_first > 0.0 and dt < DT_COLLAPSE * state.dt_first:
-        e = int(np.argmin(ws.elem[:, SL.E_DT]))
+        e = int(np.argmin(element_steps(ws.elem)))
+        how = ("its corners close too fast (the kinematic bound)"
+               if ws.elem[e, SL.E_DT_KIN] < ws.elem[e, SL.E_DT] else
+               "it is nearly crushed or distorted")
         raise SimulationError(
             f"time step collapsed at t = {state.t:.6e} s: Δt = {dt:.3e} s is below "
             f"{DT_COLLAPSE:g} of the first step ({state.dt_first:.3e} s), governed by element "
-            f"{e} (nodes {model.quads[e].tolist()}): it is nearly crushed or distorted"
+            f"{e} (nodes {model.quads[e].tolist()}): {how}"
         )
     return dt
+
+
+def element_steps(elem: np.ndarray) -> np.ndarray:
+    """Each element's own step before α and mass scaling: the smaller of its wave bound
+    (``E_DT``) and its kinematic bound (``E_DT_KIN``)."""
+    return np.minimum(elem[:, SL.E_DT], elem[:, SL.E_DT_KIN])
 
 
 def release(model, state: State) -> None:

@@ -175,12 +175,12 @@ def test_the_stable_step_of_a_square_is_its_side_over_the_wave_speed():
     side, c_memb, mu, t = 0.005, 5e7, 0.5, 5e-4  # C_m (N/m), μ (kg/m²)
     px, py, pz = (0.0, side, side, 0.0), (0.0, 0.0, side, side), (0.0,) * 4
     a = side * side
-    dt = element_stable_step(px, py, pz, a, c_memb, 1e3, mu, a, t, 0.0, 1.0)
+    inertia = 0.25 * mu * a * max(t * t / 12.0, a / 8.0)
+    dt = element_stable_step(px, py, pz, a, c_memb, 1e3, mu, inertia, 0.0, 1.0)
     assert dt == pytest.approx(side / math.sqrt(c_memb / mu), rel=1e-14)
     # a stiff bending term: the corners' spins govern, Δt = 2 √(I/k_θ)
     d_b, bb, kgt = 1e3, 4.0 / a, 1e3
-    dt = element_stable_step(px, py, pz, a, c_memb, kgt, mu, a, t, d_b, bb)
-    inertia = 0.25 * mu * a * max(t * t / 12.0, a / 8.0)
+    dt = element_stable_step(px, py, pz, a, c_memb, kgt, mu, inertia, d_b, bb)
     assert dt == pytest.approx(2.0 * math.sqrt(inertia / (a * (0.25 * kgt + d_b * bb))),
                                rel=1e-14)
     assert dt < side / math.sqrt(c_memb / mu)

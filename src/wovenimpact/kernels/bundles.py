@@ -34,6 +34,7 @@ class ShellMesh(NamedTuple):
     ref_grad: np.ndarray  # (n_elems, 2, 4) ∂N_I/∂X at the centre, material frame
     gauss_grad: np.ndarray  # (n_elems, 4, 2, 4) the same at the 2×2 Gauss points
     gauss_weight: np.ndarray  # (n_elems, 4) their weights (det J)
+    rot_inertia: np.ndarray  # (n_elems,) rotary inertia lumped on each corner (kg m²)
     point_width: int  # values per material point state block
     step_mode: int  # shell_layout STEP_*: the fabric elements' stable step
 

@@ -640,15 +640,16 @@ def corner_forces(e, blocks, frame, mf_x, mf_y, fzs, gam, hg0, hg1, hg2, hg3, hg
 
 
 @inline_kernel
-def element_stable_step(px, py, pz, area, c_memb, kgt, mu, a0, thick, d_b, bb):
+def element_stable_step(px, py, pz, area, c_memb, kgt, mu, inertia, d_b, bb):
     """The element's stable step (eq. 4.9–4.11): L_e/c_e with L_e = A / longest edge and
     c_e² = max(C_m, k G t)/μ, and no more than the rotational bound 2 √(I/k_θ).
 
     Rotations: a corner's spin against this element's transverse-shear and bending
-    stiffness, k_θ = A (k G t/4 + D Σb²), with the rotary inertia the element lumped on
-    it, I = ¼ μ A0 max(t²/12, A0/8); ω Δt ≤ 2 needs Δt ≤ 2 √(I/k_θ). In an element that
-    has stretched far beyond its reference size (a broken yarn family) this, not the
-    membrane, governs.
+    stiffness, k_θ = A (k G t/4 + D Σb²), with ``inertia`` I the rotary inertia the
+    element lumped on it (``model.rotary_inertia``: at the reference geometry the bound
+    is no shorter than the membrane's); ω Δt ≤ 2 needs Δt ≤ 2 √(I/k_θ). In an element
+    that has stretched far beyond its reference size (a broken yarn family) this, not
+    the membrane, governs.
     """
     edge2 = 0.0
     for i in range(4):
@@ -659,7 +660,6 @@ def element_stable_step(px, py, pz, area, c_memb, kgt, mu, a0, thick, d_b, bb):
         edge2 = max(edge2, dx * dx + dy * dy + dz * dz)
     c2 = max(c_memb, kgt) / mu
     dt_e = area / math.sqrt(edge2 * c2)
-    inertia = 0.25 * mu * a0 * max(thick * thick / 12.0, a0 / 8.0)
     k_rot = area * (0.25 * kgt + d_b * bb)
     return min(dt_e, 2.0 * math.sqrt(inertia / k_rot))
 
@@ -888,11 +888,12 @@ def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
                          mxx, myy, mxy, qx, qy)
 
     # 7. stable step; the isotropic bound is also the erosion test's
-    dt_iso = element_stable_step(px, py, pz, area, c_memb, kgt, mu, a0, thick, d_b, bb)
+    inertia = mesh.rot_inertia[e]
+    dt_iso = element_stable_step(px, py, pz, area, c_memb, kgt, mu, inertia, d_b, bb)
     if mesh.step_mode == STEP_YARN:
         # (k_warp, k_fill: the yarn families' stiffnesses; k_w above is the w hourglass
         # mode's); the kinematic bound is kept apart: mass scaling cannot raise it
-        dt_e = min(element_stable_step(px, py, pz, area, c_step, kgt, mu, a0, thick, d_b, bb),
+        dt_e = min(element_stable_step(px, py, pz, area, c_step, kgt, mu, inertia, d_b, bb),
                    family_stable_step(k_warp, c_step, mu, g1),
                    family_stable_step(k_fill, c_step, mu, g2))
         dt_kin = kinematic_step(px, py, pz, vx_, vy_, vz_)

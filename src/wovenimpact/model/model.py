@@ -363,6 +363,9 @@ class Model:
     max_added_mass_fraction: float = 0.02
     stable_step: str = "isotropic"
     elem_mass: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    # the rotary inertia each element lumps on each of its corners (kg m²; node_inertia
+    # is their sum, so the digest covers it)
+    elem_rot_inertia: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
     def n_nodes(self) -> int:
@@ -391,6 +394,51 @@ class Model:
             h.update(self.stable_step.encode())
         h.update(np.ascontiguousarray(self.release_elems).tobytes())
         return h.hexdigest()
+
+
+def rotary_inertia(x0, quads, sec_table, elem_section, mat_kind, mat_params, area0, ref_grad):
+    """The rotary inertia I_e each element lumps on each of its corners (kg m²):
+
+        I_e = ¼ m_e ρ_e,   ρ_e = max(t²/12, A0/8, ρ_θ),
+
+    m_e = μ A0 the element's mass. t²/12 is the physical value, A0/8 the usual scaling
+    that keeps a thin shell's spins slower than its membrane (theory §4, "Stable step").
+    ρ_θ (metal sections only) makes the element's rotational bound 2 √(I_e/k_θ) no shorter
+    than its membrane bound L_e/c_e at the reference geometry, with
+    k_θ = A0 (k G t/4 + D Σb²) and c_e² = max(C_m, k G t)/μ, C_m = E t/(1 − ν²):
+
+        ρ_θ = k_θ (L_e/c_e)² / m_e.
+
+    A thick shell needs it: the titanium blade, 4.98 mm on ~5 mm elements, has
+    k_θ/I three to four times the membrane's (2/Δt)² with A0/8, and its spins set the
+    model's step (6.6e-7 against 9.1e-7 s). Translational mass is unchanged; only spins
+    faster than the membrane's fastest mode are slowed. Fabric sections keep
+    max(t²/12, A0/8): their bending and transverse-shear stiffnesses are far below the
+    yarns' tension stiffness, whose wave bound the element kernel computes from the
+    current state (none of the 51 800 fabric elements of the 10-ply casing is governed
+    by its spins)."""
+    t = sec_table[elem_section, SL.C_THICK]
+    mu = sec_table[elem_section, SL.C_AREAL_MASS]
+    m_el = mu * area0
+    rho = np.maximum(t**2 / 12.0, area0 / 8.0)
+    mat = sec_table[elem_section, SL.C_MAT].astype(np.int64)
+    metal = (mat_kind[mat] == SL.MAT_ELASTIC) | (mat_kind[mat] == SL.MAT_J2)
+    if not np.any(metal):
+        return 0.25 * m_el * rho
+    e_mod, nu = mat_params[mat, 0], mat_params[mat, 1]
+    c_m = e_mod * t / (1.0 - nu**2)
+    kgt = sec_table[elem_section, SL.C_SHEAR_K] * sec_table[elem_section, SL.C_SHEAR_G] * t
+    e_b, nu_b = sec_table[elem_section, SL.C_BEND_E], sec_table[elem_section, SL.C_BEND_NU]
+    integrated = sec_table[elem_section, SL.C_POINTS] > 1  # bending from the points (kernel)
+    d_b = np.where(integrated, c_m * t**2 / 12.0, e_b * t**3 / (12.0 * (1.0 - nu_b**2)))
+    p = x0[quads]
+    edge = np.linalg.norm(np.roll(p, -1, axis=1) - p, axis=2).max(axis=1)
+    bb = np.sum(ref_grad**2, axis=(1, 2))
+    dt_m = area0 / (edge * np.sqrt(np.maximum(c_m, kgt) / mu))
+    k_rot = area0 * (0.25 * kgt + d_b * bb)
+    rho_theta = k_rot * dt_m**2 / m_el
+    rho = np.where(metal, np.maximum(rho, rho_theta), rho)
+    return 0.25 * m_el * rho
 
 
 def material_frame_gradients(x0, quads, warp_direction):
@@ -612,15 +660,18 @@ def build_model(
     for i, b in enumerate(blocks):
         section_state0[i, : len(b)] = b
     ref_grad, area0, gauss_grad, gauss_weight = material_frame_gradients(x0, q, warp_direction)
-    # lumped masses: a quarter of each element's mass to each corner; rotary inertia
-    # m · max(t²/12, A/8) so that rotations never govern the stable step (theory §3)
+    # lumped masses: a quarter of each element's mass to each corner, and the rotary
+    # inertia the element lumps on each corner (rotary_inertia: rotations never govern
+    # the stable step at the reference geometry; theory §4, "Stable step")
     thick = sec_table[es, SL.C_THICK]
     m_el = sec_table[es, SL.C_AREAL_MASS] * area0
+    elem_rot_inertia = rotary_inertia(x0, q, sec_table, es, np.array(kinds), mat_params, area0,
+                                      ref_grad)
     node_mass = np.zeros(len(x0))
     node_inertia = np.zeros(len(x0))
     for c in range(4):
         np.add.at(node_mass, q[:, c], 0.25 * m_el)
-        np.add.at(node_inertia, q[:, c], 0.25 * m_el * np.maximum(thick**2 / 12.0, area0 / 8.0))
+        np.add.at(node_inertia, q[:, c], elem_rot_inertia)
     if bcs is None:
         bcs = BoundaryConditions(len(x0))
     if bcs.code.shape != (len(x0), 6):
@@ -661,5 +712,6 @@ def build_model(
         section_names=tuple(names), material_names=tuple(getattr(m, "name", "") for m in mats),
         mass_scaling_fraction=float(mass_scaling_fraction),
         max_added_mass_fraction=float(max_added_mass_fraction), elem_mass=m_el,
+        elem_rot_inertia=elem_rot_inertia,
         stable_step=str(stable_step),
     )

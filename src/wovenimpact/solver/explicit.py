@@ -137,7 +137,8 @@ class Workspace:
             quads=model.quads, elem_section=model.elem_section, sections=model.sections,
             mat_kind=model.mat_kind, mat_params=model.mat_params, area0=model.area0,
             ref_grad=model.ref_grad, gauss_grad=model.gauss_grad,
-            gauss_weight=model.gauss_weight, point_width=int(model.point_width),
+            gauss_weight=model.gauss_weight, rot_inertia=model.elem_rot_inertia,
+            point_width=int(model.point_width),
             step_mode=SL.STABLE_STEPS[model.stable_step])
         ws.results = ElementResults(blocks=ws.blocks, status=ws.status,
                                     eroded_now=ws.eroded_now, alive=ws.alive)

@@ -14,9 +14,11 @@ import sys
 import numba
 
 from wovenimpact.benchmark import DEFAULT_SIZES, case_line, machine, machine_line, run_cases
+from wovenimpact.jit import configure_threading
 
 
 def main() -> None:
+    configure_threading()  # the CLI's threading layer and wait policy, as `wovenimpact bench`
     sizes = DEFAULT_SIZES
     kinds = ("elastic", "metal", "fabric", "fabric_reduced")
     thread_counts = sorted({1, min(2, numba.config.NUMBA_NUM_THREADS)})

@@ -56,12 +56,14 @@ def momentum_z(model, st) -> float:
     return float(np.sum(model.node_mass * st.v[:, 2]) + body)
 
 
-def test_projectile_perforates_metal_then_meets_fabric_momentum_and_energy_booked():
+def test_projectile_perforates_metal_and_its_plug_meets_fabric_momentum_and_energy_booked():
     """The FSP at 600 m/s erodes a ring of aluminium elements and carries on with the
     plug into the plies: momentum along z is conserved to 1e-6 of the projectile's;
     the energy balance holds to 1e-3; the fabric is pushed by the shell–shell contact
-    (metal on fabric) and then by the projectile itself, the metal by the projectile,
-    all three forces nonzero; the metal's
+    (the metal plug on fabric), the metal by the projectile; the plug stays between the
+    projectile and the fabric, so the projectile's own force on the fabric is round-off
+    (until 2026-11-27 this asserted it nonzero: a 1e-14 N graze at 5 µs passed it; to
+    40 µs it never reaches 1 N); the metal's
     plastic work is a part of the internal work. A node that loses its last element
     leaves the model with its velocity (theory §5): its momentum is booked as it goes."""
     model, mesh = hybrid_model()
@@ -95,7 +97,8 @@ def test_projectile_perforates_metal_then_meets_fabric_momentum_and_energy_booke
           f"{shell_on_fabric:.1f} N, projectile on metal {body_on_metal:.1f} N, "
           f"projectile on fabric {body_on_fabric:.1f} N")
     assert eroded_metal > 0
-    assert shell_on_fabric > 0.0 and body_on_metal > 0.0 and body_on_fabric > 0.0
+    assert shell_on_fabric > 0.1 * body_on_metal > 0.0
+    assert body_on_fabric < 1e-6 * body_on_metal
     assert momentum_z(model, st) + eroded_p == pytest.approx(p0, abs=1e-6 * abs(p0))
     assert worst < 1e-3
     assert 0.0 < w_p < eb["internal_work_J"]

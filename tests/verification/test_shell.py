@@ -285,6 +285,82 @@ def test_a_crushed_fabric_elements_stable_step_follows_its_taut_yarns_not_its_wi
     assert 0.9 * res["warp taut"][0] * res["warp taut"][1] > 1.5
 
 
+def titanium_plate(n, side, thickness):
+    """An n × n grid of squares of ``side`` in elastic titanium (the blade's E, ν, ρ)."""
+    mat = elastic(modulus=115.1424e9, poisson=0.35, density=4424.0)
+    nodes, quads = rect_grid(n, n, n * side, n * side)
+    return mat, nodes, build_model(nodes, quads, {"s": Section(mat, thickness=thickness)},
+                                   np.zeros(len(quads), int))
+
+
+def test_a_thick_metal_shells_spins_do_not_set_its_step_and_add_no_faster_mode():
+    """Rotary inertia (``model.rotary_inertia``, theory §4 "Stable step"): a metal
+    element's corner inertia is raised, where it must be, so that its rotational bound
+    2 √(I/k_θ) is no shorter than its membrane bound L_e/c_e at the reference geometry.
+    A titanium square of 5 mm side and 5 mm thick (the blade's proportions) had its step
+    set by its spins, at 0.73 of the membrane's (A0/8 scaling alone). Now its step at
+    rest is the membrane's, L_e/c_e, and its largest eigenfrequency ω_max (24 dofs, its
+    lumped masses and inertias) times its step is no larger than a thin element's
+    (0.5 mm, whose spins are slow anyway) at rest, stretched, crushed and sheared: the
+    spins add no faster mode. (A single free element has α ω_max Δt_e ≈ 2.1 whatever
+    its thickness: it bounds an assembled mesh's from above; the mesh is tested below.)
+    The thin one keeps ¼ m max(t²/12, A0/8) bit for bit."""
+    side = 5e-3
+    states = {"rest": (1.0, 1.0, 0.0), "stretched": (1.05, 1.0, 0.0),
+              "crushed": (0.6, 1.0, 0.0), "sheared": (1.0, 1.0, 0.3)}
+    res = {}
+    for t in (5e-3, 0.5e-3):
+        mat, nodes, model = titanium_plate(1, side, t)
+        res[t] = {name: fabric_element_frequency(model, nodes, *f, h=1e-9)
+                  for name, f in states.items()}
+        m_el = model.sections[0, SL.C_AREAL_MASS] * model.area0[0]  # (the old expression)
+        plain = 0.25 * m_el * max(t * t / 12.0, model.area0[0] / 8.0)
+        if t < side / 2:
+            assert model.elem_rot_inertia[0] == plain
+        else:
+            assert model.elem_rot_inertia[0] > plain
+    c = math.sqrt(mat.modulus / (mat.density * (1 - mat.poisson**2)))
+    assert res[5e-3]["rest"][1] == pytest.approx(side / c, rel=1e-12)
+    for name in states:
+        (w_thick, dt_thick), (w_thin, dt_thin) = res[5e-3][name], res[0.5e-3][name]
+        print(f"\n{name:10s} α ω_max Δt_e: 5 mm {0.9 * w_thick * dt_thick:.3f}, "
+              f"0.5 mm {0.9 * w_thin * dt_thin:.3f}", end="")
+        assert w_thick * dt_thick <= w_thin * dt_thin * (1 + 1e-6), name
+
+
+def test_a_clamped_thick_titanium_plate_is_stable_at_its_membrane_step():
+    """The assembled check behind the rule: a 4 × 4 plate of 5 mm squares, 5 mm thick,
+    clamped on its edge, its tangent K (translations and rotations of the 9 free nodes)
+    by central differences of the element forces: α ω_max Δt₁ ≤ 2, with Δt₁ the
+    model's first step (now the membrane's)."""
+    mat, nodes, model = titanium_plate(4, 5e-3, 5e-3)
+    lo, hi = nodes[:, :2].min(axis=0), nodes[:, :2].max(axis=0)
+    inner = np.flatnonzero(np.all((nodes[:, :2] > lo + 1e-9) & (nodes[:, :2] < hi - 1e-9), axis=1))
+    dofs = [(n, d) for n in inner for d in range(6)]
+    h = 1e-9
+
+    def forces(sign, n, d):
+        st = initial_state(model)
+        st.dt = h
+        (st.v if d < 3 else st.omega)[n, d % 3] = sign
+        st.x = st.x + h * st.v
+        ws = Workspace.for_model(model, st)
+        element_forces(model, st, ws)
+        return np.array([ws.f_int[m, e] for m, e in dofs]), ws.elem[:, SL.E_DT].min()
+
+    k = np.zeros((len(dofs), len(dofs)))
+    for j, (n, d) in enumerate(dofs):
+        k[:, j] = (forces(1.0, n, d)[0] - forces(-1.0, n, d)[0]) / (2.0 * h)
+    mass = np.array([model.node_mass[n] if d < 3 else model.node_inertia[n] for n, d in dofs])
+    omega = math.sqrt(float(np.max(np.linalg.eigvals(k / mass[:, None]).real)))
+    dt1 = 0.9 * forces(0.0, 0, 0)[1]
+    c = math.sqrt(mat.modulus / (mat.density * (1 - mat.poisson**2)))
+    print(f"\nclamped 4×4, 5 mm thick: Δt₁ = {dt1:.4e} s (α L/c = {0.9 * 5e-3 / c:.4e}), "
+          f"α ω_max Δt₁/α = {omega * dt1:.3f}")
+    assert dt1 == pytest.approx(0.9 * 5e-3 / c, rel=1e-12)
+    assert omega * dt1 <= 2.0
+
+
 @pytest.mark.parametrize("stable_step", ["isotropic", "yarn"])
 def test_erosion_on_the_stable_step_reads_the_isotropic_bound_under_either_option(stable_step):
     """An element erodes when its isotropic step L_e/c_e falls below the erosion step

@@ -347,7 +347,9 @@ class RunSpec(BaseModel):
     # an element crushed through itself is eroded (true) or stops the run (false)
     erode_inverted: bool = False
     # selective mass scaling (docs/theory.md §4): elements whose step falls below this
-    # fraction of the first get mass so that it is that fraction again (0: off)
+    # fraction of the first get mass so that it is that fraction again (0: off); under
+    # stable_step = "yarn" only the wave bound gets mass, not the kinematic limit (which
+    # no mass raises)
     mass_scaling_fraction: quantity("dimensionless", ge=0, lt=1, example="0.3") = 0.0
     # the fabric elements' stable step (docs/theory.md §4, "Stable step"): "isotropic",
     # the element's shortest width with the stiffest yarn family per current width

@@ -422,22 +422,22 @@ def rotary_inertia(x0, quads, sec_table, elem_section, mat_kind, mat_params, are
     m_el = mu * area0
     rho = np.maximum(t**2 / 12.0, area0 / 8.0)
     mat = sec_table[elem_section, SL.C_MAT].astype(np.int64)
-    metal = (mat_kind[mat] == SL.MAT_ELASTIC) | (mat_kind[mat] == SL.MAT_J2)
-    if not np.any(metal):
-        return 0.25 * m_el * rho
-    e_mod, nu = mat_params[mat, 0], mat_params[mat, 1]
-    c_m = e_mod * t / (1.0 - nu**2)
-    kgt = sec_table[elem_section, SL.C_SHEAR_K] * sec_table[elem_section, SL.C_SHEAR_G] * t
-    e_b, nu_b = sec_table[elem_section, SL.C_BEND_E], sec_table[elem_section, SL.C_BEND_NU]
-    integrated = sec_table[elem_section, SL.C_POINTS] > 1  # bending from the points (kernel)
-    d_b = np.where(integrated, c_m * t**2 / 12.0, e_b * t**3 / (12.0 * (1.0 - nu_b**2)))
-    p = x0[quads]
-    edge = np.linalg.norm(np.roll(p, -1, axis=1) - p, axis=2).max(axis=1)
-    bb = np.sum(ref_grad**2, axis=(1, 2))
-    dt_m = area0 / (edge * np.sqrt(np.maximum(c_m, kgt) / mu))
-    k_rot = area0 * (0.25 * kgt + d_b * bb)
-    rho_theta = k_rot * dt_m**2 / m_el
-    rho = np.where(metal, np.maximum(rho, rho_theta), rho)
+    metal = np.flatnonzero((mat_kind[mat] == SL.MAT_ELASTIC) | (mat_kind[mat] == SL.MAT_J2))
+    if metal.size:  # (the fabric rows' parameters are not E, ν: left out)
+        sec = sec_table[elem_section[metal]]
+        tm, mu_m, a0 = t[metal], mu[metal], area0[metal]
+        e_mod, nu = mat_params[mat[metal], 0], mat_params[mat[metal], 1]
+        c_m = e_mod * tm / (1.0 - nu**2)
+        kgt = sec[:, SL.C_SHEAR_K] * sec[:, SL.C_SHEAR_G] * tm
+        e_b, nu_b = sec[:, SL.C_BEND_E], sec[:, SL.C_BEND_NU]
+        integrated = sec[:, SL.C_POINTS] > 1  # bending from the points (as the kernel)
+        d_b = np.where(integrated, c_m * tm**2 / 12.0, e_b * tm**3 / (12.0 * (1.0 - nu_b**2)))
+        p = x0[quads[metal]]
+        edge = np.linalg.norm(np.roll(p, -1, axis=1) - p, axis=2).max(axis=1)
+        bb = np.sum(ref_grad[metal] ** 2, axis=(1, 2))
+        dt_m = a0 / (edge * np.sqrt(np.maximum(c_m, kgt) / mu_m))
+        k_rot = a0 * (0.25 * kgt + d_b * bb)
+        rho[metal] = np.maximum(rho[metal], k_rot * dt_m**2 / m_el[metal])
     return 0.25 * m_el * rho
 
 

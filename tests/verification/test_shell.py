@@ -764,3 +764,28 @@ def test_a_warped_element_round_a_closed_loop_returns_its_work():
         assert peak > 1e-3  # the loop loads the element
         assert abs(work - booked) < 3e-5 * peak
         assert abs(coarse - booked) > 3.0 * abs(work - booked)  # second order
+
+
+def test_rotary_inertia_raises_only_thick_metal_elements_of_a_mixed_model():
+    """``model.rotary_inertia`` on a hybrid stack (two Kevlar plies under 0.5 mm of
+    aluminium on 0.5 mm elements, the mixed-contact test's model): the aluminium, as
+    thick as its elements are wide, gets more than ¼ m max(t²/12, A0/8); the fabric keeps
+    exactly that (its parameter row is not E, ν, and is not read: no warning either)."""
+    import warnings
+
+    from tests.verification.test_mixed_contact import hybrid_model
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        model, mesh = hybrid_model()
+    sec = model.sections[model.elem_section]
+    m_el = sec[:, SL.C_AREAL_MASS] * model.area0
+    plain = 0.25 * m_el * np.maximum(sec[:, SL.C_THICK] ** 2 / 12.0, model.area0 / 8.0)
+    fabric, metal = mesh.ply < 2, mesh.ply == 2
+    np.testing.assert_array_equal(model.elem_rot_inertia[fabric], plain[fabric])
+    assert np.all(model.elem_rot_inertia[metal] > plain[metal])
+    # and the nodes carry the sum of their elements' corner inertias
+    summed = np.zeros(model.n_nodes)
+    for c in range(4):
+        np.add.at(summed, model.quads[:, c], model.elem_rot_inertia)
+    np.testing.assert_allclose(model.node_inertia, summed, rtol=1e-14)

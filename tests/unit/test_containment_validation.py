@@ -40,6 +40,24 @@ def test_regression_uses_escaped_runs_and_finds_their_zero():
     assert res["most_escaped_below"] == 30
     assert res["undecided"] == [20]
     assert res["mass_per_area"](36) == pytest.approx(2.7 + 0.5 * 36)
+    assert res["regression_points"] == 5  # 4, 8, 12, 16, 30 escaped
+
+
+def test_a_regression_through_exactly_three_points_says_so(tmp_path):
+    """With three escaped N the quadratic passes through them: R² = 1 by construction,
+    and the report says so instead of letting it read as a good fit."""
+    rows = [_row(n, "escaped", 150.0 - 5.0 * n - 0.1 * n * n, 2.7 + 0.5 * n) for n in (4, 8, 12)]
+    rows.append(_row(24, "contained", 0.0, 2.7 + 0.5 * 24))
+    res = cv.ladder_result(rows)
+    assert res["regression_points"] == 3
+    assert res["regression"].r2 == pytest.approx(1.0, abs=1e-12)
+    lines, _ = cv.ladder_lines("containment_metal", "Metal", "layers", {}, "note", rows,
+                               tmp_path)
+    assert any("R² = 1 by construction" in line for line in lines)
+    rows.append(_row(16, "escaped", 150.0 - 5.0 * 16 - 0.1 * 256 + 3.0, 2.7 + 0.5 * 16))
+    lines, _ = cv.ladder_lines("containment_metal", "Metal", "layers", {}, "note", rows,
+                               tmp_path)
+    assert not any("by construction" in line for line in lines)
 
 
 def test_an_escape_whose_speed_was_still_falling_stays_out_of_the_regression():

@@ -96,7 +96,8 @@ def ladder_result(rows: list[dict]) -> dict:
         return m0 + (m1 - m0) * (n - n0) / (n1 - n0) if n1 != n0 else None
 
     below = [float(r[KEY]) for r in through if not contained or float(r[KEY]) < contained[0]]
-    return {"regression": regression, "fewest_contained": contained[0] if contained else None,
+    return {"regression": regression, "regression_points": len({n for n, _ in escaped}),
+            "fewest_contained": contained[0] if contained else None,
             "most_escaped_below": int(max(below)) if below else None,
             "undecided": undecided, "mass_per_area": mass_per_area}
 
@@ -133,6 +134,10 @@ def ladder_lines(name: str, title: str, unit: str, thesis: dict, note: str, rows
                      f"{c2:.4g} N² {c1:+.4g} N {c0:+.4g} (R² = {reg.r2:.3f}); it reaches zero "
                      + (f"at N = {reg.root:.1f}: **{reg.plies_to_stop} {unit} to contain**."
                         if reg.plies_to_stop else "nowhere on its decreasing branch."))
+        if result["regression_points"] == 3:
+            lines.append("Three escaped N for three coefficients: the parabola passes through "
+                         "them (as the thesis's eq. 8.2 did), so R² = 1 by construction and "
+                         "says nothing of the fit; a fourth escaped N would test it.")
     else:
         lines.append("No regression: it needs escaped runs at three or more N.")
     if result["fewest_contained"] is not None:

@@ -83,8 +83,9 @@ def ladder_result(rows: list[dict]) -> dict:
     contained = sorted(int(float(r[KEY])) for r in done if r.get("outcome") == "contained")
     undecided = sorted(int(float(r[KEY])) for r in done
                        if r.get("outcome") not in ("escaped", "contained"))
+    points = len({n for n, _ in escaped})  # distinct N the regression would rest on
     regression = None
-    if len({n for n, _ in escaped}) >= 3:
+    if points >= 3:
         regression = quadratic_ply_regression(*zip(*escaped))
     per_area = sorted((float(r[KEY]), float(r["casing_mass_per_area_kg_per_m2"])) for r in done)
 
@@ -96,7 +97,7 @@ def ladder_result(rows: list[dict]) -> dict:
         return m0 + (m1 - m0) * (n - n0) / (n1 - n0) if n1 != n0 else None
 
     below = [float(r[KEY]) for r in through if not contained or float(r[KEY]) < contained[0]]
-    return {"regression": regression, "regression_points": len({n for n, _ in escaped}),
+    return {"regression": regression, "regression_points": points,
             "fewest_contained": contained[0] if contained else None,
             "most_escaped_below": int(max(below)) if below else None,
             "undecided": undecided, "mass_per_area": mass_per_area}

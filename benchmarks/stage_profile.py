@@ -52,7 +52,8 @@ def main(argv: list[str]) -> None:
         print(f"  {stage:24s} {seconds / n * 1e3:8.3f} ms  {100 * seconds / total:5.1f} %")
     shells = ws.contact.shells
     if shells is not None:
-        print(f"shell contact: {shells.n_pairs} candidates, {shells.searches} searches")
+        print(f"shell contact: {shells.n_pairs} candidates, {shells.searches} searches, "
+              f"{shells.updates} incremental updates")
         contact_parts(shells, state)
 
 
@@ -69,6 +70,7 @@ def best_ms(f, repeats: int = 10):
 def contact_parts(sc, state) -> None:
     """The shell contact's search and narrow phase at ``state``, each timed alone."""
     from wovenimpact.kernels import contact_broad as B
+    from wovenimpact.kernels import contact_update as U
     from wovenimpact.kernels.contact_narrow import (
         GEO_SIDE,
         assemble_contact_forces,
@@ -90,7 +92,8 @@ def contact_parts(sc, state) -> None:
     t_query, _ = best_ms(lambda: B.query_candidates(
         x, sc.quads, sc.ply, sc.node_ply, sc.node_on, sc.h_node, sigma, sc.self_contact,
         sc.node_ptr, sc.node_elem, sc.seg_plane, edge, sc.bucket_ptr, sc.entry_seg,
-        sc.entry_cell, sc.entry_box, sc.entry_ply, sc.slots, sc.pair_ptr, sc.pair_seg))
+        sc.entry_cell, sc.entry_box, sc.entry_ply, sc.no_skip, sc.slots, sc.pair_ptr,
+        sc.pair_seg))
     nodes = int((sc.node_on != 0).sum())
     print(f"  one search {t_all:.2f} ms: boxes {t_box:.2f}, binning {t_bin:.2f} ({entries} "
           f"entries, cell {edge * 1e3:.2f} mm), query {t_query:.2f} ({n} candidates, "
@@ -109,8 +112,10 @@ def contact_parts(sc, state) -> None:
     alive = state.elem[:, E_ALIVE].copy()
     t_mask, _ = best_ms(lambda: B.contact_masks(alive, sc.elem_part, state.node_active,
                                                 sc.node_part, sc.seg_on, sc.node_on))
-    t_valid, _ = best_ms(lambda: B.candidates_still_valid(
-        x, sc.x_search, sc.sigma, sc.node_on, sc.node_on_search, sc.seg_on, sc.seg_on_search))
+    t_valid, _ = best_ms(lambda: (U.surfaces_joined(sc.node_on, sc.node_on_search, sc.seg_on,
+                                                    sc.seg_on_search),
+                                  U.nodes_beyond_skins(x, sc.x_search, sc.sigma, sc.node_on,
+                                                       sc.far)))
     t_geo, _ = best_ms(lambda: segment_geometry(x, sc.quads, sc.seg_on, sc.seg_geo))
     out = np.zeros((x.shape[0], 3))
     t_asm, _ = best_ms(lambda: assemble_contact_forces(

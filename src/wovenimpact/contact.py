@@ -19,13 +19,22 @@ from wovenimpact.kernels.contact_broad import (
     REUSE_STEPS,
     SKIN_FLOOR,
     bin_segments,
+    MAX_CELLS_PER_AXIS,
     bucket_count,
-    candidates_still_valid,
     cell_edge,
     contact_masks,
     node_skins,
     query_candidates,
     segment_boxes,
+)
+from wovenimpact.kernels.contact_update import (
+    mark_requery,
+    nodes_beyond_skins,
+    refresh_far_nodes,
+    requery_candidates,
+    splice_candidates,
+    surfaces_joined,
+    widest_box,
 )
 from wovenimpact.kernels.contact_narrow import (
     N_GEO,
@@ -38,6 +47,34 @@ from wovenimpact.kernels.contact_narrow import (
 
 
 CANDIDATE_SLOTS = 16  # candidates per node kept from the search's counting pass
+# an incremental update (contact_update) instead of a full search while the nodes that
+# left their skins, and the segments re-boxed since the last full search, are at most
+# INCREMENTAL_FRACTION of those on the surfaces, or INCREMENTAL_FLOOR (small models)
+INCREMENTAL_FRACTION = 0.125
+INCREMENTAL_FLOOR = 256
+
+
+class SegmentBins:
+    """Hashed-grid bins of a subset of the segments (``contact_broad.bin_segments``),
+    growing on overflow: ``arrays`` = (bucket_ptr, entry_seg, entry_cell, entry_box,
+    entry_ply)."""
+
+    def __init__(self, capacity: int = 64) -> None:
+        self._alloc(capacity)
+
+    def _alloc(self, capacity: int) -> None:
+        cap = max(64, int(capacity))
+        self.arrays = (np.zeros(bucket_count(cap) + 1, dtype=np.int64),
+                       np.zeros(cap, dtype=np.int64), np.zeros((cap, 3), dtype=np.int64),
+                       np.zeros((cap, N_SEG_BOX)), np.zeros(cap, dtype=np.int64))
+
+    def fill(self, seg_mask, seg_box, ply, inv_edge: float) -> int:
+        """Bin the segments of ``seg_mask``; returns the number of entries."""
+        while True:
+            n = bin_segments(seg_mask, seg_box, ply, inv_edge, *self.arrays)
+            if n <= self.arrays[1].shape[0]:
+                return n
+            self._alloc(int(1.5 * n))
 
 
 def node_plies(node_ptr, node_elem, ply) -> np.ndarray:
@@ -93,8 +130,7 @@ class ShellContact:
     Candidate reuse (Verlet lists): ``forces`` searches with every node given a skin
     σ_p and keeps those candidates while no node has moved farther than its skin since
     that search and no segment or node has joined the surfaces (one that left them,
-    eroded, is passed over by the narrow phase)
-    (:func:`~wovenimpact.kernels.contact_broad.candidates_still_valid`); they then hold
+    eroded, is passed over by the narrow phase); they then hold
     every pair that could act (the narrow phase repeats the box test of a fresh search
     and keeps the closest segment per ply and side, so the same pairs give the same
     forces, bitwise: each node's candidates are listed in segment order whatever the
@@ -103,7 +139,12 @@ class ShellContact:
     a quarter of its shell's thickness, a moving one what it would cover in
     REUSE_STEPS steps, so a fast blade and a casing at rest are both searched rarely
     and the lists hold the next ply, not the whole stack. ``searches`` counts the
-    searches. The persistent state is ``overlap``, computed once from the initial
+    searches. When a few nodes have left their skins (at most INCREMENTAL_FRACTION of
+    those on the surfaces, or 256), only they and the nodes within reach of their segments are
+    re-queried (:mod:`~wovenimpact.kernels.contact_update`, theory §6), with the same
+    forces, bitwise; ``updates`` counts these incremental updates, and a segment or node
+    joining the surfaces, or too many nodes out, still forces a full search. The
+    persistent state is ``overlap``, computed once from the initial
     configuration (deterministic, so a restart rebuilding this object from the same
     Model gets the same one), and the reused candidates, which do not change the forces.
 
@@ -209,6 +250,21 @@ class ShellContact:
         self.node_on_search = np.zeros(nn, dtype=np.int8)
         self.searched = False
         self.searches = 0
+        self.updates = 0
+        # incremental updates (contact_update): nodes out of their skins, the re-queried
+        # nodes and their lists, segments re-boxed this update and since the last search
+        self.far = np.zeros(nn, dtype=np.int8)
+        self.sigma_new = np.zeros(nn)
+        self.req_pos = np.zeros(nn, dtype=np.int64)
+        self.req_list = np.zeros(nn, dtype=np.int64)
+        self.req_ptr = np.zeros(nn + 1, dtype=np.int64)
+        self.req_seg = np.zeros(64, dtype=np.int64)
+        self.seg_new = np.zeros(ne, dtype=np.int8)
+        self.seg_moved = np.zeros(ne, dtype=np.int8)
+        self.seg_side = np.zeros(ne, dtype=np.int8)
+        self.no_skip = np.zeros(ne, dtype=np.int8)
+        self.new_bins = SegmentBins()
+        self.side_bins = SegmentBins()
         # fixed-size scratch
         self.seg_on = np.zeros(ne, dtype=np.int8)
         self.node_on = np.zeros(nn, dtype=np.int8)
@@ -217,6 +273,7 @@ class ShellContact:
         self.seg_geo = np.zeros((ne, N_SEG_GEO))  # the narrow phase's segment table at x
         self._alloc_entries(8 * ne)
         self.pair_ptr = np.zeros(nn + 1, dtype=np.int64)
+        self.pair_ptr_alt = np.zeros(nn + 1, dtype=np.int64)  # the splice's output
         self.seg_ptr = np.zeros(nn + 1, dtype=np.int64)
         self.cursor = np.zeros(nn, dtype=np.int64)
         self.node_f = np.zeros((nn, 3))
@@ -242,9 +299,15 @@ class ShellContact:
         """Pairs the buffers hold before growing."""
         return self.pair_seg.shape[0]
 
-    def _alloc_pairs(self, capacity: int) -> None:
+    def _alloc_pairs(self, capacity: int, keep: int = 0) -> None:
+        """Pair buffers of ``capacity`` pairs; the first ``keep`` candidates of pair_seg
+        are carried over."""
         cap = int(capacity)
+        old = self.pair_seg[:keep] if keep else None
         self.pair_seg = np.zeros(cap, dtype=np.int64)
+        if old is not None:
+            self.pair_seg[:keep] = old
+        self.pair_seg_alt = np.zeros(cap, dtype=np.int64)
         self.geo = np.zeros((cap, N_GEO))
         self.pair_on = np.zeros(cap, dtype=np.int8)
         self.pair_f = np.zeros((cap, 3))
@@ -279,7 +342,7 @@ class ShellContact:
                 x, self.quads, self.ply, self.node_ply, self.node_on, self.h_node, sigma,
                 self.self_contact, self.node_ptr, self.node_elem, self.seg_plane, edge,
                 self.bucket_ptr, self.entry_seg, self.entry_cell, self.entry_box,
-                self.entry_ply, self.slots, self.pair_ptr, self.pair_seg,
+                self.entry_ply, self.no_skip, self.slots, self.pair_ptr, self.pair_seg,
             )
             if n <= self.capacity:
                 break
@@ -289,13 +352,76 @@ class ShellContact:
         self.cell = edge
         return self.n_pairs
 
-    def node_skins(self, v, dt: float) -> np.ndarray:
-        """The skins σ_p of a search (class docstring) into ``self.sigma``."""
+    def node_skins(self, v, dt: float, out=None) -> np.ndarray:
+        """The skins σ_p of a search (class docstring) into ``out`` (default
+        ``self.sigma``)."""
+        out = self.sigma if out is None else out
         if self.skin is not None:
-            self.sigma[:] = 0.5 * self.skin
+            out[:] = 0.5 * self.skin
         else:
-            node_skins(v, dt, REUSE_STEPS, self.h_node, SKIN_FLOOR, self.sigma)
-        return self.sigma
+            node_skins(v, dt, REUSE_STEPS, self.h_node, SKIN_FLOOR, out)
+        return out
+
+    def _full_search(self, x, v, dt: float) -> None:
+        """A search at x with new skins for every node; forgets the updates."""
+        self._search(x, self.node_skins(v, dt))
+        self.x_search[:] = x
+        self.seg_on_search[:] = self.seg_on
+        self.node_on_search[:] = self.node_on
+        self.seg_moved[:] = 0
+        self.searched = self.skin is None or self.skin > 0.0
+        self.searches += 1
+
+    def _update(self, x, v, dt: float, n_far: int) -> bool:
+        """The incremental update of the lists (kernels.contact_update, steps 2–5) after
+        ``n_far`` nodes (``self.far``) left their skins; False, with nothing to keep,
+        when it would not pay (too many nodes or segments) or could not bin the
+        re-boxed segments on the search's cells: the caller then searches afresh."""
+        n_on = int(np.count_nonzero(self.node_on_search))
+        if n_far > max(INCREMENTAL_FLOOR, INCREMENTAL_FRACTION * n_on):
+            return False
+        self.node_skins(v, dt, self.sigma_new)
+        n_new, n_side = refresh_far_nodes(
+            x, self.sigma_new, self.far, self.node_ptr, self.node_elem, self.seg_on,
+            self.x_search, self.sigma, self.seg_new, self.seg_moved, self.seg_side)
+        n_seg = np.count_nonzero(self.seg_on_search)
+        if n_side > max(INCREMENTAL_FLOOR, INCREMENTAL_FRACTION * n_seg):
+            return False
+        segment_boxes(self.x_search, self.quads, self.seg_new, self.h_seg, self.sigma,
+                      self.margin, self.seg_box, self.seg_plane)
+        if widest_box(self.seg_new, self.seg_box) > MAX_CELLS_PER_AXIS * self.cell:
+            return False
+        inv = 1.0 / self.cell
+        self.new_bins.fill(self.seg_new, self.seg_box, self.ply, inv)
+        self.side_bins.fill(self.seg_side, self.seg_box, self.ply, inv)
+        bp, es, ec, eb, _ = self.new_bins.arrays
+        n_req = mark_requery(self.x_search, self.h_node, self.sigma, self.node_on, self.far,
+                             self.cell, self.seg_plane, bp, es, ec, eb, self.req_pos,
+                             self.req_list)
+        main = (self.bucket_ptr, self.entry_seg, self.entry_cell, self.entry_box,
+                self.entry_ply)
+        while True:
+            n = requery_candidates(
+                self.req_list, n_req, self.x_search, self.quads, self.ply, self.node_ply,
+                self.h_node, self.sigma, self.self_contact, self.node_ptr, self.node_elem,
+                self.seg_plane, self.cell, main, self.seg_moved, self.side_bins.arrays,
+                self.no_skip, self.slots, self.req_ptr, self.req_seg)
+            if n <= self.req_seg.shape[0]:
+                break
+            self.req_seg = np.zeros(int(1.5 * n) + 64, dtype=np.int64)
+        while True:
+            total = splice_candidates(self.pair_ptr, self.pair_seg, self.req_pos,
+                                      self.req_ptr, self.req_seg, self.pair_ptr_alt,
+                                      self.pair_seg_alt)
+            if total <= self.capacity:
+                break
+            self._alloc_pairs(int(1.5 * total) + 64, keep=self.n_pairs)
+            self.grow_count += 1
+        self.pair_ptr, self.pair_ptr_alt = self.pair_ptr_alt, self.pair_ptr
+        self.pair_seg, self.pair_seg_alt = self.pair_seg_alt, self.pair_seg
+        self.n_pairs = int(total)
+        self.updates += 1
+        return True
 
     def candidates(self, x, elem_alive=None, node_active=None) -> tuple[np.ndarray, np.ndarray]:
         """Candidate pairs (node, segment) at x, node-major (copies; for tests/diagnostics)."""
@@ -315,15 +441,13 @@ class ShellContact:
             raise ValueError(f"contact forces need a time step dt > 0, got {dt!r}")
         contact_masks(elem_alive, self.elem_part, node_active, self.node_part,
                       self.seg_on, self.node_on)
-        if not (self.searched and candidates_still_valid(
-                x, self.x_search, self.sigma, self.node_on, self.node_on_search,
-                self.seg_on, self.seg_on_search)):
-            self._search(x, self.node_skins(v, dt))
-            self.x_search[:] = x
-            self.seg_on_search[:] = self.seg_on
-            self.node_on_search[:] = self.node_on
-            self.searched = self.skin is None or self.skin > 0.0
-            self.searches += 1
+        if not self.searched or surfaces_joined(self.node_on, self.node_on_search,
+                                                self.seg_on, self.seg_on_search):
+            self._full_search(x, v, dt)
+        else:
+            n_far = nodes_beyond_skins(x, self.x_search, self.sigma, self.node_on, self.far)
+            if n_far and not self._update(x, v, dt, n_far):
+                self._full_search(x, v, dt)
         segment_geometry(x, self.quads, self.seg_on, self.seg_geo)
         penalty_forces(
             x, v, self.quads, self.ply, self.node_mass, self.h_node, self.h_seg, self.margin,

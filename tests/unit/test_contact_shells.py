@@ -216,7 +216,7 @@ class RawSearch:
         assert bin_segments(seg_on, self.seg_box, m.ply, 1.0 / edge, *bins) == n_entries
         args = (x, m.quads, m.ply, self.node_ply, node_on, self.h_node, sigma,
                 self.self_contact, self.ptr, self.elem, self.seg_plane, edge, *bins,
-                self.slots, self.pair_ptr)
+                np.zeros(m.n_elems, np.int8), self.slots, self.pair_ptr)
         n = query_candidates(*args, self.pair_seg)
         if n > self.pair_seg.shape[0]:  # overflow: nothing written but the count
             self.pair_seg = np.full(n, -1, np.int64)
@@ -658,3 +658,78 @@ def test_the_plane_bound_passes_over_only_segments_farther_than_it(seed, warp):
         d = math.dist(p, out[2:5])
         bound = abs(float(n @ (p - mid))) - w
         assert bound <= d * (1.0 + 1e-12) + 1e-12
+
+
+def listed_pairs(contact):
+    """The (node, segment) pairs of a ShellContact's current candidate lists."""
+    nodes = np.repeat(np.arange(contact.pair_ptr.shape[0] - 1), np.diff(contact.pair_ptr))
+    return set(zip(nodes.tolist(), contact.pair_seg[:contact.n_pairs].tolist()))
+
+
+@settings(max_examples=12, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), fast=st.integers(1, 6), speed=st.floats(40.0, 300.0))
+def test_incremental_updates_keep_every_pair_that_can_act(seed, fast, speed):
+    """Three plies at rest but for a few nodes driven across the stack at 40–300 m/s (and a
+    jitter well inside the skins): the nodes leave their skins one or a few at a time,
+    and the contact updates its lists around them instead of searching afresh
+    (kernels.contact_update). At every step every pair a fresh search without skins
+    would list (brute force: the pairs that can act now) is in the lists, and the forces,
+    energy and active pairs are bitwise those of a contact that searches at every call."""
+    rng = np.random.default_rng(seed)
+    t = 0.5e-3
+    mesh, model = plies_model(n_plies=3, side=8e-3, spacing=t + 0.05e-3, thickness=t)
+    reuse = ShellContact(model, friction=0.2, remove_initial_overlap=False)
+    fresh = ShellContact(model, friction=0.2, remove_initial_overlap=False, skin=0.0)
+    x = model.x0.copy()
+    v = rng.uniform(-0.05, 0.05, x.shape)  # 0.05 m/s: never out of a 0.125 mm skin here
+    movers = rng.choice(model.n_nodes, fast, replace=False)
+    direction = rng.normal(size=(fast, 3))
+    v[movers] = speed * direction / np.linalg.norm(direction, axis=1)[:, None]
+    nodes_on = np.ones(model.n_nodes, np.int8)
+    segs_on = np.ones(model.n_elems, np.int8)
+    zero = np.zeros(model.n_nodes)
+    h_seg = 0.5 * t * np.ones(model.n_elems)
+    m = model.node_mass[:, None]
+    for _ in range(80):  # 80 Δt: 0.32–2.4 mm, past the 0.125 mm skin of a node at rest
+        fa, ea, na = contact_forces(reuse, model, x, v=v)
+        fb, eb, nb = contact_forces(fresh, model, x, v=v)
+        assert fa.tobytes() == fb.tobytes() and ea == eb and na == nb
+        can_act = brute_force_candidates(x, model.quads, model.ply, segs_on, nodes_on,
+                                         reuse.h_node, h_seg, zero, 0.0, False,
+                                         model.node_ptr, model.node_elem)
+        assert can_act <= listed_pairs(reuse)
+        v[movers] += DT * fa[movers] / m[movers]
+        x += DT * v
+    assert reuse.updates > 0
+    assert reuse.searches < 0.5 * (reuse.searches + reuse.updates) + 1
+
+
+def test_an_incremental_update_requeries_only_around_the_nodes_that_left():
+    """One node of the middle of three plies pushed out of its skin: the update
+    re-queries that node and the nodes within reach of its four segments (within two
+    1 mm elements of it in plan), not the whole stack, and a node far from it keeps its
+    list (the same pairs)."""
+    t = 0.5e-3
+    mesh, model = plies_model(n_plies=3, side=32e-3, spacing=t + 0.05e-3, thickness=t)
+    contact = ShellContact(model, remove_initial_overlap=False)
+    x = model.x0.copy()
+    contact_forces(contact, model, x)
+    before = listed_pairs(contact)
+    middle = np.flatnonzero(model.ply == 1)
+    centre = model.x0[model.quads[middle]].mean(axis=1)
+    node = int(model.quads[middle[np.argmin(np.linalg.norm(centre[:, :2] - 8e-3, axis=1))], 0])
+    x[node, 2] += 0.2e-3  # beyond its 0.125 mm skin
+    contact_forces(contact, model, x)
+    assert (contact.searches, contact.updates) == (1, 1)
+    requeried = set(contact.req_list[:np.count_nonzero(contact.req_pos >= 0)].tolist())
+    assert node in requeried
+    assert 1 < len(requeried) < 0.1 * model.n_nodes
+    plan = np.linalg.norm(model.x0[sorted(requeried), :2] - model.x0[node, :2], axis=1)
+    assert plan.max() <= 2e-3 + 1e-12
+    far_away = int(np.argmax(np.linalg.norm(model.x0 - model.x0[node], axis=1)))
+    assert far_away not in requeried
+    after = listed_pairs(contact)
+    assert {pr for pr in after if pr[0] == far_away} == {pr for pr in before if pr[0] == far_away}
+    search = ShellContact(model, remove_initial_overlap=False, skin=0.0)
+    contact_forces(search, model, x)
+    assert listed_pairs(search) <= after  # no pair a search at x would list is missing

@@ -6,7 +6,8 @@ act when the node p (offset h_p, half its shell's thickness) lies within
 r = h_p + h_s + m of segment s (offset h_s, margin m): its gap g = d − (h_p + h_s − o_p)
 is then negative only if d < r. The search lists every such pair, and keeps listing it
 while each node i moves no more than its own skin σ_i (Euclidean) from where it was at
-the search (Verlet lists, :func:`candidates_still_valid`). Node p is a candidate of s
+the search (Verlet lists; :mod:`contact_update` re-queries only around the nodes that
+leave their skins). Node p is a candidate of s
 when, at the search,
 
 1. box: p lies in the segment's axis-aligned box inflated by r + σ_p + σ_s,
@@ -225,6 +226,16 @@ def overlap_in_cell(lo, hi, box_lo, box_hi, several, cell, inv_edge):
 
 
 @kernel
+def running_total(ptr, n):
+    """ptr[1:n + 1] holds n counts: turn ptr[:n + 1] into their running total (ptr[0] = 0,
+    the CSR offsets) and return the total ptr[n]."""
+    ptr[0] = 0
+    for i in range(n):
+        ptr[i + 1] += ptr[i]
+    return ptr[n]
+
+
+@kernel
 def sort_ascending(a, start, stop):
     """Insertion sort of a[start:stop] in place (a node's few candidates)."""
     for i in range(start + 1, stop):
@@ -239,9 +250,11 @@ def sort_ascending(a, start, stop):
 @kernel
 def scan_node(p, x, quads, ply, node_ply, h_node, sigma, self_contact, node_ptr, node_elem,
               seg_plane, edge, bucket_ptr, entry_seg, entry_cell, entry_box, entry_ply,
-              out, start, room):
-    """Node p's candidates (module docstring, step 3): their number; the first ``room``
-    of them are written to out[start:], in scan order."""
+              skip, out, start, room):
+    """Node p's candidates (module docstring, step 3) among the binned segments not
+    marked in ``skip`` (int8 per segment; all 0 in a full search, the re-boxed segments
+    in an incremental one, :mod:`contact_update`): their number; the first ``room`` of
+    them are written to out[start:], in scan order."""
     mask = bucket_ptr.shape[0] - 2
     inv = 1.0 / edge
     px, py, pz = x[p, 0], x[p, 1], x[p, 2]
@@ -274,6 +287,8 @@ def scan_node(p, x, quads, ply, node_ply, h_node, sigma, self_contact, node_ptr,
                     if own_ply >= 0 and entry_ply[k] == own_ply:
                         continue
                     s = entry_seg[k]
+                    if skip[s] != 0:
+                        continue
                     height = (seg_plane[s, 0] * px + seg_plane[s, 1] * py
                               + seg_plane[s, 2] * pz - seg_plane[s, SP_D])
                     if abs(height) > a + seg_plane[s, SP_SLACK]:
@@ -290,7 +305,7 @@ def scan_node(p, x, quads, ply, node_ply, h_node, sigma, self_contact, node_ptr,
 @loop_kernel
 def query_candidates(
     x, quads, ply, node_ply, node_on, h_node, sigma, self_contact, node_ptr, node_elem,
-    seg_plane, edge, bucket_ptr, entry_seg, entry_cell, entry_box, entry_ply, slots,
+    seg_plane, edge, bucket_ptr, entry_seg, entry_cell, entry_box, entry_ply, skip, slots,
     pair_ptr, pair_seg,
 ):
     """Candidate (node, segment) pairs of the binned segments (module docstring, step 3).
@@ -307,6 +322,7 @@ def query_candidates(
         seg_plane: the planes of :func:`segment_boxes`; edge: the cell edge L.
         bucket_ptr, entry_seg, entry_cell, entry_box, entry_ply: the bins of
             :func:`bin_segments`.
+        skip: (n_segments,) int8: binned segments to pass over (all 0 in a search).
         slots: (n_nodes, m) int64 scratch: the first m candidates of each node, kept
             from the counting pass (a node with more is scanned again to write).
         pair_ptr: (n_nodes + 1,) int64 written: candidates of node p are
@@ -324,12 +340,9 @@ def query_candidates(
         if node_on[p] != 0:
             count = scan_node(p, x, quads, ply, node_ply, h_node, sigma, self_contact,
                               node_ptr, node_elem, seg_plane, edge, bucket_ptr, entry_seg,
-                              entry_cell, entry_box, entry_ply, flat, p * room, room)
+                              entry_cell, entry_box, entry_ply, skip, flat, p * room, room)
         pair_ptr[p + 1] = count
-    pair_ptr[0] = 0
-    for p in range(n_nodes):
-        pair_ptr[p + 1] += pair_ptr[p]
-    if pair_ptr[n_nodes] > pair_seg.shape[0]:
+    if running_total(pair_ptr, n_nodes) > pair_seg.shape[0]:
         return pair_ptr[n_nodes]
     for p in prange(n_nodes):
         base, count = pair_ptr[p], pair_ptr[p + 1] - pair_ptr[p]
@@ -339,7 +352,7 @@ def query_candidates(
         else:
             scan_node(p, x, quads, ply, node_ply, h_node, sigma, self_contact, node_ptr,
                       node_elem, seg_plane, edge, bucket_ptr, entry_seg, entry_cell,
-                      entry_box, entry_ply, pair_seg, base, count)
+                      entry_box, entry_ply, skip, pair_seg, base, count)
         sort_ascending(pair_seg, base, base + count)
     return pair_ptr[n_nodes]
 
@@ -366,30 +379,3 @@ def node_skins(v, dt, steps, h_node, floor, sigma):
     for p in prange(v.shape[0]):
         speed = math.sqrt(v[p, 0] * v[p, 0] + v[p, 1] * v[p, 1] + v[p, 2] * v[p, 2])
         sigma[p] = max(floor * h_node[p], steps * speed * dt)
-
-
-@kernel
-def candidates_still_valid(x, x_search, sigma, node_on, node_on_search, seg_on,
-                           seg_on_search):
-    """Whether the candidates of a search at x_search with node skins σ still hold every
-    pair the narrow phase could make act at x (Verlet-list reuse, module docstring):
-    every node still on within its skin of where it was, |x_p − x_search,p| ≤ σ_p, and
-    no segment or node joined the surfaces since. One that left them (an eroded
-    segment, a node left without a live element) keeps its candidates: the narrow phase
-    passes over pairs whose node or segment is off, so the lists still hold every pair
-    a fresh search would list. Serial with an early exit: one pass over the nodes at
-    most."""
-    for e in range(seg_on.shape[0]):
-        if seg_on[e] != 0 and seg_on_search[e] == 0:
-            return False
-    for p in range(x.shape[0]):
-        if node_on[p] == 0:
-            continue
-        if node_on_search[p] == 0:
-            return False
-        dx = x[p, 0] - x_search[p, 0]
-        dy = x[p, 1] - x_search[p, 1]
-        dz = x[p, 2] - x_search[p, 2]
-        if dx * dx + dy * dy + dz * dz > sigma[p] * sigma[p]:
-            return False
-    return True

@@ -115,7 +115,7 @@ def contact_parts(sc, state) -> None:
     t_valid, _ = best_ms(lambda: (U.surfaces_joined(sc.node_on, sc.node_on_search, sc.seg_on,
                                                     sc.seg_on_search),
                                   U.nodes_beyond_skins(x, sc.x_search, sc.sigma, sc.node_on,
-                                                       sc.far)))
+                                                       state.v, 4.0 * state.dt, sc.far)))
     t_geo, _ = best_ms(lambda: segment_geometry(x, sc.quads, sc.seg_on, sc.seg_geo))
     out = np.zeros((x.shape[0], 3))
     t_asm, _ = best_ms(lambda: assemble_contact_forces(

@@ -28,6 +28,7 @@ from wovenimpact.kernels.contact_broad import (
     segment_boxes,
 )
 from wovenimpact.kernels.contact_update import (
+    bounding_box,
     mark_requery,
     nodes_beyond_skins,
     refresh_far_nodes,
@@ -52,6 +53,9 @@ CANDIDATE_SLOTS = 16  # candidates per node kept from the search's counting pass
 # INCREMENTAL_FRACTION of those on the surfaces, or INCREMENTAL_FLOOR (small models)
 INCREMENTAL_FRACTION = 0.125
 INCREMENTAL_FLOOR = 256
+# an update also re-anchors the nodes that would leave their skins within this many
+# steps at their speed
+AHEAD_STEPS = 4.0
 
 
 class SegmentBins:
@@ -140,10 +144,12 @@ class ShellContact:
     REUSE_STEPS steps, so a fast blade and a casing at rest are both searched rarely
     and the lists hold the next ply, not the whole stack. ``searches`` counts the
     searches. When a few nodes have left their skins (at most INCREMENTAL_FRACTION of
-    those on the surfaces, or 256), only they and the nodes within reach of their segments are
+    those on the surfaces, or 256), only they (with those that would leave within
+    AHEAD_STEPS steps at their speed) and the nodes within reach of their segments are
     re-queried (:mod:`~wovenimpact.kernels.contact_update`, theory §6), with the same
     forces, bitwise; ``updates`` counts these incremental updates, and a segment or node
-    joining the surfaces, or too many nodes out, still forces a full search. The
+    joining the surfaces, too many nodes out or too many segments re-boxed since the
+    last full search still force one (``search_causes`` counts why). The
     persistent state is ``overlap``, computed once from the initial
     configuration (deterministic, so a restart rebuilding this object from the same
     Model gets the same one), and the reused candidates, which do not change the forces.
@@ -251,6 +257,9 @@ class ShellContact:
         self.searched = False
         self.searches = 0
         self.updates = 0
+        # why each full search of forces() was made (diagnostics)
+        self.search_causes = {"first": 0, "surfaces joined": 0, "many nodes out": 0,
+                              "many segments re-boxed": 0, "wide segment": 0}
         # incremental updates (contact_update): nodes out of their skins, the re-queried
         # nodes and their lists, segments re-boxed this update and since the last search
         self.far = np.zeros(nn, dtype=np.int8)
@@ -263,6 +272,7 @@ class ShellContact:
         self.seg_moved = np.zeros(ne, dtype=np.int8)
         self.seg_side = np.zeros(ne, dtype=np.int8)
         self.no_skip = np.zeros(ne, dtype=np.int8)
+        self.new_bounds = np.zeros(6)
         self.new_bins = SegmentBins()
         self.side_bins = SegmentBins()
         # fixed-size scratch
@@ -323,12 +333,9 @@ class ShellContact:
         self.entry_ply = np.zeros(cap, dtype=np.int64)
         self.bucket_ptr = np.zeros(bucket_count(cap) + 1, dtype=np.int64)
 
-    def _search(self, x, sigma) -> int:
-        """Candidates at x with node skins ``sigma`` into pair_ptr/pair_seg (seg_on and
-        node_on set); the bins and the pair buffers grow on overflow."""
-        segment_boxes(x, self.quads, self.seg_on, self.h_seg, sigma, self.margin,
-                      self.seg_box, self.seg_plane)
-        edge = cell_edge(self.seg_on, self.seg_box)
+    def _bin(self, edge: float) -> None:
+        """The live segments (seg_on) into the bins at their padded boxes (seg_box), on
+        cells of edge ``edge``; the bins grow on overflow."""
         while True:
             n = bin_segments(self.seg_on, self.seg_box, self.ply, 1.0 / edge,
                              self.bucket_ptr, self.entry_seg, self.entry_cell,
@@ -337,6 +344,14 @@ class ShellContact:
                 break
             self._alloc_entries(int(1.5 * n))
             self.grow_count += 1
+
+    def _search(self, x, sigma) -> int:
+        """Candidates at x with node skins ``sigma`` into pair_ptr/pair_seg (seg_on and
+        node_on set); the bins and the pair buffers grow on overflow."""
+        segment_boxes(x, self.quads, self.seg_on, self.h_seg, sigma, self.margin,
+                      self.seg_box, self.seg_plane)
+        edge = cell_edge(self.seg_on, self.seg_box)
+        self._bin(edge)
         while True:
             n = query_candidates(
                 x, self.quads, self.ply, self.node_ply, self.node_on, self.h_node, sigma,
@@ -379,25 +394,29 @@ class ShellContact:
         re-boxed segments on the search's cells: the caller then searches afresh."""
         n_on = int(np.count_nonzero(self.node_on_search))
         if n_far > max(INCREMENTAL_FLOOR, INCREMENTAL_FRACTION * n_on):
+            self.search_causes["many nodes out"] += 1
             return False
         self.node_skins(v, dt, self.sigma_new)
         n_new, n_side = refresh_far_nodes(
             x, self.sigma_new, self.far, self.node_ptr, self.node_elem, self.seg_on,
             self.x_search, self.sigma, self.seg_new, self.seg_moved, self.seg_side)
-        n_seg = np.count_nonzero(self.seg_on_search)
-        if n_side > max(INCREMENTAL_FLOOR, INCREMENTAL_FRACTION * n_seg):
-            return False
         segment_boxes(self.x_search, self.quads, self.seg_new, self.h_seg, self.sigma,
                       self.margin, self.seg_box, self.seg_plane)
         if widest_box(self.seg_new, self.seg_box) > MAX_CELLS_PER_AXIS * self.cell:
+            self.search_causes["wide segment"] += 1
+            return False
+        n_seg = np.count_nonzero(self.seg_on_search)
+        if n_side > max(INCREMENTAL_FLOOR, INCREMENTAL_FRACTION * n_seg):
+            self.search_causes["many segments re-boxed"] += 1
             return False
         inv = 1.0 / self.cell
         self.new_bins.fill(self.seg_new, self.seg_box, self.ply, inv)
         self.side_bins.fill(self.seg_side, self.seg_box, self.ply, inv)
+        bounding_box(self.seg_new, self.seg_box, self.new_bounds)
         bp, es, ec, eb, _ = self.new_bins.arrays
         n_req = mark_requery(self.x_search, self.h_node, self.sigma, self.node_on, self.far,
-                             self.cell, self.seg_plane, bp, es, ec, eb, self.req_pos,
-                             self.req_list)
+                             self.cell, self.seg_plane, self.new_bounds, bp, es, ec, eb,
+                             self.req_pos, self.req_list)
         main = (self.bucket_ptr, self.entry_seg, self.entry_cell, self.entry_box,
                 self.entry_ply)
         while True:
@@ -441,11 +460,14 @@ class ShellContact:
             raise ValueError(f"contact forces need a time step dt > 0, got {dt!r}")
         contact_masks(elem_alive, self.elem_part, node_active, self.node_part,
                       self.seg_on, self.node_on)
-        if not self.searched or surfaces_joined(self.node_on, self.node_on_search,
-                                                self.seg_on, self.seg_on_search):
+        joined = self.searched and surfaces_joined(self.node_on, self.node_on_search,
+                                                   self.seg_on, self.seg_on_search)
+        if not self.searched or joined:
+            self.search_causes["surfaces joined" if joined else "first"] += 1
             self._full_search(x, v, dt)
         else:
-            n_far = nodes_beyond_skins(x, self.x_search, self.sigma, self.node_on, self.far)
+            n_far = nodes_beyond_skins(x, self.x_search, self.sigma, self.node_on, v,
+                                       AHEAD_STEPS * dt, self.far)
             if n_far and not self._update(x, v, dt, n_far):
                 self._full_search(x, v, dt)
         segment_geometry(x, self.quads, self.seg_on, self.seg_geo)

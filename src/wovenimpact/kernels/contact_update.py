@@ -6,7 +6,9 @@ node stays within its skin: |x_p − x_search,p| ≤ σ_p. When a few nodes F le
 skins, a full search re-bins every segment and re-queries every node. This module does
 only what their leaving requires:
 
-1. ``nodes_beyond_skins``: F, the nodes on the surfaces farther than σ_p from x_search,p.
+1. ``nodes_beyond_skins``: F, the nodes on the surfaces farther than σ_p from x_search,p,
+   and with them, once one is, those that would leave within a few steps at their
+   speed (re-anchoring a node early is always allowed).
 2. ``refresh_far_nodes``: each q ∈ F gets x_search,q = x_q and a new skin σ_q; the live
    segments with a node in F (S_F, ``seg_new``) get new padded boxes and planes
    (:func:`contact_broad.segment_boxes` at x_search, with their other nodes' old
@@ -32,6 +34,8 @@ that holds them, and the forces stay bitwise those of a search at every step.
 
 from __future__ import annotations
 
+import math
+
 from numba import prange
 
 from wovenimpact.jit import kernel, loop_kernel
@@ -50,9 +54,13 @@ from wovenimpact.kernels.contact_broad import (
 
 
 @loop_kernel
-def nodes_beyond_skins(x, x_search, sigma, node_on, far):
-    """far[p] = 1 for every node on the surfaces with |x_p − x_search,p| > σ_p, else 0;
-    returns their number."""
+def nodes_beyond_skins(x, x_search, sigma, node_on, v, ahead, far):
+    """far[p] = 1 for every node on the surfaces with |x_p − x_search,p| > σ_p; 2 for one
+    within σ_p that would leave at its speed within ``ahead`` steps of Δt,
+    |x_p − x_search,p| + ahead |v_p| Δt > σ_p (``ahead`` is steps × Δt, s); else 0.
+    Returns the number of the first kind. An update takes the second kind along: nodes
+    moving together, such as a flying fragment's, then leave their skins together
+    again, one update for all instead of one at each step."""
     count = 0
     for p in prange(x.shape[0]):
         out = 0
@@ -60,10 +68,15 @@ def nodes_beyond_skins(x, x_search, sigma, node_on, far):
             dx = x[p, 0] - x_search[p, 0]
             dy = x[p, 1] - x_search[p, 1]
             dz = x[p, 2] - x_search[p, 2]
-            if dx * dx + dy * dy + dz * dz > sigma[p] * sigma[p]:
+            d = math.sqrt(dx * dx + dy * dy + dz * dz)
+            if d > sigma[p]:
                 out = 1
+            else:
+                speed = math.sqrt(v[p, 0] * v[p, 0] + v[p, 1] * v[p, 1] + v[p, 2] * v[p, 2])
+                if d + ahead * speed > sigma[p]:
+                    out = 2
         far[p] = out
-        count += out
+        count += 1 if out == 1 else 0
     return count
 
 
@@ -152,20 +165,41 @@ def meets_binned_segment(px, py, pz, reach, edge, seg_plane, bucket_ptr, entry_s
     return False
 
 
+@kernel
+def bounding_box(seg_mask, seg_box, out):
+    """out = (lower corner, upper corner) of the padded boxes of the segments of
+    ``seg_mask`` (empty, lower > upper, when there is none)."""
+    for d in range(3):
+        out[d] = math.inf
+        out[3 + d] = -math.inf
+    for s in range(seg_mask.shape[0]):
+        if seg_mask[s] == 0:
+            continue
+        for d in range(3):
+            out[d] = min(out[d], seg_box[s, SB_LO + d])
+            out[3 + d] = max(out[3 + d], seg_box[s, SB_HI + d])
+
+
 @loop_kernel
-def mark_requery(x_search, h_node, sigma, node_on, far, edge, seg_plane, bucket_ptr,
+def mark_requery(x_search, h_node, sigma, node_on, far, edge, seg_plane, bounds, bucket_ptr,
                  entry_seg, entry_cell, entry_box, req_pos, req_list):
     """Step 3: R = F ∪ {nodes on whose box x_search,p ± (h_p + σ_p) meets a segment of
-    the bins of S_F}. req_pos[p] = position of p in req_list (−1 outside R); req_list
-    holds R in increasing node order. Returns |R|."""
+    the bins of S_F} (``bounds``: the box around those segments, a first test).
+    req_pos[p] = position of p in req_list (−1 outside R); req_list holds R in
+    increasing node order. Returns |R|."""
     n = x_search.shape[0]
     for p in prange(n):
         flag = -1
         if node_on[p] != 0:
+            reach = h_node[p] + sigma[p] + TOLERANCE * edge
+            px, py, pz = x_search[p, 0], x_search[p, 1], x_search[p, 2]
             if far[p] != 0:
                 flag = 0
+            elif (px + reach < bounds[0] or bounds[3] < px - reach
+                  or py + reach < bounds[1] or bounds[4] < py - reach
+                  or pz + reach < bounds[2] or bounds[5] < pz - reach):
+                flag = -1
             else:
-                reach = h_node[p] + sigma[p] + TOLERANCE * edge
                 if meets_binned_segment(x_search[p, 0], x_search[p, 1], x_search[p, 2],
                                         reach, edge, seg_plane, bucket_ptr, entry_seg,
                                         entry_cell, entry_box):

@@ -397,7 +397,7 @@ class ShellContact:
             self.search_causes["many nodes out"] += 1
             return False
         self.node_skins(v, dt, self.sigma_new)
-        n_new, n_side = refresh_far_nodes(
+        _, n_side = refresh_far_nodes(
             x, self.sigma_new, self.far, self.node_ptr, self.node_elem, self.seg_on,
             self.x_search, self.sigma, self.seg_new, self.seg_moved, self.seg_side)
         segment_boxes(self.x_search, self.quads, self.seg_new, self.h_seg, self.sigma,

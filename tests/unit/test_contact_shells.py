@@ -674,7 +674,8 @@ def test_incremental_updates_keep_every_pair_that_can_act(seed, fast, speed):
     and the contact updates its lists around them instead of searching afresh
     (kernels.contact_update). At every step every pair a fresh search without skins
     would list (brute force: the pairs that can act now) is in the lists, and the forces,
-    energy and active pairs are bitwise those of a contact that searches at every call."""
+    energy and active pairs are bitwise those of a contact that searches at every call;
+    and the contact made at most one full search more than it made updates."""
     rng = np.random.default_rng(seed)
     t = 0.5e-3
     mesh, model = plies_model(n_plies=3, side=8e-3, spacing=t + 0.05e-3, thickness=t)

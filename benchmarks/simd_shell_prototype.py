@@ -1,5 +1,5 @@
-"""Prototype of the SIMD element pass (issue 13): the 2x2-membrane elastic shell element
-(resultant section) as one loop over elements that LLVM vectorises, timed against
+"""Prototype of the SIMD element pass (issue 13): the 2×2-membrane elastic shell element
+(resultant section) written so that LLVM vectorises it across elements, timed against
 ``shell_force`` on the same state. A measurement, not solver code.
 
     python benchmarks/simd_shell_prototype.py [N_ELEMENTS]   (default 100 000)
@@ -8,24 +8,22 @@ Checks the outputs (corner forces and moments, resultants, energies, F at the po
 curvatures, stable step) against ``shell_force`` (bit for bit: the same formulas in the
 same order; exit 1 otherwise), then prints ns per element of each, one thread.
 
-What Numba's loops need to vectorise (found here with LLVM's
-``--pass-remarks-missed=loop-vectorize``; docs/theory.md §4, "SIMD element pass"):
+What Numba's loops need to vectorise (found with LLVM's
+``--pass-remarks-missed=loop-vectorize``; docs/theory.md §4.6, "SIMD element pass"):
 
-1. Structure-of-arrays tables, one row per value, indexed ``[value, e]``; the corner
-   gathers ``x[quads[e, i]]`` do not vectorise (LLVM's cost model declines gathers on
-   this CPU), so a scalar pass copies each element's corners into such a table first
-   (``gather_corners``).
-2. No alias checks: LLVM must prove that no output overlaps an input. Numba marks array
-   arguments ``noalias`` only in parfor bodies; here every function is compiled with
-   the flag set (``_with_noalias``, Numba's internal ``Flags.noalias``, set only after
-   the solver's own kernels are compiled), and each output
-   row is a separate array (a tuple of rows): rows of one 2-D table written at
-   different indices need a run-time check per pair ("too many memory checks needed").
-3. No inner loops with long bodies: the vectoriser takes innermost loops only, and a
-   loop over the four Gauss points or corners that LLVM does not unroll itself is one;
-   they are written out (``gauss_point``, ``corner_out`` called four times).
-4. No early exits and no calls (``sqrt`` and division vectorise; ``atan2``, ``exp``
-   have no vector version without SVML, absent here).
+1. Blocks of LANES = 8 elements with each value's 8 lanes side by side (one AVX-512
+   register), all of a block's values contiguous, and the loop over a block's lanes
+   innermost; indices unsigned (:func:`lane`), so that they are affine.
+2. The corner gathers ``x[quads[e, i]]`` do not vectorise (LLVM's cost model declines
+   gathers here): a scalar loop copies the block's corners into a small table first.
+3. No run-time alias checks: Numba passes arrays without ``noalias`` (it sets it only on
+   the parfor bodies it generates), and LLVM gives up past its limit of checks ("too
+   many memory checks needed"). Here every function compiled after the reference is
+   compiled with Numba's internal ``Flags.noalias`` set (``_with_noalias``).
+4. No inner loops with long bodies (the vectoriser takes innermost loops only): the four
+   Gauss points and corners are written out (``gauss_point``, ``corner_out``).
+5. No early exits and no calls: ``sqrt`` and division vectorise; ``atan2`` and ``exp``
+   have no vector form without SVML (not installed here).
 """
 
 import math
@@ -67,16 +65,51 @@ from wovenimpact.kernels.shell_layout import (  # noqa: E402
     E_U_BEND,
     E_U_HG,
     E_U_MEMB,
+    N_ELEM_STATE,
 )
 
 FAST = dict(boundscheck=False, error_model="numpy")
 STEEL_E, STEEL_NU = 210e9, 0.3  # the benchmark's elastic plate (wovenimpact.benchmark)
 
 
+LANES = 8  # elements per block: one AVX-512 register of doubles
+_U = np.uint64
+
+
 @njit(inline="always", **FAST)
-def gauss_point(lx, ly, a1, a2, a3, a4, c1, c2, c3, c4, wg, e_mod, nu, thick):
+def lane(b, width, c, lu):
+    """Index of value c of lane lu of block b in a table of blocks of ``width`` values
+    (unsigned, so that Numba adds no negative-index test and LLVM sees an affine
+    index)."""
+    return (b * _U(width) + _U(c)) * _U(LANES) + lu
+
+
+@njit(inline="always", **FAST)
+def col(b, c, lu):
+    """Element-state column c of lane lu of block b."""
+    return lane(b, N_ELEM_STATE, c, lu)
+
+
+@njit(inline="always", **FAST)
+def slot(c, lu):
+    """Value c (corner·9 + x, y, z, v_x, v_y, v_z, ω_x, ω_y, ω_z) of the corner block."""
+    return _U(c) * _U(LANES) + lu
+
+
+@njit(inline="always", **FAST)
+def gauss_gradients(gg, bu, g, lu):
+    """Gauss point g's ∂N_I/∂X (4) and ∂N_I/∂Y (4)."""
+    return (gg[lane(bu, 32, 8 * g, lu)], gg[lane(bu, 32, 8 * g + 1, lu)],
+            gg[lane(bu, 32, 8 * g + 2, lu)], gg[lane(bu, 32, 8 * g + 3, lu)],
+            gg[lane(bu, 32, 8 * g + 4, lu)], gg[lane(bu, 32, 8 * g + 5, lu)],
+            gg[lane(bu, 32, 8 * g + 6, lu)], gg[lane(bu, 32, 8 * g + 7, lu)])
+
+
+@njit(inline="always", **FAST)
+def gauss_point(lx, ly, grads, wg, e_mod, nu, thick):
     """One 2x2 point: F = sum x_I (x) dN_I/dX, the elastic membrane, and its weighted
     energy, resultant and corner forces w_g P G_gI (shell.full_membrane's terms)."""
+    a1, a2, a3, a4, c1, c2, c3, c4 = grads
     f11 = lx[0] * a1 + lx[1] * a2 + lx[2] * a3 + lx[3] * a4
     f12 = lx[0] * c1 + lx[1] * c2 + lx[2] * c3 + lx[3] * c4
     f21 = ly[0] * a1 + ly[1] * a2 + ly[2] * a3 + ly[3] * a4
@@ -108,189 +141,200 @@ def corner_out(mfx, mfy, gam, b1, b2, fzs, area, h0, h1, hg2, hg3, hg4, mxx, myy
 
 
 @njit(**FAST)
-def element_pass(n, cn, gg, gw, a0s, inertia, dt, thick, mu, e_mod, nu, e_b, nu_b, kgt, r_hg,
-                 el_in, el_out, blk):
+def element_pass(nb, x, v, omega, quads, cn, gg, gw, a0s, inertia, dt, thick, mu, e_mod, nu,
+                 e_b, nu_b, kgt, r_hg, el_in, el_out, blk):
     """``shell_force`` of a 2×2-membrane elastic element with a resultant section, for
-    elements 0 … n − 1, on structure-of-arrays tables: cn[corner, value, e]
-    (gather_corners), gg[g, ∂/∂X or ∂/∂Y, corner, e], gw[g, e], el_in[column, e]; el_out
-    and blk are tuples of rows (an element-state column; a corner's force or moment
-    component), written. No failure checks (every element of the plate is sound)."""
+    the nb blocks of LANES elements (element e = LANES·b + l; quads padded to whole
+    blocks), on tables of blocks: value c of element e at [lane(b, width, c, l)]
+    (:func:`lane`): gg (the 32 Gauss gradients, [g, ∂/∂X or ∂/∂Y, corner]), gw (4),
+    a0s and inertia (1), el_in and el_out (the element state), blk (written: corner
+    forces and moments, [corner, component]). cn is a scratch block of corners. No
+    failure checks (every element of the plate is sound)."""
     c_m = e_mod * thick / (1.0 - nu * nu)
     d_b = e_b * thick * thick * thick / (12.0 * (1.0 - nu_b * nu_b))
-    for e in range(n):
-        px = (cn[0, 0, e], cn[1, 0, e], cn[2, 0, e], cn[3, 0, e])
-        py = (cn[0, 1, e], cn[1, 1, e], cn[2, 1, e], cn[3, 1, e])
-        pz = (cn[0, 2, e], cn[1, 2, e], cn[2, 2, e], cn[3, 2, e])
-        vx_ = (cn[0, 3, e], cn[1, 3, e], cn[2, 3, e], cn[3, 3, e])
-        vy_ = (cn[0, 4, e], cn[1, 4, e], cn[2, 4, e], cn[3, 4, e])
-        vz_ = (cn[0, 5, e], cn[1, 5, e], cn[2, 5, e], cn[3, 5, e])
-        wx_ = (cn[0, 6, e], cn[1, 6, e], cn[2, 6, e], cn[3, 6, e])
-        wy_ = (cn[0, 7, e], cn[1, 7, e], cn[2, 7, e], cn[3, 7, e])
-        wz_ = (cn[0, 8, e], cn[1, 8, e], cn[2, 8, e], cn[3, 8, e])
-        frame = corotational_frame(px, py, pz)
-        area = frame[4]
-        mid = midpoint_frame(px, py, pz, vx_, vy_, vz_, dt)
-        lx, ly = frame[3]
-        b1, b2 = frame[5]
-        vx, vy, vz, tx, ty, dkx, dky, dkxy2, dgxz, dgyz = midpoint_rates(
-            mid, vx_, vy_, vz_, wx_, wy_, wz_, dt)
-        el_out[E_KAPPA][e] = el_in[E_KAPPA, e] + dkx
-        el_out[E_KAPPA + 1][e] = el_in[E_KAPPA + 1, e] + dky
-        el_out[E_KAPPA + 2][e] = el_in[E_KAPPA + 2, e] + dkxy2
-        # membrane at the 2x2 points
-        F0, u0, n0, m0_, f0 = gauss_point(
-            lx, ly, gg[0, 0, 0, e], gg[0, 0, 1, e], gg[0, 0, 2, e], gg[0, 0, 3, e],
-            gg[0, 1, 0, e], gg[0, 1, 1, e], gg[0, 1, 2, e], gg[0, 1, 3, e], gw[0, e],
-            e_mod, nu, thick)
-        el_out[E_FG + 0][e] = F0[0]
-        el_out[E_FG + 1][e] = F0[1]
-        el_out[E_FG + 2][e] = F0[2]
-        el_out[E_FG + 3][e] = F0[3]
-        F1, u1, n1, m1_, f1 = gauss_point(
-            lx, ly, gg[1, 0, 0, e], gg[1, 0, 1, e], gg[1, 0, 2, e], gg[1, 0, 3, e],
-            gg[1, 1, 0, e], gg[1, 1, 1, e], gg[1, 1, 2, e], gg[1, 1, 3, e], gw[1, e],
-            e_mod, nu, thick)
-        el_out[E_FG + 4][e] = F1[0]
-        el_out[E_FG + 5][e] = F1[1]
-        el_out[E_FG + 6][e] = F1[2]
-        el_out[E_FG + 7][e] = F1[3]
-        F2, u2, n2, m2_, f2 = gauss_point(
-            lx, ly, gg[2, 0, 0, e], gg[2, 0, 1, e], gg[2, 0, 2, e], gg[2, 0, 3, e],
-            gg[2, 1, 0, e], gg[2, 1, 1, e], gg[2, 1, 2, e], gg[2, 1, 3, e], gw[2, e],
-            e_mod, nu, thick)
-        el_out[E_FG + 8][e] = F2[0]
-        el_out[E_FG + 9][e] = F2[1]
-        el_out[E_FG + 10][e] = F2[2]
-        el_out[E_FG + 11][e] = F2[3]
-        F3, u3, n3, m3_, f3 = gauss_point(
-            lx, ly, gg[3, 0, 0, e], gg[3, 0, 1, e], gg[3, 0, 2, e], gg[3, 0, 3, e],
-            gg[3, 1, 0, e], gg[3, 1, 1, e], gg[3, 1, 2, e], gg[3, 1, 3, e], gw[3, e],
-            e_mod, nu, thick)
-        el_out[E_FG + 12][e] = F3[0]
-        el_out[E_FG + 13][e] = F3[1]
-        el_out[E_FG + 14][e] = F3[2]
-        el_out[E_FG + 15][e] = F3[3]
-        u = u0 + u1 + u2 + u3
-        n_xx = n0[0] + n1[0] + n2[0] + n3[0]
-        n_yy = n0[1] + n1[1] + n2[1] + n3[1]
-        n_xy = n0[2] + n1[2] + n2[2] + n3[2]
-        fx0 = m0_[0] + m1_[0] + m2_[0] + m3_[0]
-        fx1 = m0_[1] + m1_[1] + m2_[1] + m3_[1]
-        fx2 = m0_[2] + m1_[2] + m2_[2] + m3_[2]
-        fx3 = m0_[3] + m1_[3] + m2_[3] + m3_[3]
-        fy0 = f0[0] + f1[0] + f2[0] + f3[0]
-        fy1 = f0[1] + f1[1] + f2[1] + f3[1]
-        fy2 = f0[2] + f1[2] + f2[2] + f3[2]
-        fy3 = f0[3] + f1[3] + f2[3] + f3[3]
-        a0 = a0s[e]
-        inv = 1.0 / a0
-        el_out[E_N][e] = n_xx * inv
-        el_out[E_N + 1][e] = n_yy * inv
-        el_out[E_N + 2][e] = n_xy * inv
-        el_out[E_U_MEMB][e] = u
-        mf_x = (fx0, fx1, fx2, fx3)
-        mf_y = (fy0, fy1, fy2, fy3)
-        # bending and shear (resultant section)
-        m0, m1, m2 = el_in[E_M, e], el_in[E_M + 1, e], el_in[E_M + 2, e]
-        qo0, qo1 = el_in[E_Q, e], el_in[E_Q + 1, e]
-        mxx = m0 + d_b * (dkx + nu_b * dky)
-        myy = m1 + d_b * (dky + nu_b * dkx)
-        mxy = m2 + d_b * 0.5 * (1.0 - nu_b) * dkxy2
-        qx = qo0 + kgt * dgxz
-        qy = qo1 + kgt * dgyz
-        el_out[E_M][e] = mxx
-        el_out[E_M + 1][e] = myy
-        el_out[E_M + 2][e] = mxy
-        el_out[E_Q][e] = qx
-        el_out[E_Q + 1][e] = qy
-        el_out[E_U_BEND][e] = el_in[E_U_BEND, e] + area * (
-            (0.5 * (m0 + mxx) * dkx + 0.5 * (m1 + myy) * dky + 0.5 * (m2 + mxy) * dkxy2)
-            + 0.5 * (qo0 + qx) * dgxz + 0.5 * (qo1 + qy) * dgyz)
-        # hourglass (w, theta modes; a 2x2 membrane has no in-plane ones)
-        gam, bb = hourglass_vectors(lx, ly, b1, b2)
-        gam_mid = hourglass_vectors(mid[3][0], mid[3][1], mid[5][0], mid[5][1])[0]
-        k_w = r_hg * 16.0 * d_b * bb
-        k_t = r_hg * d_b * area * bb
-        rz = gam_mid[0] * vz[0] + gam_mid[1] * vz[1] + gam_mid[2] * vz[2] + gam_mid[3] * vz[3]
-        rtx = gam_mid[0] * tx[0] + gam_mid[1] * tx[1] + gam_mid[2] * tx[2] + gam_mid[3] * tx[3]
-        rty = gam_mid[0] * ty[0] + gam_mid[1] * ty[1] + gam_mid[2] * ty[2] + gam_mid[3] * ty[3]
-        h0o, h1o, h2o, h3o, h4o = (el_in[E_HG, e], el_in[E_HG + 1, e], el_in[E_HG + 2, e],
-                                   el_in[E_HG + 3, e], el_in[E_HG + 4, e])
-        hg2 = h2o + k_w * rz * dt
-        hg3 = h3o + k_t * rtx * dt
-        hg4 = h4o + k_t * rty * dt
-        e_hg = (0.5 * (h2o + hg2) * rz * dt + 0.5 * (h3o + hg3) * rtx * dt
-                + 0.5 * (h4o + hg4) * rty * dt)
-        el_out[E_HG][e] = h0o
-        el_out[E_HG + 1][e] = h1o
-        el_out[E_HG + 2][e] = hg2
-        el_out[E_HG + 3][e] = hg3
-        el_out[E_HG + 4][e] = hg4
-        el_out[E_U_HG][e] = el_in[E_U_HG, e] + e_hg
-        fzs = warp_forces(mf_x, mf_y, lx, ly, frame[6], area)
-        c0 = corner_out(mf_x[0], mf_y[0], gam[0], b1[0], b2[0], fzs[0], area, h0o, h1o,
-                        hg2, hg3, hg4, mxx, myy, mxy, qx, qy, frame)
-        blk[0][e] = c0[0]
-        blk[1][e] = c0[1]
-        blk[2][e] = c0[2]
-        blk[3][e] = c0[3]
-        blk[4][e] = c0[4]
-        blk[5][e] = c0[5]
-        c1 = corner_out(mf_x[1], mf_y[1], gam[1], b1[1], b2[1], fzs[1], area, h0o, h1o,
-                        hg2, hg3, hg4, mxx, myy, mxy, qx, qy, frame)
-        blk[6][e] = c1[0]
-        blk[7][e] = c1[1]
-        blk[8][e] = c1[2]
-        blk[9][e] = c1[3]
-        blk[10][e] = c1[4]
-        blk[11][e] = c1[5]
-        c2 = corner_out(mf_x[2], mf_y[2], gam[2], b1[2], b2[2], fzs[2], area, h0o, h1o,
-                        hg2, hg3, hg4, mxx, myy, mxy, qx, qy, frame)
-        blk[12][e] = c2[0]
-        blk[13][e] = c2[1]
-        blk[14][e] = c2[2]
-        blk[15][e] = c2[3]
-        blk[16][e] = c2[4]
-        blk[17][e] = c2[5]
-        c3 = corner_out(mf_x[3], mf_y[3], gam[3], b1[3], b2[3], fzs[3], area, h0o, h1o,
-                        hg2, hg3, hg4, mxx, myy, mxy, qx, qy, frame)
-        blk[18][e] = c3[0]
-        blk[19][e] = c3[1]
-        blk[20][e] = c3[2]
-        blk[21][e] = c3[3]
-        blk[22][e] = c3[4]
-        blk[23][e] = c3[5]
-        # stable step
-        edge2 = 0.0
-        for i in range(4):
-            j = (i + 1) % 4
-            dx = px[j] - px[i]
-            dy = py[j] - py[i]
-            dz = pz[j] - pz[i]
-            edge2 = max(edge2, dx * dx + dy * dy + dz * dz)
-        c2 = max(c_m, kgt) / mu
-        dt_e = area / math.sqrt(edge2 * c2)
-        k_rot = area * (0.25 * kgt + d_b * bb)
-        el_out[E_DT][e] = min(dt_e, 2.0 * math.sqrt(inertia[e] / k_rot))
+    for b in range(nb):
+        bu = np.uint64(b)
+        # the block's corners (scalar: gathers) into cn[(corner·9 + value)·8 + lane]
+        for l in range(LANES):
+            for i in range(4):
+                node = np.uint64(quads[b * LANES + l, i])
+                for d in range(3):
+                    cn[(i * 9 + d) * LANES + l] = x[node, d]
+                    cn[(i * 9 + 3 + d) * LANES + l] = v[node, d]
+                    cn[(i * 9 + 6 + d) * LANES + l] = omega[node, d]
+        # the element arithmetic, vectorised across the block's lanes
+        for l in range(LANES):
+            lu = np.uint64(l)
+            px = (cn[slot(0, lu)], cn[slot(9, lu)], cn[slot(18, lu)], cn[slot(27, lu)])
+            py = (cn[slot(1, lu)], cn[slot(10, lu)], cn[slot(19, lu)], cn[slot(28, lu)])
+            pz = (cn[slot(2, lu)], cn[slot(11, lu)], cn[slot(20, lu)], cn[slot(29, lu)])
+            vx_ = (cn[slot(3, lu)], cn[slot(12, lu)], cn[slot(21, lu)], cn[slot(30, lu)])
+            vy_ = (cn[slot(4, lu)], cn[slot(13, lu)], cn[slot(22, lu)], cn[slot(31, lu)])
+            vz_ = (cn[slot(5, lu)], cn[slot(14, lu)], cn[slot(23, lu)], cn[slot(32, lu)])
+            wx_ = (cn[slot(6, lu)], cn[slot(15, lu)], cn[slot(24, lu)], cn[slot(33, lu)])
+            wy_ = (cn[slot(7, lu)], cn[slot(16, lu)], cn[slot(25, lu)], cn[slot(34, lu)])
+            wz_ = (cn[slot(8, lu)], cn[slot(17, lu)], cn[slot(26, lu)], cn[slot(35, lu)])
+            frame = corotational_frame(px, py, pz)
+            area = frame[4]
+            mid = midpoint_frame(px, py, pz, vx_, vy_, vz_, dt)
+            lx, ly = frame[3]
+            b1, b2 = frame[5]
+            vx, vy, vz, tx, ty, dkx, dky, dkxy2, dgxz, dgyz = midpoint_rates(
+                mid, vx_, vy_, vz_, wx_, wy_, wz_, dt)
+            el_out[col(bu, E_KAPPA, lu)] = el_in[col(bu, E_KAPPA, lu)] + dkx
+            el_out[col(bu, E_KAPPA + 1, lu)] = el_in[col(bu, E_KAPPA + 1, lu)] + dky
+            el_out[col(bu, E_KAPPA + 2, lu)] = el_in[col(bu, E_KAPPA + 2, lu)] + dkxy2
+            # membrane at the 2x2 points
+            F0, u0, n0, m0_, f0 = gauss_point(
+                lx, ly, gauss_gradients(gg, bu, 0, lu), gw[lane(bu, 4, 0, lu)], e_mod, nu,
+                thick)
+            el_out[col(bu, E_FG + 0, lu)] = F0[0]
+            el_out[col(bu, E_FG + 1, lu)] = F0[1]
+            el_out[col(bu, E_FG + 2, lu)] = F0[2]
+            el_out[col(bu, E_FG + 3, lu)] = F0[3]
+            F1, u1, n1, m1_, f1 = gauss_point(
+                lx, ly, gauss_gradients(gg, bu, 1, lu), gw[lane(bu, 4, 1, lu)], e_mod, nu,
+                thick)
+            el_out[col(bu, E_FG + 4, lu)] = F1[0]
+            el_out[col(bu, E_FG + 5, lu)] = F1[1]
+            el_out[col(bu, E_FG + 6, lu)] = F1[2]
+            el_out[col(bu, E_FG + 7, lu)] = F1[3]
+            F2, u2, n2, m2_, f2 = gauss_point(
+                lx, ly, gauss_gradients(gg, bu, 2, lu), gw[lane(bu, 4, 2, lu)], e_mod, nu,
+                thick)
+            el_out[col(bu, E_FG + 8, lu)] = F2[0]
+            el_out[col(bu, E_FG + 9, lu)] = F2[1]
+            el_out[col(bu, E_FG + 10, lu)] = F2[2]
+            el_out[col(bu, E_FG + 11, lu)] = F2[3]
+            F3, u3, n3, m3_, f3 = gauss_point(
+                lx, ly, gauss_gradients(gg, bu, 3, lu), gw[lane(bu, 4, 3, lu)], e_mod, nu,
+                thick)
+            el_out[col(bu, E_FG + 12, lu)] = F3[0]
+            el_out[col(bu, E_FG + 13, lu)] = F3[1]
+            el_out[col(bu, E_FG + 14, lu)] = F3[2]
+            el_out[col(bu, E_FG + 15, lu)] = F3[3]
+            u = u0 + u1 + u2 + u3
+            n_xx = n0[0] + n1[0] + n2[0] + n3[0]
+            n_yy = n0[1] + n1[1] + n2[1] + n3[1]
+            n_xy = n0[2] + n1[2] + n2[2] + n3[2]
+            fx0 = m0_[0] + m1_[0] + m2_[0] + m3_[0]
+            fx1 = m0_[1] + m1_[1] + m2_[1] + m3_[1]
+            fx2 = m0_[2] + m1_[2] + m2_[2] + m3_[2]
+            fx3 = m0_[3] + m1_[3] + m2_[3] + m3_[3]
+            fy0 = f0[0] + f1[0] + f2[0] + f3[0]
+            fy1 = f0[1] + f1[1] + f2[1] + f3[1]
+            fy2 = f0[2] + f1[2] + f2[2] + f3[2]
+            fy3 = f0[3] + f1[3] + f2[3] + f3[3]
+            a0 = a0s[lane(bu, 1, 0, lu)]
+            inv = 1.0 / a0
+            el_out[col(bu, E_N, lu)] = n_xx * inv
+            el_out[col(bu, E_N + 1, lu)] = n_yy * inv
+            el_out[col(bu, E_N + 2, lu)] = n_xy * inv
+            el_out[col(bu, E_U_MEMB, lu)] = u
+            mf_x = (fx0, fx1, fx2, fx3)
+            mf_y = (fy0, fy1, fy2, fy3)
+            # bending and shear (resultant section)
+            m0 = el_in[col(bu, E_M, lu)]
+            m1 = el_in[col(bu, E_M + 1, lu)]
+            m2 = el_in[col(bu, E_M + 2, lu)]
+            qo0, qo1 = el_in[col(bu, E_Q, lu)], el_in[col(bu, E_Q + 1, lu)]
+            mxx = m0 + d_b * (dkx + nu_b * dky)
+            myy = m1 + d_b * (dky + nu_b * dkx)
+            mxy = m2 + d_b * 0.5 * (1.0 - nu_b) * dkxy2
+            qx = qo0 + kgt * dgxz
+            qy = qo1 + kgt * dgyz
+            el_out[col(bu, E_M, lu)] = mxx
+            el_out[col(bu, E_M + 1, lu)] = myy
+            el_out[col(bu, E_M + 2, lu)] = mxy
+            el_out[col(bu, E_Q, lu)] = qx
+            el_out[col(bu, E_Q + 1, lu)] = qy
+            el_out[col(bu, E_U_BEND, lu)] = el_in[col(bu, E_U_BEND, lu)] + area * (
+                (0.5 * (m0 + mxx) * dkx + 0.5 * (m1 + myy) * dky + 0.5 * (m2 + mxy) * dkxy2)
+                + 0.5 * (qo0 + qx) * dgxz + 0.5 * (qo1 + qy) * dgyz)
+            # hourglass (w, theta modes; a 2x2 membrane has no in-plane ones)
+            gam, bb = hourglass_vectors(lx, ly, b1, b2)
+            gam_mid = hourglass_vectors(mid[3][0], mid[3][1], mid[5][0], mid[5][1])[0]
+            k_w = r_hg * 16.0 * d_b * bb
+            k_t = r_hg * d_b * area * bb
+            rz = gam_mid[0] * vz[0] + gam_mid[1] * vz[1] + gam_mid[2] * vz[2] + gam_mid[3] * vz[3]
+            rtx = gam_mid[0] * tx[0] + gam_mid[1] * tx[1] + gam_mid[2] * tx[2] + gam_mid[3] * tx[3]
+            rty = gam_mid[0] * ty[0] + gam_mid[1] * ty[1] + gam_mid[2] * ty[2] + gam_mid[3] * ty[3]
+            h0o = el_in[col(bu, E_HG + 0, lu)]
+            h1o = el_in[col(bu, E_HG + 1, lu)]
+            h2o = el_in[col(bu, E_HG + 2, lu)]
+            h3o = el_in[col(bu, E_HG + 3, lu)]
+            h4o = el_in[col(bu, E_HG + 4, lu)]
+            hg2 = h2o + k_w * rz * dt
+            hg3 = h3o + k_t * rtx * dt
+            hg4 = h4o + k_t * rty * dt
+            e_hg = (0.5 * (h2o + hg2) * rz * dt + 0.5 * (h3o + hg3) * rtx * dt
+                    + 0.5 * (h4o + hg4) * rty * dt)
+            el_out[col(bu, E_HG, lu)] = h0o
+            el_out[col(bu, E_HG + 1, lu)] = h1o
+            el_out[col(bu, E_HG + 2, lu)] = hg2
+            el_out[col(bu, E_HG + 3, lu)] = hg3
+            el_out[col(bu, E_HG + 4, lu)] = hg4
+            el_out[col(bu, E_U_HG, lu)] = el_in[col(bu, E_U_HG, lu)] + e_hg
+            fzs = warp_forces(mf_x, mf_y, lx, ly, frame[6], area)
+            c0 = corner_out(mf_x[0], mf_y[0], gam[0], b1[0], b2[0], fzs[0], area, h0o, h1o,
+                            hg2, hg3, hg4, mxx, myy, mxy, qx, qy, frame)
+            blk[lane(bu, 24, 0, lu)] = c0[0]
+            blk[lane(bu, 24, 1, lu)] = c0[1]
+            blk[lane(bu, 24, 2, lu)] = c0[2]
+            blk[lane(bu, 24, 3, lu)] = c0[3]
+            blk[lane(bu, 24, 4, lu)] = c0[4]
+            blk[lane(bu, 24, 5, lu)] = c0[5]
+            c1 = corner_out(mf_x[1], mf_y[1], gam[1], b1[1], b2[1], fzs[1], area, h0o, h1o,
+                            hg2, hg3, hg4, mxx, myy, mxy, qx, qy, frame)
+            blk[lane(bu, 24, 6, lu)] = c1[0]
+            blk[lane(bu, 24, 7, lu)] = c1[1]
+            blk[lane(bu, 24, 8, lu)] = c1[2]
+            blk[lane(bu, 24, 9, lu)] = c1[3]
+            blk[lane(bu, 24, 10, lu)] = c1[4]
+            blk[lane(bu, 24, 11, lu)] = c1[5]
+            c2 = corner_out(mf_x[2], mf_y[2], gam[2], b1[2], b2[2], fzs[2], area, h0o, h1o,
+                            hg2, hg3, hg4, mxx, myy, mxy, qx, qy, frame)
+            blk[lane(bu, 24, 12, lu)] = c2[0]
+            blk[lane(bu, 24, 13, lu)] = c2[1]
+            blk[lane(bu, 24, 14, lu)] = c2[2]
+            blk[lane(bu, 24, 15, lu)] = c2[3]
+            blk[lane(bu, 24, 16, lu)] = c2[4]
+            blk[lane(bu, 24, 17, lu)] = c2[5]
+            c3 = corner_out(mf_x[3], mf_y[3], gam[3], b1[3], b2[3], fzs[3], area, h0o, h1o,
+                            hg2, hg3, hg4, mxx, myy, mxy, qx, qy, frame)
+            blk[lane(bu, 24, 18, lu)] = c3[0]
+            blk[lane(bu, 24, 19, lu)] = c3[1]
+            blk[lane(bu, 24, 20, lu)] = c3[2]
+            blk[lane(bu, 24, 21, lu)] = c3[3]
+            blk[lane(bu, 24, 22, lu)] = c3[4]
+            blk[lane(bu, 24, 23, lu)] = c3[5]
+            # stable step
+            edge2 = 0.0
+            for i in range(4):
+                j = (i + 1) % 4
+                dx = px[j] - px[i]
+                dy = py[j] - py[i]
+                dz = pz[j] - pz[i]
+                edge2 = max(edge2, dx * dx + dy * dy + dz * dz)
+            c2 = max(c_m, kgt) / mu
+            dt_e = area / math.sqrt(edge2 * c2)
+            k_rot = area * (0.25 * kgt + d_b * bb)
+            rot = 2.0 * math.sqrt(inertia[lane(bu, 1, 0, lu)] / k_rot)
+            el_out[col(bu, E_DT, lu)] = min(dt_e, rot)
 
 
-@njit(**FAST)
-def gather_corners(x, v, omega, quads, cn):
-    """Each element's corner positions, velocities and spins into cn[corner, value, e]
-    (scalar: the gathers)."""
-    for e in range(quads.shape[0]):
-        for i in range(4):
-            n = np.uint64(quads[e, i])
-            for d in range(3):
-                cn[i, d, e] = x[n, d]
-                cn[i, 3 + d, e] = v[n, d]
-                cn[i, 6 + d, e] = omega[n, d]
+def to_blocks(a: np.ndarray, nb: int) -> np.ndarray:
+    """(values, n) → the flat table of blocks [(b, value, lane)], the last element
+    repeated into the padding lanes."""
+    nv, n = a.shape
+    padded = np.concatenate([a, np.repeat(a[:, -1:], nb * LANES - n, axis=1)], axis=1)
+    return np.ascontiguousarray(padded.reshape(nv, nb, LANES).transpose(1, 0, 2)).ravel()
 
 
-@njit(**FAST)
-def prototype_step(x, v, omega, quads, cn, *tables):
-    gather_corners(x, v, omega, quads, cn)
-    element_pass(quads.shape[0], cn, *tables)
+def from_blocks(flat: np.ndarray, nv: int, n: int) -> np.ndarray:
+    """The inverse of :func:`to_blocks`: (values, n)."""
+    nb = flat.size // (nv * LANES)
+    return flat.reshape(nb, nv, LANES).transpose(1, 0, 2).reshape(nv, nb * LANES)[:, :n]
 
 
 def elastic_full_plate(n: int):
@@ -342,7 +386,6 @@ def main() -> int:
         C_SHEAR_G,
         C_SHEAR_K,
         C_THICK,
-        N_ELEM_STATE,
     )
     from wovenimpact.solver import explicit as X
 
@@ -356,34 +399,33 @@ def main() -> int:
     mesh = ws.mesh
     sec = mesh.sections[0]
     thick = sec[C_THICK]
-    gg = np.ascontiguousarray(np.transpose(mesh.gauss_grad, (1, 2, 3, 0)))
-    gw = np.ascontiguousarray(mesh.gauss_weight.T)
-    el_in = np.ascontiguousarray(st.elem.T)
-    el_out = np.zeros((N_ELEM_STATE, ne))
-    blocks = np.zeros((4, 6, ne))
-    cn = np.zeros((4, 9, ne))
-    args = (st.x, st.v, st.omega, mesh.quads, cn, gg, gw, mesh.area0, mesh.rot_inertia,
-            st.dt, thick, sec[C_AREAL_MASS], STEEL_E, STEEL_NU, sec[C_BEND_E], sec[C_BEND_NU],
-            sec[C_SHEAR_K] * sec[C_SHEAR_G] * thick, sec[C_HOURGLASS], el_in,
-            tuple(el_out[j] for j in range(N_ELEM_STATE)),
-            tuple(blocks[i, j] for i in range(4) for j in range(6)))
-    prototype_step(*args)
+    nb = (ne + LANES - 1) // LANES
+    quads = np.concatenate([mesh.quads, np.repeat(mesh.quads[-1:], nb * LANES - ne, axis=0)])
+    el_in = to_blocks(st.elem.T, nb)
+    el_out = np.zeros_like(el_in)
+    blk = np.zeros(nb * 24 * LANES)
+    args = (nb, st.x, st.v, st.omega, quads, np.zeros(36 * LANES),
+            to_blocks(np.transpose(mesh.gauss_grad, (1, 2, 3, 0)).reshape(32, ne), nb),
+            to_blocks(mesh.gauss_weight.T, nb), to_blocks(mesh.area0[None, :], nb),
+            to_blocks(mesh.rot_inertia[None, :], nb), st.dt, thick, sec[C_AREAL_MASS],
+            STEEL_E, STEEL_NU, sec[C_BEND_E], sec[C_BEND_NU],
+            sec[C_SHEAR_K] * sec[C_SHEAR_G] * thick, sec[C_HOURGLASS], el_in, el_out, blk)
+    element_pass(*args)
+    state = from_blocks(el_out, N_ELEM_STATE, ne)
     written = [E_N, E_N + 1, E_N + 2, E_M, E_M + 1, E_M + 2, E_Q, E_Q + 1, E_HG + 2, E_HG + 3,
                E_HG + 4, E_U_MEMB, E_U_BEND, E_U_HG, E_DT, E_KAPPA, E_KAPPA + 1, E_KAPPA + 2,
                *range(E_FG, E_FG + 16)]
-    same = (np.array_equal(np.transpose(blocks, (2, 0, 1)), ref_blocks)
-            and all(np.array_equal(el_out[c], ref_el[:, c]) for c in written))
+    same = (np.array_equal(from_blocks(blk, 24, ne).T.reshape(ne, 4, 6), ref_blocks)
+            and all(np.array_equal(state[c], ref_el[:, c]) for c in written))
     print(f"outputs bitwise equal to shell_force's: {same}")
     t_ref = best_seconds(lambda: X.shell_forces(model, st, ws))
-    t_new = best_seconds(lambda: prototype_step(*args))
-    t_gather = best_seconds(lambda: gather_corners(st.x, st.v, st.omega, mesh.quads, cn))
+    t_new = best_seconds(lambda: element_pass(*args))
     asm = next(iter(element_pass.inspect_asm().values()))
     packed = sum(line.split()[0].endswith("pd") for line in asm.splitlines()
                  if line.strip() and ("%zmm" in line or "%ymm" in line))
     print(f"element_pass: {packed} packed-double instructions (0: not vectorised)")
     print(f"{ne} elements, 1 thread: shell_force {t_ref / ne * 1e9:.0f} ns, prototype "
-          f"{t_new / ne * 1e9:.0f} ns per element ({t_ref / t_new:.2f}x; its corner gather "
-          f"{t_gather / ne * 1e9:.0f} ns)")
+          f"{t_new / ne * 1e9:.0f} ns per element ({t_ref / t_new:.2f}x)")
     return 0 if same else 1
 
 

@@ -4,7 +4,7 @@ vectorised bicubic Hermite evaluation — against the scalar ``crossover_from_ta
 on the same random points (docs/theory.md §4.6, "SIMD element pass"). A measurement,
 not solver code.
 
-    python benchmarks/simd_table_prototype.py [N_POINTS]   (default 4 000: in cache)
+    NUMBA_NUM_THREADS=1 python benchmarks/simd_table_prototype.py [N_POINTS]   (4 000: in cache)
 
 Prints whether the split gives bitwise the same flags and values (exit 1 if not) and ns
 per point of each part, one thread.
@@ -16,9 +16,8 @@ import re
 import sys
 import time
 
-import numba.core.cpu as _cpu
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 from wovenimpact.benchmark import REFERENCE_FABRIC
 from wovenimpact.kernels import fabric_layout as L
@@ -32,7 +31,6 @@ from wovenimpact.kernels.fabric_table import (
 )
 from wovenimpact.spec import load_material
 
-_fin = _cpu.CPUTargetOptions.finalize
 FAST = dict(boundscheck=False, error_model="numpy")
 LANES = 8
 N_COEF = 48  # 4 corners × (W, H_w, H_f) × (f, f_x, f_y, f_xy)
@@ -105,28 +103,34 @@ def corner(cf, b, k, ax, bx, dax, dbx, ay, by, day, dby, lu):
     return w, gw, gf, hw, hf
 
 
-@njit(**FAST)
+@njit(forceinline=True, **FAST)
+def hermite_block(b, lam_w, lam_f, coef, geo, out):
+    """Block b of :func:`hermite_blocks` (inlined by LLVM into the parallel loop, whose
+    arguments are noalias: docs/theory.md §4.6)."""
+    for ll in range(LANES):
+        lu = _U(ll)
+        e = b * _U(LANES) + lu
+        x0, hx = geo[at(b, 4, 0, lu)], geo[at(b, 4, 1, lu)]
+        y0, hy = geo[at(b, 4, 2, lu)], geo[at(b, 4, 3, lu)]
+        ax0, ax1, bx0, bx1, dax0, dax1, dbx0, dbx1 = hermite_basis((lam_w[e] - x0) / hx, hx)
+        ay0, ay1, by0, by1, day0, day1, dby0, dby1 = hermite_basis((lam_f[e] - y0) / hy, hy)
+        c0 = corner(coef, b, 0, ax0, bx0, dax0, dbx0, ay0, by0, day0, dby0, lu)
+        c1 = corner(coef, b, 1, ax0, bx0, dax0, dbx0, ay1, by1, day1, dby1, lu)
+        c2 = corner(coef, b, 2, ax1, bx1, dax1, dbx1, ay0, by0, day0, dby0, lu)
+        c3 = corner(coef, b, 3, ax1, bx1, dax1, dbx1, ay1, by1, day1, dby1, lu)
+        out[at(b, 5, 0, lu)] = (c0[0] + c1[0]) + (c2[0] + c3[0])
+        out[at(b, 5, 1, lu)] = (c0[1] + c1[1]) + (c2[1] + c3[1])
+        out[at(b, 5, 2, lu)] = (c0[2] + c1[2]) + (c2[2] + c3[2])
+        out[at(b, 5, 3, lu)] = (c0[3] + c1[3]) + (c2[3] + c3[3])
+        out[at(b, 5, 4, lu)] = (c0[4] + c1[4]) + (c2[4] + c3[4])
+
+
+@njit(parallel=True, **FAST)
 def hermite_blocks(nb, lam_w, lam_f, coef, geo, out):
     """Vectorised part: the bicubic Hermite W, ∂W/∂λ_w, ∂W/∂λ_f, H_w, H_f of every point
     from the copied coefficients, into out[at(b, 5, ·, l)]."""
-    for bb in range(nb):
-        b = _U(bb)
-        for ll in range(LANES):
-            lu = _U(ll)
-            e = b * _U(LANES) + lu
-            x0, hx = geo[at(b, 4, 0, lu)], geo[at(b, 4, 1, lu)]
-            y0, hy = geo[at(b, 4, 2, lu)], geo[at(b, 4, 3, lu)]
-            ax0, ax1, bx0, bx1, dax0, dax1, dbx0, dbx1 = hermite_basis((lam_w[e] - x0) / hx, hx)
-            ay0, ay1, by0, by1, day0, day1, dby0, dby1 = hermite_basis((lam_f[e] - y0) / hy, hy)
-            c0 = corner(coef, b, 0, ax0, bx0, dax0, dbx0, ay0, by0, day0, dby0, lu)
-            c1 = corner(coef, b, 1, ax0, bx0, dax0, dbx0, ay1, by1, day1, dby1, lu)
-            c2 = corner(coef, b, 2, ax1, bx1, dax1, dbx1, ay0, by0, day0, dby0, lu)
-            c3 = corner(coef, b, 3, ax1, bx1, dax1, dbx1, ay1, by1, day1, dby1, lu)
-            out[at(b, 5, 0, lu)] = (c0[0] + c1[0]) + (c2[0] + c3[0])
-            out[at(b, 5, 1, lu)] = (c0[1] + c1[1]) + (c2[1] + c3[1])
-            out[at(b, 5, 2, lu)] = (c0[2] + c1[2]) + (c2[2] + c3[2])
-            out[at(b, 5, 3, lu)] = (c0[3] + c1[3]) + (c2[3] + c3[3])
-            out[at(b, 5, 4, lu)] = (c0[4] + c1[4]) + (c2[4] + c3[4])
+    for b in prange(nb):
+        hermite_block(_U(b), lam_w, lam_f, coef, geo, out)
 
 
 def best(f, repeats=200):
@@ -137,11 +141,6 @@ def best(f, repeats=200):
         f()
         t = min(t, time.perf_counter() - t0)
     return t
-
-
-def _with_noalias(self, flags, options):
-    _fin(self, flags, options)
-    flags.noalias = True
 
 
 def main() -> int:
@@ -155,7 +154,6 @@ def main() -> int:
     ref = np.empty((n, 6))
     crossover_from_table_for_points(row, lw, lf, ref)
     t_ref = best(lambda: crossover_from_table_for_points(row, lw, lf, ref))
-    _cpu.CPUTargetOptions.finalize = _with_noalias  # for this file's functions only
     nb = n // LANES
     coef = np.zeros(nb * N_COEF * LANES)
     geo = np.zeros(nb * 4 * LANES)

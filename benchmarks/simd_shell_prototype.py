@@ -41,6 +41,7 @@ from wovenimpact.jit import set_threads
 from wovenimpact.kernels.shell import (
     corotational_frame,
     elastic_membrane,
+    element_stable_step,
     first_piola,
     hourglass_vectors,
     midpoint_frame,
@@ -139,6 +140,13 @@ def corner_out(mfx, mfy, gam, b1, b2, fzs, area, h0, h1, hg2, hg3, hg4, mxx, myy
     return (fx * e1x + fy * e2x + fz * e3x, fx * e1y + fy * e2y + fz * e3y,
             fx * e1z + fy * e2z + fz * e3z, mx * e1x + my * e2x, mx * e1y + my * e2y,
             mx * e1z + my * e2z)
+
+
+@njit(inline="always", **FAST)
+def store_corner(blk, bu, i, lu, values):
+    """Corner i's force and moment (6 values) into the block table of corner forces."""
+    for k in range(6):
+        blk[lane(bu, 24, 6 * i + k, lu)] = values[k]
 
 
 @njit(forceinline=True, **FAST)
@@ -272,51 +280,20 @@ def block_pass(b, tid, x, v, omega, quads, cn, gg, gw, a0s, inertia, dt, thick, 
         el_out[col(bu, E_HG + 4, lu)] = hg4
         el_out[col(bu, E_U_HG, lu)] = el_in[col(bu, E_U_HG, lu)] + e_hg
         fzs = warp_forces(mf_x, mf_y, lx, ly, frame[6], area)
-        c0 = corner_out(mf_x[0], mf_y[0], gam[0], b1[0], b2[0], fzs[0], area, h0o, h1o,
-                        hg2, hg3, hg4, mxx, myy, mxy, qx, qy, frame)
-        blk[lane(bu, 24, 0, lu)] = c0[0]
-        blk[lane(bu, 24, 1, lu)] = c0[1]
-        blk[lane(bu, 24, 2, lu)] = c0[2]
-        blk[lane(bu, 24, 3, lu)] = c0[3]
-        blk[lane(bu, 24, 4, lu)] = c0[4]
-        blk[lane(bu, 24, 5, lu)] = c0[5]
-        c1 = corner_out(mf_x[1], mf_y[1], gam[1], b1[1], b2[1], fzs[1], area, h0o, h1o,
-                        hg2, hg3, hg4, mxx, myy, mxy, qx, qy, frame)
-        blk[lane(bu, 24, 6, lu)] = c1[0]
-        blk[lane(bu, 24, 7, lu)] = c1[1]
-        blk[lane(bu, 24, 8, lu)] = c1[2]
-        blk[lane(bu, 24, 9, lu)] = c1[3]
-        blk[lane(bu, 24, 10, lu)] = c1[4]
-        blk[lane(bu, 24, 11, lu)] = c1[5]
-        c2 = corner_out(mf_x[2], mf_y[2], gam[2], b1[2], b2[2], fzs[2], area, h0o, h1o,
-                        hg2, hg3, hg4, mxx, myy, mxy, qx, qy, frame)
-        blk[lane(bu, 24, 12, lu)] = c2[0]
-        blk[lane(bu, 24, 13, lu)] = c2[1]
-        blk[lane(bu, 24, 14, lu)] = c2[2]
-        blk[lane(bu, 24, 15, lu)] = c2[3]
-        blk[lane(bu, 24, 16, lu)] = c2[4]
-        blk[lane(bu, 24, 17, lu)] = c2[5]
-        c3 = corner_out(mf_x[3], mf_y[3], gam[3], b1[3], b2[3], fzs[3], area, h0o, h1o,
-                        hg2, hg3, hg4, mxx, myy, mxy, qx, qy, frame)
-        blk[lane(bu, 24, 18, lu)] = c3[0]
-        blk[lane(bu, 24, 19, lu)] = c3[1]
-        blk[lane(bu, 24, 20, lu)] = c3[2]
-        blk[lane(bu, 24, 21, lu)] = c3[3]
-        blk[lane(bu, 24, 22, lu)] = c3[4]
-        blk[lane(bu, 24, 23, lu)] = c3[5]
-        # stable step
-        edge2 = 0.0
-        for i in range(4):
-            j = (i + 1) % 4
-            dx = px[j] - px[i]
-            dy = py[j] - py[i]
-            dz = pz[j] - pz[i]
-            edge2 = max(edge2, dx * dx + dy * dy + dz * dz)
-        c2 = max(c_m, kgt) / mu
-        dt_e = area / math.sqrt(edge2 * c2)
-        k_rot = area * (0.25 * kgt + d_b * bb)
-        rot = 2.0 * math.sqrt(inertia[lane(bu, 1, 0, lu)] / k_rot)
-        el_out[col(bu, E_DT, lu)] = min(dt_e, rot)
+        store_corner(blk, bu, 0, lu, corner_out(
+            mf_x[0], mf_y[0], gam[0], b1[0], b2[0], fzs[0], area, h0o, h1o, hg2, hg3, hg4,
+            mxx, myy, mxy, qx, qy, frame))
+        store_corner(blk, bu, 1, lu, corner_out(
+            mf_x[1], mf_y[1], gam[1], b1[1], b2[1], fzs[1], area, h0o, h1o, hg2, hg3, hg4,
+            mxx, myy, mxy, qx, qy, frame))
+        store_corner(blk, bu, 2, lu, corner_out(
+            mf_x[2], mf_y[2], gam[2], b1[2], b2[2], fzs[2], area, h0o, h1o, hg2, hg3, hg4,
+            mxx, myy, mxy, qx, qy, frame))
+        store_corner(blk, bu, 3, lu, corner_out(
+            mf_x[3], mf_y[3], gam[3], b1[3], b2[3], fzs[3], area, h0o, h1o, hg2, hg3, hg4,
+            mxx, myy, mxy, qx, qy, frame))
+        el_out[col(bu, E_DT, lu)] = element_stable_step(
+            px, py, pz, area, c_m, kgt, mu, inertia[lane(bu, 1, 0, lu)], d_b, bb)
 
 
 @njit(parallel=True, **FAST)

@@ -108,17 +108,23 @@ def gauss_gradients(gg, bu, g, lu):
 
 
 @njit(inline="always", **FAST)
-def gauss_point(lx, ly, grads, wg, e_mod, nu, thick):
-    """One 2x2 point: F = sum x_I (x) dN_I/dX, the elastic membrane, and its weighted
-    energy, resultant and corner forces w_g P G_gI (shell.full_membrane's terms)."""
-    a1, a2, a3, a4, c1, c2, c3, c4 = grads
+def gauss_point(el_out, gg, gw, bu, g, lu, lx, ly, e_mod, nu, thick):
+    """2×2 point g: F = Σ x̂_I ⊗ ∂N_I/∂X (stored in the element state, E_FG), the elastic
+    membrane, and its weighted energy, resultant and corner forces w_g P G_gI
+    (shell.full_membrane's terms)."""
+    a1, a2, a3, a4, c1, c2, c3, c4 = gauss_gradients(gg, bu, g, lu)
+    wg = gw[lane(bu, 4, g, lu)]
     f11 = lx[0] * a1 + lx[1] * a2 + lx[2] * a3 + lx[3] * a4
     f12 = lx[0] * c1 + lx[1] * c2 + lx[2] * c3 + lx[3] * c4
     f21 = ly[0] * a1 + ly[1] * a2 + ly[2] * a3 + ly[3] * a4
     f22 = ly[0] * c1 + ly[1] * c2 + ly[2] * c3 + ly[3] * c4
+    el_out[col(bu, E_FG + 4 * g, lu)] = f11
+    el_out[col(bu, E_FG + 4 * g + 1, lu)] = f12
+    el_out[col(bu, E_FG + 4 * g + 2, lu)] = f21
+    el_out[col(bu, E_FG + 4 * g + 3, lu)] = f22
     w, c, a, b, c12 = elastic_membrane(f11, f12, f21, f22, e_mod, nu, thick)
     p11, p12, p21, p22 = first_piola(a, b, c12, f11, f12, f21, f22)
-    return ((f11, f12, f21, f22), wg * w, (wg * a, wg * b, wg * c12),
+    return (wg * w, (wg * a, wg * b, wg * c12),
             (wg * (p11 * a1 + p12 * c1), wg * (p11 * a2 + p12 * c2),
              wg * (p11 * a3 + p12 * c3), wg * (p11 * a4 + p12 * c4)),
             (wg * (p21 * a1 + p22 * c1), wg * (p21 * a2 + p22 * c2),
@@ -189,34 +195,10 @@ def block_pass(b, tid, x, v, omega, quads, cn, gg, gw, a0s, inertia, dt, thick, 
         el_out[col(bu, E_KAPPA + 1, lu)] = el_in[col(bu, E_KAPPA + 1, lu)] + dky
         el_out[col(bu, E_KAPPA + 2, lu)] = el_in[col(bu, E_KAPPA + 2, lu)] + dkxy2
         # membrane at the 2x2 points
-        F0, u0, n0, m0_, f0 = gauss_point(
-            lx, ly, gauss_gradients(gg, bu, 0, lu), gw[lane(bu, 4, 0, lu)], e_mod, nu,
-            thick)
-        el_out[col(bu, E_FG + 0, lu)] = F0[0]
-        el_out[col(bu, E_FG + 1, lu)] = F0[1]
-        el_out[col(bu, E_FG + 2, lu)] = F0[2]
-        el_out[col(bu, E_FG + 3, lu)] = F0[3]
-        F1, u1, n1, m1_, f1 = gauss_point(
-            lx, ly, gauss_gradients(gg, bu, 1, lu), gw[lane(bu, 4, 1, lu)], e_mod, nu,
-            thick)
-        el_out[col(bu, E_FG + 4, lu)] = F1[0]
-        el_out[col(bu, E_FG + 5, lu)] = F1[1]
-        el_out[col(bu, E_FG + 6, lu)] = F1[2]
-        el_out[col(bu, E_FG + 7, lu)] = F1[3]
-        F2, u2, n2, m2_, f2 = gauss_point(
-            lx, ly, gauss_gradients(gg, bu, 2, lu), gw[lane(bu, 4, 2, lu)], e_mod, nu,
-            thick)
-        el_out[col(bu, E_FG + 8, lu)] = F2[0]
-        el_out[col(bu, E_FG + 9, lu)] = F2[1]
-        el_out[col(bu, E_FG + 10, lu)] = F2[2]
-        el_out[col(bu, E_FG + 11, lu)] = F2[3]
-        F3, u3, n3, m3_, f3 = gauss_point(
-            lx, ly, gauss_gradients(gg, bu, 3, lu), gw[lane(bu, 4, 3, lu)], e_mod, nu,
-            thick)
-        el_out[col(bu, E_FG + 12, lu)] = F3[0]
-        el_out[col(bu, E_FG + 13, lu)] = F3[1]
-        el_out[col(bu, E_FG + 14, lu)] = F3[2]
-        el_out[col(bu, E_FG + 15, lu)] = F3[3]
+        u0, n0, m0_, f0 = gauss_point(el_out, gg, gw, bu, 0, lu, lx, ly, e_mod, nu, thick)
+        u1, n1, m1_, f1 = gauss_point(el_out, gg, gw, bu, 1, lu, lx, ly, e_mod, nu, thick)
+        u2, n2, m2_, f2 = gauss_point(el_out, gg, gw, bu, 2, lu, lx, ly, e_mod, nu, thick)
+        u3, n3, m3_, f3 = gauss_point(el_out, gg, gw, bu, 3, lu, lx, ly, e_mod, nu, thick)
         u = u0 + u1 + u2 + u3
         n_xx = n0[0] + n1[0] + n2[0] + n3[0]
         n_yy = n0[1] + n1[1] + n2[1] + n3[1]

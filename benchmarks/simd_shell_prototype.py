@@ -6,7 +6,9 @@
 
 Checks the outputs (corner forces and moments, resultants, energies, F at the points,
 curvatures, stable step) against ``shell_force`` (bit for bit: the same formulas in the
-same order; exit 1 otherwise), then prints ns per element of each.
+same order; exit 1 otherwise), then prints ns per element of each: the pass on tables
+of blocks (``element_pass``), and the same pass on the solver's row tables of element
+state and corner forces, copied in and out per block (``element_pass_rows``).
 
 What Numba's loops need to vectorise (found with LLVM's
 ``--pass-remarks-missed=loop-vectorize``; docs/theory.md §4.6, "SIMD element pass"):
@@ -108,8 +110,9 @@ def gauss_gradients(gg, bu, g, lu):
 
 
 @njit(inline="always", **FAST)
-def gauss_point(el_out, gg, gw, bu, g, lu, lx, ly, e_mod, nu, thick):
-    """2×2 point g: F = Σ x̂_I ⊗ ∂N_I/∂X (stored in the element state, E_FG), the elastic
+def gauss_point(el_out, su, gg, gw, bu, g, lu, lx, ly, e_mod, nu, thick):
+    """2×2 point g of lane lu: F = Σ x̂_I ⊗ ∂N_I/∂X (into block su of the element state,
+    E_FG; the gradients are block bu's), the elastic
     membrane, and its weighted energy, resultant and corner forces w_g P G_gI
     (shell.full_membrane's terms)."""
     a1, a2, a3, a4, c1, c2, c3, c4 = gauss_gradients(gg, bu, g, lu)
@@ -118,10 +121,10 @@ def gauss_point(el_out, gg, gw, bu, g, lu, lx, ly, e_mod, nu, thick):
     f12 = lx[0] * c1 + lx[1] * c2 + lx[2] * c3 + lx[3] * c4
     f21 = ly[0] * a1 + ly[1] * a2 + ly[2] * a3 + ly[3] * a4
     f22 = ly[0] * c1 + ly[1] * c2 + ly[2] * c3 + ly[3] * c4
-    el_out[col(bu, E_FG + 4 * g, lu)] = f11
-    el_out[col(bu, E_FG + 4 * g + 1, lu)] = f12
-    el_out[col(bu, E_FG + 4 * g + 2, lu)] = f21
-    el_out[col(bu, E_FG + 4 * g + 3, lu)] = f22
+    el_out[col(su, E_FG + 4 * g, lu)] = f11
+    el_out[col(su, E_FG + 4 * g + 1, lu)] = f12
+    el_out[col(su, E_FG + 4 * g + 2, lu)] = f21
+    el_out[col(su, E_FG + 4 * g + 3, lu)] = f22
     w, c, a, b, c12 = elastic_membrane(f11, f12, f21, f22, e_mod, nu, thick)
     p11, p12, p21, p22 = first_piola(a, b, c12, f11, f12, f21, f22)
     return (wg * w, (wg * a, wg * b, wg * c12),
@@ -156,14 +159,17 @@ def store_corner(blk, bu, i, lu, values):
 
 
 @njit(forceinline=True, **FAST)
-def block_pass(b, tid, x, v, omega, quads, cn, gg, gw, a0s, inertia, dt, thick, mu, e_mod, nu,
-               e_b, nu_b, kgt, r_hg, el_in, el_out, blk):
+def block_pass(b, bs, tid, x, v, omega, quads, cn, gg, gw, a0s, inertia, dt, thick, mu, e_mod,
+               nu, e_b, nu_b, kgt, r_hg, el_in, el_out, blk):
     """Block b of :func:`element_pass` (inlined by LLVM into the parallel loop, so that
     its arrays are the loop's noalias arguments; Numba's own inlining would run the
-    parfor array analysis over the helpers' tuples, which fails)."""
+    parfor array analysis over the helpers' tuples, which fails). The block's state and
+    corner forces are block bs of el_in, el_out and blk: b itself (tables of blocks), or
+    the thread's block of scratch tables (:func:`element_pass_rows`)."""
     c_m = e_mod * thick / (1.0 - nu * nu)
     d_b = e_b * thick * thick * thick / (12.0 * (1.0 - nu_b * nu_b))
     bu = np.uint64(b)
+    su = np.uint64(bs)
     # the block's corners (scalar: gathers) into cn[(corner·9 + value)·8 + lane]
     for l in range(LANES):
         for i in range(4):
@@ -191,14 +197,14 @@ def block_pass(b, tid, x, v, omega, quads, cn, gg, gw, a0s, inertia, dt, thick, 
         b1, b2 = frame[5]
         vx, vy, vz, tx, ty, dkx, dky, dkxy2, dgxz, dgyz = midpoint_rates(
             mid, vx_, vy_, vz_, wx_, wy_, wz_, dt)
-        el_out[col(bu, E_KAPPA, lu)] = el_in[col(bu, E_KAPPA, lu)] + dkx
-        el_out[col(bu, E_KAPPA + 1, lu)] = el_in[col(bu, E_KAPPA + 1, lu)] + dky
-        el_out[col(bu, E_KAPPA + 2, lu)] = el_in[col(bu, E_KAPPA + 2, lu)] + dkxy2
+        el_out[col(su, E_KAPPA, lu)] = el_in[col(su, E_KAPPA, lu)] + dkx
+        el_out[col(su, E_KAPPA + 1, lu)] = el_in[col(su, E_KAPPA + 1, lu)] + dky
+        el_out[col(su, E_KAPPA + 2, lu)] = el_in[col(su, E_KAPPA + 2, lu)] + dkxy2
         # membrane at the 2x2 points
-        u0, n0, m0_, f0 = gauss_point(el_out, gg, gw, bu, 0, lu, lx, ly, e_mod, nu, thick)
-        u1, n1, m1_, f1 = gauss_point(el_out, gg, gw, bu, 1, lu, lx, ly, e_mod, nu, thick)
-        u2, n2, m2_, f2 = gauss_point(el_out, gg, gw, bu, 2, lu, lx, ly, e_mod, nu, thick)
-        u3, n3, m3_, f3 = gauss_point(el_out, gg, gw, bu, 3, lu, lx, ly, e_mod, nu, thick)
+        u0, n0, m0_, f0 = gauss_point(el_out, su, gg, gw, bu, 0, lu, lx, ly, e_mod, nu, thick)
+        u1, n1, m1_, f1 = gauss_point(el_out, su, gg, gw, bu, 1, lu, lx, ly, e_mod, nu, thick)
+        u2, n2, m2_, f2 = gauss_point(el_out, su, gg, gw, bu, 2, lu, lx, ly, e_mod, nu, thick)
+        u3, n3, m3_, f3 = gauss_point(el_out, su, gg, gw, bu, 3, lu, lx, ly, e_mod, nu, thick)
         u = u0 + u1 + u2 + u3
         n_xx = n0[0] + n1[0] + n2[0] + n3[0]
         n_yy = n0[1] + n1[1] + n2[1] + n3[1]
@@ -213,28 +219,28 @@ def block_pass(b, tid, x, v, omega, quads, cn, gg, gw, a0s, inertia, dt, thick, 
         fy3 = f0[3] + f1[3] + f2[3] + f3[3]
         a0 = a0s[lane(bu, 1, 0, lu)]
         inv = 1.0 / a0
-        el_out[col(bu, E_N, lu)] = n_xx * inv
-        el_out[col(bu, E_N + 1, lu)] = n_yy * inv
-        el_out[col(bu, E_N + 2, lu)] = n_xy * inv
-        el_out[col(bu, E_U_MEMB, lu)] = u
+        el_out[col(su, E_N, lu)] = n_xx * inv
+        el_out[col(su, E_N + 1, lu)] = n_yy * inv
+        el_out[col(su, E_N + 2, lu)] = n_xy * inv
+        el_out[col(su, E_U_MEMB, lu)] = u
         mf_x = (fx0, fx1, fx2, fx3)
         mf_y = (fy0, fy1, fy2, fy3)
         # bending and shear (resultant section)
-        m0 = el_in[col(bu, E_M, lu)]
-        m1 = el_in[col(bu, E_M + 1, lu)]
-        m2 = el_in[col(bu, E_M + 2, lu)]
-        qo0, qo1 = el_in[col(bu, E_Q, lu)], el_in[col(bu, E_Q + 1, lu)]
+        m0 = el_in[col(su, E_M, lu)]
+        m1 = el_in[col(su, E_M + 1, lu)]
+        m2 = el_in[col(su, E_M + 2, lu)]
+        qo0, qo1 = el_in[col(su, E_Q, lu)], el_in[col(su, E_Q + 1, lu)]
         mxx = m0 + d_b * (dkx + nu_b * dky)
         myy = m1 + d_b * (dky + nu_b * dkx)
         mxy = m2 + d_b * 0.5 * (1.0 - nu_b) * dkxy2
         qx = qo0 + kgt * dgxz
         qy = qo1 + kgt * dgyz
-        el_out[col(bu, E_M, lu)] = mxx
-        el_out[col(bu, E_M + 1, lu)] = myy
-        el_out[col(bu, E_M + 2, lu)] = mxy
-        el_out[col(bu, E_Q, lu)] = qx
-        el_out[col(bu, E_Q + 1, lu)] = qy
-        el_out[col(bu, E_U_BEND, lu)] = el_in[col(bu, E_U_BEND, lu)] + area * (
+        el_out[col(su, E_M, lu)] = mxx
+        el_out[col(su, E_M + 1, lu)] = myy
+        el_out[col(su, E_M + 2, lu)] = mxy
+        el_out[col(su, E_Q, lu)] = qx
+        el_out[col(su, E_Q + 1, lu)] = qy
+        el_out[col(su, E_U_BEND, lu)] = el_in[col(su, E_U_BEND, lu)] + area * (
             (0.5 * (m0 + mxx) * dkx + 0.5 * (m1 + myy) * dky + 0.5 * (m2 + mxy) * dkxy2)
             + 0.5 * (qo0 + qx) * dgxz + 0.5 * (qo1 + qy) * dgyz)
         # hourglass (w, theta modes; a 2x2 membrane has no in-plane ones)
@@ -245,36 +251,36 @@ def block_pass(b, tid, x, v, omega, quads, cn, gg, gw, a0s, inertia, dt, thick, 
         rz = gam_mid[0] * vz[0] + gam_mid[1] * vz[1] + gam_mid[2] * vz[2] + gam_mid[3] * vz[3]
         rtx = gam_mid[0] * tx[0] + gam_mid[1] * tx[1] + gam_mid[2] * tx[2] + gam_mid[3] * tx[3]
         rty = gam_mid[0] * ty[0] + gam_mid[1] * ty[1] + gam_mid[2] * ty[2] + gam_mid[3] * ty[3]
-        h0o = el_in[col(bu, E_HG + 0, lu)]
-        h1o = el_in[col(bu, E_HG + 1, lu)]
-        h2o = el_in[col(bu, E_HG + 2, lu)]
-        h3o = el_in[col(bu, E_HG + 3, lu)]
-        h4o = el_in[col(bu, E_HG + 4, lu)]
+        h0o = el_in[col(su, E_HG + 0, lu)]
+        h1o = el_in[col(su, E_HG + 1, lu)]
+        h2o = el_in[col(su, E_HG + 2, lu)]
+        h3o = el_in[col(su, E_HG + 3, lu)]
+        h4o = el_in[col(su, E_HG + 4, lu)]
         hg2 = h2o + k_w * rz * dt
         hg3 = h3o + k_t * rtx * dt
         hg4 = h4o + k_t * rty * dt
         e_hg = (0.5 * (h2o + hg2) * rz * dt + 0.5 * (h3o + hg3) * rtx * dt
                 + 0.5 * (h4o + hg4) * rty * dt)
-        el_out[col(bu, E_HG, lu)] = h0o
-        el_out[col(bu, E_HG + 1, lu)] = h1o
-        el_out[col(bu, E_HG + 2, lu)] = hg2
-        el_out[col(bu, E_HG + 3, lu)] = hg3
-        el_out[col(bu, E_HG + 4, lu)] = hg4
-        el_out[col(bu, E_U_HG, lu)] = el_in[col(bu, E_U_HG, lu)] + e_hg
+        el_out[col(su, E_HG, lu)] = h0o
+        el_out[col(su, E_HG + 1, lu)] = h1o
+        el_out[col(su, E_HG + 2, lu)] = hg2
+        el_out[col(su, E_HG + 3, lu)] = hg3
+        el_out[col(su, E_HG + 4, lu)] = hg4
+        el_out[col(su, E_U_HG, lu)] = el_in[col(su, E_U_HG, lu)] + e_hg
         fzs = warp_forces(mf_x, mf_y, lx, ly, frame[6], area)
-        store_corner(blk, bu, 0, lu, corner_out(
+        store_corner(blk, su, 0, lu, corner_out(
             mf_x[0], mf_y[0], gam[0], b1[0], b2[0], fzs[0], area, h0o, h1o, hg2, hg3, hg4,
             mxx, myy, mxy, qx, qy, frame))
-        store_corner(blk, bu, 1, lu, corner_out(
+        store_corner(blk, su, 1, lu, corner_out(
             mf_x[1], mf_y[1], gam[1], b1[1], b2[1], fzs[1], area, h0o, h1o, hg2, hg3, hg4,
             mxx, myy, mxy, qx, qy, frame))
-        store_corner(blk, bu, 2, lu, corner_out(
+        store_corner(blk, su, 2, lu, corner_out(
             mf_x[2], mf_y[2], gam[2], b1[2], b2[2], fzs[2], area, h0o, h1o, hg2, hg3, hg4,
             mxx, myy, mxy, qx, qy, frame))
-        store_corner(blk, bu, 3, lu, corner_out(
+        store_corner(blk, su, 3, lu, corner_out(
             mf_x[3], mf_y[3], gam[3], b1[3], b2[3], fzs[3], area, h0o, h1o, hg2, hg3, hg4,
             mxx, myy, mxy, qx, qy, frame))
-        el_out[col(bu, E_DT, lu)] = element_stable_step(
+        el_out[col(su, E_DT, lu)] = element_stable_step(
             px, py, pz, area, c_m, kgt, mu, inertia[lane(bu, 1, 0, lu)], d_b, bb)
 
 
@@ -289,8 +295,34 @@ def element_pass(nb, x, v, omega, quads, cn, gg, gw, a0s, inertia, dt, thick, mu
     forces and moments, [corner, component]). cn (threads, 36·LANES) is a scratch block
     of corners per thread. No failure checks (every element of the plate is sound)."""
     for b in prange(nb):
-        block_pass(b, get_thread_id(), x, v, omega, quads, cn, gg, gw, a0s, inertia, dt, thick,
-                   mu, e_mod, nu, e_b, nu_b, kgt, r_hg, el_in, el_out, blk)
+        block_pass(b, b, get_thread_id(), x, v, omega, quads, cn, gg, gw, a0s, inertia, dt,
+                   thick, mu, e_mod, nu, e_b, nu_b, kgt, r_hg, el_in, el_out, blk)
+
+
+@njit(parallel=True, **FAST)
+def element_pass_rows(nb, x, v, omega, quads, cn, gg, gw, a0s, inertia, dt, thick, mu, e_mod,
+                      nu, e_b, nu_b, kgt, r_hg, rows_in, rows_out, blocks, s_in, s_out, s_blk):
+    """:func:`element_pass` with the element state and corner forces in the solver's row
+    tables, as they are today (rows_in, rows_out (n, N_ELEM_STATE); blocks (n, 4, 6)):
+    each block's rows are copied into the thread's block of the scratch tables s_in,
+    s_out, s_blk and back (scalar loops), the geometry staying in blocks."""
+    for b in prange(nb):
+        tid = get_thread_id()
+        t = np.uint64(tid)
+        for l in range(LANES):
+            e = b * LANES + l
+            for c in range(N_ELEM_STATE):
+                s_in[col(t, c, np.uint64(l))] = rows_in[e, c]
+                s_out[col(t, c, np.uint64(l))] = rows_in[e, c]
+        block_pass(b, tid, tid, x, v, omega, quads, cn, gg, gw, a0s, inertia, dt, thick, mu,
+                   e_mod, nu, e_b, nu_b, kgt, r_hg, s_in, s_out, s_blk)
+        for l in range(LANES):
+            e = b * LANES + l
+            for c in range(N_ELEM_STATE):
+                rows_out[e, c] = s_out[col(t, c, np.uint64(l))]
+            for i in range(4):
+                for j in range(6):
+                    blocks[e, i, j] = s_blk[lane(t, 24, 6 * i + j, np.uint64(l))]
 
 
 def to_blocks(a: np.ndarray, nb: int) -> np.ndarray:
@@ -374,7 +406,8 @@ def main() -> int:
     el_in = to_blocks(st.elem.T, nb)
     el_out = np.zeros_like(el_in)
     blk = np.zeros(nb * 24 * LANES)
-    args = (nb, st.x, st.v, st.omega, quads, np.zeros((numba.config.NUMBA_NUM_THREADS, 36 * LANES)),
+    args = (nb, st.x, st.v, st.omega, quads,
+            np.zeros((numba.config.NUMBA_NUM_THREADS, 36 * LANES)),
             to_blocks(np.transpose(mesh.gauss_grad, (1, 2, 3, 0)).reshape(32, ne), nb),
             to_blocks(mesh.gauss_weight.T, nb), to_blocks(mesh.area0[None, :], nb),
             to_blocks(mesh.rot_inertia[None, :], nb), st.dt, thick, sec[C_AREAL_MASS],
@@ -387,16 +420,32 @@ def main() -> int:
                *range(E_FG, E_FG + 16)]
     same = (np.array_equal(from_blocks(blk, 24, ne).T.reshape(ne, 4, 6), ref_blocks)
             and all(np.array_equal(state[c], ref_el[:, c]) for c in written))
-    print(f"outputs bitwise equal to shell_force's: {same}")
+    # the same pass on the solver's row tables (padded to whole blocks)
+    threads_max = numba.config.NUMBA_NUM_THREADS
+    pad = nb * LANES - ne
+    rows_in = np.concatenate([st.elem, np.repeat(st.elem[-1:], pad, axis=0)])
+    rows_out = np.zeros_like(rows_in)
+    blocks_rows = np.zeros((nb * LANES, 4, 6))
+    rows_args = args[:-3] + (rows_in, rows_out, blocks_rows,
+                             np.zeros(threads_max * N_ELEM_STATE * LANES),
+                             np.zeros(threads_max * N_ELEM_STATE * LANES),
+                             np.zeros(threads_max * 24 * LANES))
+    element_pass_rows(*rows_args)
+    same_rows = (np.array_equal(blocks_rows[:ne], ref_blocks)
+                 and all(np.array_equal(rows_out[:ne, c], ref_el[:, c]) for c in written))
+    print(f"outputs bitwise equal to shell_force's: {same} (blocks), {same_rows} (rows)")
     t_ref = best_seconds(lambda: X.shell_forces(model, st, ws))
     t_new = best_seconds(lambda: element_pass(*args))
-    asm = next(iter(element_pass.inspect_asm().values()))
-    packed = sum(line.split()[0].endswith("pd") for line in asm.splitlines()
-                 if line.strip() and ("%zmm" in line or "%ymm" in line))
-    print(f"element_pass: {packed} packed-double instructions (0: not vectorised)")
-    print(f"{ne} elements, {threads} thread(s): shell_force {t_ref / ne * 1e9:.0f} ns, prototype "
-          f"{t_new / ne * 1e9:.0f} ns per element ({t_ref / t_new:.2f}x)")
-    return 0 if same else 1
+    t_rows = best_seconds(lambda: element_pass_rows(*rows_args))
+    for name, f in (("element_pass", element_pass), ("element_pass_rows", element_pass_rows)):
+        asm = next(iter(f.inspect_asm().values()))
+        packed = sum(line.split()[0].endswith("pd") for line in asm.splitlines()
+                     if line.strip() and ("%zmm" in line or "%ymm" in line))
+        print(f"{name}: {packed} packed-double instructions (0: not vectorised)")
+    print(f"{ne} elements, {threads} thread(s), ns per element: shell_force "
+          f"{t_ref / ne * 1e9:.0f}; blocks {t_new / ne * 1e9:.0f} ({t_ref / t_new:.2f}x); "
+          f"state in rows {t_rows / ne * 1e9:.0f} ({t_ref / t_rows:.2f}x)")
+    return 0 if same and same_rows else 1
 
 
 if __name__ == "__main__":

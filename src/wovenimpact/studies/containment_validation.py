@@ -259,7 +259,8 @@ def intro_lines() -> list[str]:
             "the blade meets the casing (the default blade is a fan blade's, its chord 30° "
             "from the axis at the root and 60° at the tip, with a curved tip; a flat blade "
             "flying face-on loads far more of the casing: 4-ply hybrid casing 102.75 m/s "
-            "face-on against 129.90 with the default blade, 7 mm ring) and the hybrid "
+            "face-on against 129.90 with the default blade, 7 mm ring, both by the default "
+            "stable step) and the hybrid "
             "casing's inner aluminium shell (ours 1 mm).", ""]
 
 

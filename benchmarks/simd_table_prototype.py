@@ -4,7 +4,7 @@ vectorised bicubic Hermite evaluation — against the scalar ``crossover_from_ta
 on the same random points (docs/theory.md §4.6, "SIMD element pass"). A measurement,
 not solver code.
 
-    NUMBA_NUM_THREADS=1 python benchmarks/simd_table_prototype.py [N_POINTS]   (4 000: in cache)
+    python benchmarks/simd_table_prototype.py [N_POINTS]   (4 000: in cache)
 
 Prints whether the split gives bitwise the same flags and values (exit 1 if not) and ns
 per point of each part, one thread.
@@ -20,6 +20,7 @@ import numpy as np
 from numba import njit, prange
 
 from wovenimpact.benchmark import REFERENCE_FABRIC
+from wovenimpact.jit import set_threads
 from wovenimpact.kernels import fabric_layout as L
 from wovenimpact.kernels.fabric_table import (
     EXACT,
@@ -145,6 +146,7 @@ def best(f, repeats=200):
 
 def main() -> int:
     n = LANES * (int(sys.argv[1]) // LANES) if len(sys.argv) > 1 else 4000
+    set_threads(1)
     fabric = load_material(REFERENCE_FABRIC)
     row = dataclasses.replace(fabric, options=dataclasses.replace(fabric.options,
                                                                   crossover="table")).to_array()

@@ -14,12 +14,15 @@ vectorised, and ns per value of each, one thread.
 import math
 import re
 import sys
-import time
+from pathlib import Path
 
 import numpy as np
 from numba import njit, prange
 
 from wovenimpact.jit import set_threads
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from simd_table_prototype import best  # noqa: E402
 
 FAST = dict(boundscheck=False, error_model="numpy")
 # Cephes atan.c (S. L. Moshier): atan(z) ≈ z + z³ P(z²)/Q(z²) for |z| ≤ tan(π/8)
@@ -72,16 +75,6 @@ def atan2_blocks(y, x, out):
 def atan2_libm(y, x, out):
     for e in range(y.shape[0]):
         out[e] = math.atan2(y[e], x[e])
-
-
-def best(f, repeats=20):
-    """Best of ``repeats`` calls (s)."""
-    t = math.inf
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        f()
-        t = min(t, time.perf_counter() - t0)
-    return t
 
 
 def main() -> int:

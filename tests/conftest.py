@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import os
 
 import pytest
 
@@ -12,6 +13,9 @@ from wovenimpact.materials.fabric import FabricOptions, FabricParameters, YarnFa
 
 INCH = 0.0254
 configure_threading()  # the CLI's threading layer in tests too (importing sets nothing)
+# the tests' many scaled materials are not stored in the user's table cache (the disk
+# cache has its own test, which turns it back on in a temporary folder)
+os.environ.setdefault("WOVENIMPACT_TABLE_CACHE", "0")
 
 
 def reference_fabric(**options) -> FabricParameters:

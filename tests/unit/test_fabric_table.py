@@ -4,6 +4,7 @@ against the exact solve, and the kernel's use of the table."""
 from __future__ import annotations
 
 import dataclasses
+import os
 
 import numpy as np
 import pytest
@@ -272,3 +273,53 @@ def test_bucket_lookup_finds_the_same_interval_as_a_search():
     out = np.empty(3, dtype=np.int64)
     lookup(table, np.array([kw[0] - 1e-9, kw[-1] + 1e-9, np.nan]), out)
     assert np.all(out == -1)
+
+
+def test_tables_are_kept_on_disk_and_read_back_bitwise(tmp_path, monkeypatch):
+    """A table built once is stored under the cache directory and the next process reads
+    it (here: the uncached builder, with tabulation made to fail) bit for bit; a damaged
+    file is rebuilt; another material gets another file; WOVENIMPACT_TABLE_CACHE=0 keeps
+    none."""
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path))
+    monkeypatch.setenv("WOVENIMPACT_TABLE_CACHE", "1")  # tests/conftest.py turns it off
+    params = FT._options_free(reference_fabric())
+    build = FT._cached_table.__wrapped__  # the builder without this process's memory
+    built = build(params)
+    files = list((tmp_path / "wovenimpact" / "tables").glob("*.npz"))
+    assert [f.stem for f in files] == [FT.table_key(params)]
+
+    def no_build(*args):
+        raise AssertionError("the table was rebuilt instead of read")
+
+    with monkeypatch.context() as m:
+        m.setattr(FT, "tabulate", no_build)
+        again = build(params)
+    assert np.array_equal(again, built) and again.tobytes() == built.tobytes()
+
+    files[0].write_bytes(b"not a table")  # damaged: rebuilt and stored again
+    assert build(params).tobytes() == built.tobytes()
+    assert FT._read_table(files[0], FT.table_key(params)) is not None
+
+    stiffer = dataclasses.replace(
+        params, warp=dataclasses.replace(params.warp, modulus=1.1 * params.warp.modulus))
+    assert FT.table_key(stiffer) != FT.table_key(params)
+
+    monkeypatch.setenv("WOVENIMPACT_TABLE_CACHE", "0")
+    assert FT.table_cache_dir() is None
+    files[0].unlink()
+    build(params)
+    assert not files[0].exists()
+
+
+def test_the_table_cache_keeps_the_most_recently_used(tmp_path, monkeypatch):
+    """Past TABLE_CACHE_FILES tables the least recently used file goes; a table read is
+    used."""
+    monkeypatch.setattr(FT, "TABLE_CACHE_FILES", 2)
+    row = FT._cached_table(FT._options_free(reference_fabric()))
+    paths = [tmp_path / f"k{i}.npz" for i in range(3)]
+    for i, path in enumerate(paths[:2]):
+        FT._write_table(path, f"k{i}", row)
+        os.utime(path, (1000.0 + i, 1000.0 + i))
+    assert FT._read_table(paths[0], "k0") is not None  # k0 is now the most recent
+    FT._write_table(paths[2], "k2", row)
+    assert sorted(p.name for p in tmp_path.glob("*.npz")) == ["k0.npz", "k2.npz"]

@@ -23,9 +23,14 @@ family (its slack height reaches h_w0 + h_f0).
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import functools
+import hashlib
 import math
+import os
+import zipfile
+from pathlib import Path
 
 import numpy as np
 
@@ -319,12 +324,76 @@ TABLE_HEADER = (L.P_CROSSOVER, L.P_TAB_NW, L.P_TAB_NF, L.P_TAB_START, L.P_TAB_NB
                 L.P_TAB_NBF, L.P_TAB_IBW, L.P_TAB_IBF, L.P_TAB_DATA)
 
 
+def table_cache_dir() -> Path | None:
+    """Where built tables are kept between runs: ``$XDG_CACHE_HOME/wovenimpact/tables``
+    (``~/.cache`` when unset), beside the compiled kernels; none with
+    ``WOVENIMPACT_TABLE_CACHE=0``."""
+    if os.environ.get("WOVENIMPACT_TABLE_CACHE", "1") in ("0", "false", "no"):
+        return None
+    root = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
+    return root / "wovenimpact" / "tables"
+
+
+def table_key(params) -> str:
+    """The name of a table on disk: SHA-256 of the material's parameter vector (options
+    left out, as in the table) and of the package's sources (``provenance.source_digest``:
+    any change of the code builds the tables afresh)."""
+    from wovenimpact.provenance import source_digest
+
+    head = _options_free(params).to_array()
+    return hashlib.sha256(head.tobytes() + source_digest().encode()).hexdigest()[:24]
+
+
+def _read_table(path: Path, key: str) -> np.ndarray | None:
+    """The row stored at ``path`` under ``key``, or None if the file is missing, not a
+    table of this key, or damaged (the caller then builds it). No pickles are read."""
+    try:
+        with np.load(path, allow_pickle=False) as f:
+            if str(f["key"]) != key:
+                return None
+            row = np.array(f["row"], dtype=np.float64)
+    except (OSError, KeyError, ValueError, EOFError, zipfile.BadZipFile):
+        return None
+    if row.ndim != 1 or row.size <= L.N_PARAM or row[L.P_CROSSOVER] != L.CROSSOVER_TABLE:
+        return None
+    with contextlib.suppress(OSError):
+        os.utime(path)  # recently used: kept when the folder is pruned
+    return row
+
+
+TABLE_CACHE_FILES = 64  # tables kept on disk (~2.3 MB each); the least recently used go
+
+
+def _write_table(path: Path, key: str, row: np.ndarray) -> None:
+    """Store ``row`` at ``path`` (written to a temporary name, then renamed: a reader never
+    sees half a file), and keep the TABLE_CACHE_FILES most recently used tables of the
+    folder. A cache that cannot be written is skipped: it only saves time."""
+    tmp = path.with_name(f"{path.stem}.{os.getpid()}.tmp.npz")
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        np.savez(tmp, key=np.array(key), row=row)
+        os.replace(tmp, path)
+        kept = sorted(path.parent.glob("*.npz"), key=lambda f: f.stat().st_mtime, reverse=True)
+        for old in kept[TABLE_CACHE_FILES:]:
+            old.unlink(missing_ok=True)
+    except OSError:
+        tmp.unlink(missing_ok=True)
+
+
 @functools.lru_cache(maxsize=64)
 def _cached_table(params) -> np.ndarray:
-    kw = family_knots(params.warp, params.fill)
-    kf = family_knots(params.fill, params.warp)
-    row = install(np.zeros(L.N_PARAM), kw, kf, tabulate(params, kw, kf))
-    mark_exact_cells(params, row)
+    """The table row of ``params`` (options-free): from this process's memory, else from
+    the disk cache (:func:`table_cache_dir`), else built (1–2 s) and stored there."""
+    folder = table_cache_dir()
+    key = table_key(params) if folder is not None else ""
+    row = _read_table(folder / f"{key}.npz", key) if folder is not None else None
+    if row is None:
+        kw = family_knots(params.warp, params.fill)
+        kf = family_knots(params.fill, params.warp)
+        row = install(np.zeros(L.N_PARAM), kw, kf, tabulate(params, kw, kf))
+        mark_exact_cells(params, row)
+        if folder is not None:
+            _write_table(folder / f"{key}.npz", key, row)
     row.flags.writeable = False
     return row
 

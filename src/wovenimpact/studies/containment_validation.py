@@ -261,7 +261,11 @@ def intro_lines() -> list[str]:
             "flying face-on loads far more of the casing: 4-ply hybrid casing 102.75 m/s "
             "face-on against 129.90 with the default blade, 7 mm ring, both by the default "
             "stable step) and the hybrid "
-            "casing's inner aluminium shell (ours 1 mm).", ""]
+            "casing's inner aluminium shell (ours 1 mm).", "",
+            "Mesh: the energy a casing absorbs is not yet mesh-converged (docs/theory.md "
+            "§8.8: yarn and aluminium failure have no element-size regularisation, and a "
+            "finer mesh absorbs less), so the layers a coarse ladder needs to contain are "
+            "likely too few.", ""]
 
 
 def runs_lines(ladders: dict[str, list[dict]], unfinished: list[str]) -> list[str]:

@@ -5,10 +5,11 @@ shells, the thesis's casing plies nest: initial overlap removed), the stack pres
 together under a dome of transverse displacement (as under an impactor: up to 0.1 mm
 at the centre for the top ply, so that part of the pairs is in contact) and set
 sliding (the top ply at 5 m/s along x and 20 m/s down, the others in proportion to
-their height, for any number of plies), with Coulomb friction μ = 0.2. ``ShellContact.forces`` is timed twice: with
-a search at every call (skin 0: broad + narrow phase + assembly) and reusing its
-candidates (the default skin, positions fixed: narrow phase + assembly, what most steps
-cost); the broad phase with the skin alone is also reported. The cost per
+their height, for any number of plies), with Coulomb friction μ = 0.2.
+``ShellContact.forces`` is timed twice: with a search at every call (skin 0: broad +
+narrow phase + assembly) and reusing its candidates (the default skin, positions fixed:
+narrow phase + assembly, what most steps cost); the broad phase with the skin alone is
+also reported. The cost per
 node must stay about constant as plies multiply (linear scaling).
 ``--threads=1,2`` chooses the thread counts, ``--plies=1,2,4,6`` the stacks,
 ``--calls=N`` the timed calls per batch (50, best of 5 batches), ``--json`` prints

@@ -104,12 +104,18 @@ def _kernel_source_digest() -> str:
     return h.hexdigest()[:16]
 
 
+def cache_root() -> Path:
+    """wovenimpact's cache folder: ``$XDG_CACHE_HOME/wovenimpact`` (``~/.cache`` when
+    unset). Compiled kernels go to its ``numba`` folder, crossover tables to ``tables``
+    (``materials.fabric_table``)."""
+    return Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache")) / "wovenimpact"
+
+
 PARALLEL = os.environ.get("WOVENIMPACT_SERIAL", "0") not in ("1", "true", "yes")
 # Numba's cache key ignores the ``parallel`` flag: serial builds get their own directory,
 # or WOVENIMPACT_SERIAL=1 would load the parallel object code cached before it
 _CACHE_DIR = None if "NUMBA_CACHE_DIR" in os.environ else str(
-    Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
-    / "wovenimpact" / "numba" / (_kernel_source_digest() + ("" if PARALLEL else "-serial"))
+    cache_root() / "numba" / (_kernel_source_digest() + ("" if PARALLEL else "-serial"))
 )
 
 

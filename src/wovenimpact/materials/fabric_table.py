@@ -328,10 +328,11 @@ def table_cache_dir() -> Path | None:
     """Where built tables are kept between runs: ``$XDG_CACHE_HOME/wovenimpact/tables``
     (``~/.cache`` when unset), beside the compiled kernels; none with
     ``WOVENIMPACT_TABLE_CACHE=0``."""
+    from wovenimpact.jit import cache_root
+
     if os.environ.get("WOVENIMPACT_TABLE_CACHE", "1") in ("0", "false", "no"):
         return None
-    root = Path(os.environ.get("XDG_CACHE_HOME", Path.home() / ".cache"))
-    return root / "wovenimpact" / "tables"
+    return cache_root() / "tables"
 
 
 def table_key(params) -> str:
@@ -373,7 +374,9 @@ def _write_table(path: Path, key: str, row: np.ndarray) -> None:
         path.parent.mkdir(parents=True, exist_ok=True)
         np.savez(tmp, key=np.array(key), row=row)
         os.replace(tmp, path)
-        kept = sorted(path.parent.glob("*.npz"), key=lambda f: f.stat().st_mtime, reverse=True)
+        tables = [f for f in path.parent.glob("*.npz") if ".tmp." not in f.name]  # not
+        # another process's file being written
+        kept = sorted(tables, key=lambda f: f.stat().st_mtime, reverse=True)
         for old in kept[TABLE_CACHE_FILES:]:
             old.unlink(missing_ok=True)
     except OSError:

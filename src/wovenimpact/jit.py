@@ -201,6 +201,9 @@ def _limit_threads(n: int) -> None:
     os.environ["NUMBA_NUM_THREADS"] = str(n)
     numba.config.reload_config()
     configure_threading()
+    # a forked worker inherits the parent's launched thread pool: without this its
+    # parallel loops still ran on the parent's thread count (2 per worker here)
+    numba.set_num_threads(min(n, numba.get_num_threads()))
     threading.Thread(target=_watch_parent, args=(os.getppid(),), daemon=True,
                      name="wovenimpact-parent-watchdog").start()
 
@@ -243,6 +246,16 @@ def process_pool(workers: int, threads: int = 1):
             proc.terminate()
         raise
     pool.shutdown(wait=True)
+
+
+def block_kernel(fn):
+    """A stage of a parallel loop's body that LLVM must inline there (``forceinline``):
+    the loop's array arguments are ``noalias``, so that a lane loop in the stage
+    vectorises without run-time alias checks (kernels.shell_blocks; theory §4.6).
+    Numba's own inlining (``inline="always"``) in a ``prange`` body runs the parfor
+    array analysis over the stage's tuples, which fails ("Dimension mismatch")."""
+    with _cache_dir():
+        return numba.njit(forceinline=True, **NO_REFCOUNT, **JIT_FLAGS)(fn)
 
 
 def inline_kernel(fn):

@@ -103,3 +103,32 @@ class NodeEnergies(NamedTuple):
     w_ext: np.ndarray
     ke: np.ndarray
     ke_eroded: np.ndarray
+
+
+class BlockPlan(NamedTuple):
+    """Which elements the element stage takes in blocks of ``LANES`` (kernels.shell_blocks)
+    and their static geometry in block layout — value k of lane l of block b at
+    (b · width + k) · LANES + l — built once per Workspace (solver.element_blocks)."""
+    elems: np.ndarray  # (n_blocks · LANES,) int64 element of each lane (the last repeated)
+    lanes: np.ndarray  # (n_blocks,) int64 lanes in use
+    section: np.ndarray  # (n_blocks,) int64 the block's section (one per block)
+    others: np.ndarray  # (n,) int64 the elements left to ``shell_force`` alone
+    gauss_grad: np.ndarray  # width 32: [g, ∂/∂X or ∂/∂Y, corner]
+    gauss_weight: np.ndarray  # width 4
+    ref_grad: np.ndarray  # width 8: [∂/∂X or ∂/∂Y, corner]
+    area0: np.ndarray  # width 1
+    rot_inertia: np.ndarray  # width 1
+
+
+class BlockScratch(NamedTuple):
+    """Per-thread scratch rows of the block stages (kernels.shell_blocks), (threads, n)."""
+    corners: np.ndarray  # the block's corners (x, v, ω)
+    old: np.ndarray  # the element state the step reads
+    kin: np.ndarray  # each point's F and stretches
+    coef: np.ndarray  # each point's table cell
+    geo: np.ndarray
+    flag: np.ndarray  # > 0: the lane goes to shell_force
+    res: np.ndarray  # each point's crossover results
+    out_el: np.ndarray  # the element state and the isotropic step
+    out_blk: np.ndarray  # corner forces
+    pending: np.ndarray  # (n_blocks · LANES,) int8: 1 where shell_force takes the lane

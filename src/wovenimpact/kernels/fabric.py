@@ -38,6 +38,7 @@ from numba import prange
 
 from wovenimpact.jit import inline_kernel, kernel, loop_kernel
 from wovenimpact.kernels.fabric_table import crossover_from_table
+from wovenimpact.kernels.vecmath import atan2_upper
 from wovenimpact.kernels.fabric_layout import (
     CROSSOVER_TABLE,
     FAILURE_PROGRESSIVE,
@@ -284,33 +285,31 @@ def solve_crimp_heights(k_a, ell_a, ell0_a, h0_a, lt0_a, k_b, ell_b, ell0_b, h0_
     return hs_a + x, s_total - hs_a - x, 0.0, 0.0, MAX_ITER, False, False
 
 
-@kernel
+@inline_kernel
 def shear_modulus_true(gamma_abs, g1, g2, gamma1, gamma2):
     """Secant modulus G(|γ|) of the trellis law (eq. 3.16 on the true angle; theory §1.6).
 
-    Returns (G, dτ/dγ, e) with τ = G γ and e(|γ|) = ∫₀^|γ| τ dγ (J/m³).
+    Returns (G, dτ/dγ, e) with τ = G γ and e(|γ|) = ∫₀^|γ| τ dγ (J/m³): G = G1 up to γ1,
+    rising linearly to G2 at γ2 (when γ2 > γ1), G2 beyond. Every branch is computed and
+    one selected, so that a loop over points vectorises (``kernels.shell_blocks``).
     """
-    if gamma_abs <= gamma1:
-        return g1, g1, 0.5 * g1 * gamma_abs * gamma_abs
+    lo = gamma_abs <= gamma1
+    ramp = gamma2 > gamma1
+    mid = (gamma_abs <= gamma2) & ramp
     e1 = 0.5 * g1 * gamma1 * gamma1
-    if gamma2 > gamma1:
-        m = (g2 - g1) / (gamma2 - gamma1)
-        if gamma_abs <= gamma2:
-            g = g1 + m * (gamma_abs - gamma1)
-            e = (
-                e1
-                + 0.5 * g1 * (gamma_abs**2 - gamma1**2)
-                + m * ((gamma_abs**3 - gamma1**3) / 3.0 - 0.5 * gamma1 * (gamma_abs**2 - gamma1**2))
-            )
-            return g, g + m * gamma_abs, e
-        e2 = (
-            e1
-            + 0.5 * g1 * (gamma2**2 - gamma1**2)
-            + m * ((gamma2**3 - gamma1**3) / 3.0 - 0.5 * gamma1 * (gamma2**2 - gamma1**2))
-        )
-    else:
-        e2 = e1
-    return g2, g2, e2 + 0.5 * g2 * (gamma_abs**2 - gamma2**2)
+    m = (g2 - g1) / (gamma2 - gamma1) if ramp else 0.0
+    a2, a3 = gamma_abs * gamma_abs, gamma_abs * gamma_abs * gamma_abs
+    c2, c3 = gamma1 * gamma1, gamma1 * gamma1 * gamma1
+    r2, r3 = gamma2 * gamma2, gamma2 * gamma2 * gamma2
+    g_mid = g1 + m * (gamma_abs - gamma1)
+    e_mid = e1 + 0.5 * g1 * (a2 - c2) + m * ((a3 - c3) / 3.0 - 0.5 * gamma1 * (a2 - c2))
+    e2 = (e1 + 0.5 * g1 * (r2 - c2) + m * ((r3 - c3) / 3.0 - 0.5 * gamma1 * (r2 - c2))
+          if ramp else e1)
+    e_high = e2 + 0.5 * g2 * (a2 - r2)
+    g = g1 if lo else (g_mid if mid else g2)
+    g_tan = g1 if lo else (g_mid + m * gamma_abs if mid else g2)
+    e = 0.5 * g1 * gamma_abs * gamma_abs if lo else (e_mid if mid else e_high)
+    return g, g_tan, e
 
 
 @kernel
@@ -386,7 +385,7 @@ def yarn_frame(f11, f12, f21, f22):
     sin_t = ewx * efy - ewy * efx
     if not (sin_t > 0.0) or not math.isfinite(cos_t):
         return False, lam_w, lam_f, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    gamma = 0.5 * math.pi - math.atan2(sin_t, cos_t)
+    gamma = 0.5 * math.pi - atan2_upper(sin_t, cos_t)  # libm's to 1 ulp; vectorises (kernels.vecmath)
     return True, lam_w, lam_f, ewx, ewy, efx, efy, cos_t, sin_t, gamma
 
 

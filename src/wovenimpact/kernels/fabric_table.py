@@ -109,19 +109,25 @@ def hermite_corner(p, m, k, ax, bx, dax, dbx, ay, by, day, dby):
     ``k`` is the knot's unsigned row offset. Returns the corner's (W, ∂W/∂λ_w, ∂W/∂λ_f,
     H_w, H_f) terms.
     """
-    f = p[m, k + W0]
-    fx = p[m, k + W1]
-    fy = p[m, k + W2]
-    fxy = p[m, k + W3]
+    return hermite_terms(p[m, k + W0], p[m, k + W1], p[m, k + W2], p[m, k + W3],
+                         p[m, k + HW0], p[m, k + HW1], p[m, k + HW2], p[m, k + HW3],
+                         p[m, k + HF0], p[m, k + HF1], p[m, k + HF2], p[m, k + HF3],
+                         ax, bx, dax, dbx, ay, by, day, dby)
+
+
+@inline_kernel
+def hermite_terms(f, fx, fy, fxy, h0, h1, h2, h3, k0, k1, k2, k3, ax, bx, dax, dbx, ay, by,
+                  day, dby):
+    """:func:`hermite_corner` on a corner's twelve coefficients (W, ∂W/∂λ_w, ∂W/∂λ_f,
+    ∂²W/∂λ_w∂λ_f; the same four of H_w, then of H_f), wherever they were read from (the
+    element stage in blocks copies them: ``kernels.shell_blocks``)."""
     u = f * ax + fx * bx
     v = fy * ax + fxy * bx
     w = u * ay + v * by
     gw = (f * dax + fx * dbx) * ay + (fy * dax + fxy * dbx) * by
     gf = u * day + v * dby
-    hw = (p[m, k + HW0] * ax + p[m, k + HW1] * bx) * ay + (
-        p[m, k + HW2] * ax + p[m, k + HW3] * bx) * by
-    hf = (p[m, k + HF0] * ax + p[m, k + HF1] * bx) * ay + (
-        p[m, k + HF2] * ax + p[m, k + HF3] * bx) * by
+    hw = (h0 * ax + h1 * bx) * ay + (h2 * ax + h3 * bx) * by
+    hf = (k0 * ax + k1 * bx) * ay + (k2 * ax + k3 * bx) * by
     return w, gw, gf, hw, hf
 
 

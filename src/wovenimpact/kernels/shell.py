@@ -52,6 +52,7 @@ from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels.bundles import ElementTables
 from wovenimpact.kernels.fabric import fabric_point
 from wovenimpact.kernels.j2 import j2_point
+from wovenimpact.kernels.vecmath import sqrt as vsqrt
 from wovenimpact.kernels.shell_layout import (
     C_AREAL_MASS,
     C_BEND_E,
@@ -659,9 +660,9 @@ def element_stable_step(px, py, pz, area, c_memb, kgt, mu, inertia, d_b, bb):
         dz = pz[j] - pz[i]
         edge2 = max(edge2, dx * dx + dy * dy + dz * dz)
     c2 = max(c_memb, kgt) / mu
-    dt_e = area / math.sqrt(edge2 * c2)
+    dt_e = area / vsqrt(edge2 * c2)
     k_rot = area * (0.25 * kgt + d_b * bb)
-    return min(dt_e, 2.0 * math.sqrt(inertia / k_rot))
+    return min(dt_e, 2.0 * vsqrt(inertia / k_rot))
 
 
 @inline_kernel
@@ -673,10 +674,9 @@ def family_stable_step(k, k_shear, mu, g):
     trellis shear's (added, as the single bound of the undeformed element adds it),
     μ the areal mass: Δt = √(μ/((k + k_s) Σ_I (∂N_I/∂X_i)²)). Infinite for k = 0 (a
     slack family, or not a fabric): it does not limit the step."""
-    if not (k > 0.0):
-        return math.inf
     s = g[0] * g[0] + g[1] * g[1] + g[2] * g[2] + g[3] * g[3]
-    return math.sqrt(mu / ((k + k_shear) * s))
+    step = vsqrt(mu / ((k + k_shear) * s))  # outside the select: a guarded sqrt is a
+    return step if k > 0.0 else math.inf  # libm call, which stops the vectoriser
 
 
 KINEMATIC_FRACTION = 0.05  # of its length a corner pair may close in one step
@@ -700,11 +700,8 @@ def kinematic_step(px, py, pz, vx, vy, vz):
             dz = pz[j] - pz[i]
             change = abs(dx * (vx[j] - vx[i]) + dy * (vy[j] - vy[i]) + dz * (vz[j] - vz[i]))
             d2 = dx * dx + dy * dy + dz * dz
-            if change > rate * d2:
-                rate = change / d2
-    if not (rate > 0.0):
-        return math.inf
-    return KINEMATIC_FRACTION / rate
+            rate = change / d2 if change > rate * d2 else rate  # a select: vectorises
+    return KINEMATIC_FRACTION / rate if rate > 0.0 else math.inf
 
 
 @inline_kernel
@@ -907,6 +904,35 @@ def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
     return EL_OK, 0, dt_iso
 
 
+@kernel
+def finish_element(e, st, er, dt_check, el_out, blocks, status, eroded_now, alive, dt_erode,
+                   erode_inverted):
+    """After ``shell_force`` of element e (status st, er = 1 if it eroded, dt_check its
+    isotropic step): the erosion tests of the element stage (``internal_force_for_shells``'
+    dt_erode and erode_inverted), then e's status, eroded and alive bytes.
+
+    Returns (1 if e failed else 0, er, e's own step: the smaller of E_DT and E_DT_KIN)."""
+    if st == EL_INVERTED and erode_inverted:
+        # crushed through itself (LS-DYNA's erosion on a negative Jacobian): it goes,
+        # with the energies it held at the start of the step
+        el_out[e, E_ALIVE] = 0.0
+        el_out[e, E_DT] = math.inf
+        el_out[e, E_DT_KIN] = math.inf
+        clear_block(blocks, e)
+        st = EL_OK
+        er = 1
+    elif st == EL_OK and er == 0 and dt_check < dt_erode:
+        el_out[e, E_ALIVE] = 0.0
+        el_out[e, E_DT] = math.inf
+        el_out[e, E_DT_KIN] = math.inf
+        clear_block(blocks, e)
+        er = 1
+    status[e] = st
+    eroded_now[e] = er
+    alive[e] = 1 if el_out[e, E_ALIVE] != 0.0 else 0
+    return (0 if st == EL_OK else 1), er, min(el_out[e, E_DT], el_out[e, E_DT_KIN])
+
+
 @loop_kernel
 def internal_force_for_shells(mesh, motion, dt, tables, results, dt_erode, erode_inverted):
     """``shell_force`` for every element (prange; each element writes its own rows).
@@ -961,27 +987,9 @@ def internal_force_for_shells(mesh, motion, dt, tables, results, dt_erode, erode
     for e in prange(ne):
         st, er, dt_check = shell_force(np.uint64(e), mesh, motion, dt, rows, point_blocks,
                                        blocks)
-        if st == EL_INVERTED and erode_inverted:
-            # crushed through itself (LS-DYNA's erosion on a negative Jacobian): it goes,
-            # with the energies it held at the start of the step
-            el_out[e, E_ALIVE] = 0.0
-            el_out[e, E_DT] = math.inf
-            el_out[e, E_DT_KIN] = math.inf
-            clear_block(blocks, e)
-            st = EL_OK
-            er = 1
-        elif st == EL_OK and er == 0 and dt_check < dt_erode:
-            el_out[e, E_ALIVE] = 0.0
-            el_out[e, E_DT] = math.inf
-            el_out[e, E_DT_KIN] = math.inf
-            clear_block(blocks, e)
-            er = 1
-        status[e] = st
-        eroded_now[e] = er
-        alive[e] = 1 if el_out[e, E_ALIVE] != 0.0 else 0
-        dt_own = min(el_out[e, E_DT], el_out[e, E_DT_KIN])
+        failed, er, dt_own = finish_element(e, st, er, dt_check, el_out, blocks, status,
+                                            eroded_now, alive, dt_erode, erode_inverted)
         dt_min = min(dt_min, dt_own)
-        if st != EL_OK:
-            n_failed += 1
+        n_failed += failed
         n_eroded += er
     return n_failed, n_eroded, dt_min

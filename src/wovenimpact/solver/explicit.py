@@ -44,7 +44,9 @@ from wovenimpact.kernels.gather import gather_nodal_forces
 from wovenimpact.kernels.integrate import force_pair_power, gather_and_update, smooth_step
 from wovenimpact.kernels.mass_scaling import node_masses, scale_element_masses, scaled_node_masses
 from wovenimpact.solver.contact_stage import ContactBuffers, advance_bodies, contact_forces
+from wovenimpact.solver.element_blocks import block_plan, block_scratch
 from wovenimpact.kernels.shell import internal_force_for_shells
+from wovenimpact.kernels.shell_blocks import internal_force_blocks
 from wovenimpact.state import (
     BODY_KINETIC,
     CONTACT_PENALTY,
@@ -69,6 +71,7 @@ DT_COLLAPSE = 1e-3  # a step below this fraction of the first one stops the run
 # no change on one thread or on a uniform plate). Each element writes only its own rows,
 # so the results are the same for any chunking.
 ELEMENT_CHUNK = 256
+BLOCK_CHUNK = 32  # blocks of 8 elements per chunk of the block stage's loops
 STATUS_TEXT = {
     SL.EL_INVERTED: "inverted or degenerate (non-positive area or Jacobian)",
     SL.EL_MATERIAL: "material point failed (no converged crimp heights or inadmissible stretch)",
@@ -101,6 +104,8 @@ class Workspace:
     node_map: NodeMap = None  # the Model's node → (element, corner) map
     energies: NodeEnergies = None  # w_int, w_ext, ke, ke_eroded (above)
     contact: object = None  # solver.contact_stage.ContactBuffers
+    plan: object = None  # kernels.bundles.BlockPlan: the elements taken in blocks, or None
+    scratch: object = None  # kernels.bundles.BlockScratch for the block stages
     dt_min: float = math.inf  # min_e L_e/c_e of the last element stage
     n_eroded: int = 0  # elements eroded in the last element stage
     profile: bool = False
@@ -140,6 +145,8 @@ class Workspace:
             gauss_weight=model.gauss_weight, rot_inertia=model.elem_rot_inertia,
             point_width=int(model.point_width),
             step_mode=SL.STABLE_STEPS[model.stable_step])
+        ws.plan = block_plan(model, state)
+        ws.scratch = block_scratch(ws.plan) if ws.plan is not None else None
         ws.results = ElementResults(blocks=ws.blocks, status=ws.status,
                                     eroded_now=ws.eroded_now, alive=ws.alive)
         ws.node_map = NodeMap(node_ptr=model.node_ptr, node_elem=model.node_elem,
@@ -152,13 +159,18 @@ class Workspace:
 def shell_forces(model, state: State, ws: Workspace) -> None:
     """Stage 1: element forces at x^n into ws (blocks, element and material state,
     alive bytes, dt_min, n_eroded); stops naming the first failed element."""
-    with numba.parallel_chunksize(ELEMENT_CHUNK):
-        n_failed, ws.n_eroded, ws.dt_min = internal_force_for_shells(
-            ws.mesh, Motion(x=state.x, v=state.v, omega=state.omega), state.dt,
-            ElementTables(el_in=state.elem, el_out=ws.elem, mat_in=state.mat, mat_out=ws.mat),
-            ws.results, model.erode_dt_fraction * state.dt_first / model.alpha,
-            model.erode_inverted,
-        )
+    motion = Motion(x=state.x, v=state.v, omega=state.omega)
+    tables = ElementTables(el_in=state.elem, el_out=ws.elem, mat_in=state.mat, mat_out=ws.mat)
+    dt_erode = model.erode_dt_fraction * state.dt_first / model.alpha
+    if ws.plan is not None:  # fabric elements in blocks of 8 (kernels.shell_blocks)
+        with numba.parallel_chunksize(BLOCK_CHUNK):
+            n_failed, ws.n_eroded, ws.dt_min = internal_force_blocks(
+                ws.mesh, motion, state.dt, tables, ws.results, dt_erode, model.erode_inverted,
+                ws.plan, ws.scratch)
+    else:
+        with numba.parallel_chunksize(ELEMENT_CHUNK):
+            n_failed, ws.n_eroded, ws.dt_min = internal_force_for_shells(
+                ws.mesh, motion, state.dt, tables, ws.results, dt_erode, model.erode_inverted)
     if n_failed:
         bad = np.flatnonzero(ws.status)
         e = int(bad[0])

@@ -675,12 +675,37 @@ def yarn_resultant(p, m, use_table, lam_w, lam_f, sin_t, d_w, d_f, t_w, t_f, l_w
         den_w = 2.0 * ell_f * sin_t
         den_f = 2.0 * ell_w * sin_t
         scale = 1.0
+    stiff, k_w, k_f = family_stiffness(scale, yarn_w, yarn_f, t_w, t_f, den_w, den_f, l_w,
+                                       l_f, lt0_w, lt0_f, lam_w, lam_f, sin_t)
+    return c_w, c_f, stiff, k_w, k_f
+
+
+@inline_kernel
+def family_stiffness(scale, yarn_w, yarn_f, t_w, t_f, den_w, den_f, l_w, l_f, lt0_w, lt0_f,
+                     lam_w, lam_f, sin_t):
+    """:func:`yarn_resultant`'s stiffnesses from each family's yarn term and its
+    denominator: the membrane tangent bound and k_w, k_f per reference width and length
+    (a family slack by more than SLACK_MARGIN keeps its tension term alone)."""
     stiff = scale * max((yarn_w + t_w) / den_w, (yarn_f + t_f) / den_f)
     taut_w = 1.0 if l_w >= (1.0 - SLACK_MARGIN) * lt0_w else 0.0
     taut_f = 1.0 if l_f >= (1.0 - SLACK_MARGIN) * lt0_f else 0.0
     k_w = scale * (taut_w * yarn_w + t_w) / den_w * (lam_f * sin_t / lam_w)
     k_f = scale * (taut_f * yarn_f + t_f) / den_f * (lam_w * sin_t / lam_f)
-    return c_w, c_f, stiff, k_w, k_f
+    return stiff, k_w, k_f
+
+
+@inline_kernel
+def shear_resultant(n_xx, n_yy, n_xy, thick, tau, lam_w, lam_f, ewx, ewy, efx, efy, cos_t,
+                    sin_t):
+    """Step 4b's resultant: the trellis shear stress τ added to the yarns' N through its
+    work conjugate (theory §1.6), c_s = t τ / (J sin θ), J = λ_w λ_f sin θ. Returns
+    (N_xx, N_yy, N_xy, c_s)."""
+    jac = lam_w * lam_f * sin_t
+    cs = thick * tau / (jac * sin_t)
+    n_xx += cs * (2.0 * ewx * efx - cos_t * (ewx * ewx + efx * efx))
+    n_yy += cs * (2.0 * ewy * efy - cos_t * (ewy * ewy + efy * efy))
+    n_xy += cs * (ewx * efy + ewy * efx - cos_t * (ewx * ewy + efx * efy))
+    return n_xx, n_yy, n_xy, cs
 
 
 @inline_kernel
@@ -805,11 +830,8 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
     tau, g_tan, e_shear = trellis_shear(p, m, s_in, i, gamma, dgamma, h_w, h_f, lam_w, lam_f)
     s_out[i, S_TAU] = tau
     s_out[i, S_SHEAR_ENERGY] = e_shear
-    jac = lam_w * lam_f * sin_t
-    cs = thick * tau / (jac * sin_t)
-    n_xx += cs * (2.0 * ewx * efx - cos_t * (ewx * ewx + efx * efx))
-    n_yy += cs * (2.0 * ewy * efy - cos_t * (ewy * ewy + efy * efy))
-    n_xy += cs * (ewx * efy + ewy * efx - cos_t * (ewx * ewy + efx * efy))
+    n_xx, n_yy, n_xy, cs = shear_resultant(n_xx, n_yy, n_xy, thick, tau, lam_w, lam_f, ewx,
+                                           ewy, efx, efy, cos_t, sin_t)
     # the stable step's isotropic part (theory §1.8): the shear tangent and the shear
     # resultant's own (geometric) stiffness |N_s| = t|τ|/(J sinθ), counted twice — a
     # shear strain takes both in-plane gradients, Σ_I |∇N_I|² = 2/L² on a square where a

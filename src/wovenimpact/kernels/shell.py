@@ -617,27 +617,40 @@ def corner_forces(e, blocks, frame, mf_x, mf_y, fzs, gam, hg0, hg1, hg2, hg3, hg
     resisting forces), from the local ones: membrane (mf), warp (fzs), transverse shear
     (A b·Q), bending (A b·M with the shear's ¼A Q moment) and hourglass (γ_I Q_hg).
     Returns Σ_I f_x (a finiteness probe)."""
-    e1x, e1y, e1z = frame[0]
-    e2x, e2y, e2z = frame[1]
-    e3x, e3y, e3z = frame[2]
     area = frame[4]
     b1, b2 = frame[5]
     fsum = 0.0
     for i in range(4):
-        fx = mf_x[i] + gam[i] * hg0
-        fy = mf_y[i] + gam[i] * hg1
-        fz = area * (b1[i] * qx + b2[i] * qy) + gam[i] * hg2 + fzs[i]
-        mx = area * (-b2[i] * myy - b1[i] * mxy - 0.25 * qy) + gam[i] * hg3
-        my = area * (b1[i] * mxx + b2[i] * mxy + 0.25 * qx) + gam[i] * hg4
-        gx = fx * e1x + fy * e2x + fz * e3x
+        gx, gy, gz, mx, my, mz = corner_global(
+            frame, area, b1[i], b2[i], mf_x[i], mf_y[i], gam[i], fzs[i], hg0, hg1, hg2, hg3,
+            hg4, mxx, myy, mxy, qx, qy)
         blocks[e, i, 0] = gx
-        blocks[e, i, 1] = fx * e1y + fy * e2y + fz * e3y
-        blocks[e, i, 2] = fx * e1z + fy * e2z + fz * e3z
-        blocks[e, i, 3] = mx * e1x + my * e2x
-        blocks[e, i, 4] = mx * e1y + my * e2y
-        blocks[e, i, 5] = mx * e1z + my * e2z
+        blocks[e, i, 1] = gy
+        blocks[e, i, 2] = gz
+        blocks[e, i, 3] = mx
+        blocks[e, i, 4] = my
+        blocks[e, i, 5] = mz
         fsum += gx
     return fsum
+
+
+@inline_kernel
+def corner_global(frame, area, b1i, b2i, mfx, mfy, gam, fzs, hg0, hg1, hg2, hg3, hg4, mxx, myy,
+                  mxy, qx, qy):
+    """One corner's force and moment in global axes (:func:`corner_forces`' terms, and
+    the element stage in blocks'): membrane, warp, transverse shear, bending and
+    hourglass in the local frame, turned to global axes."""
+    e1x, e1y, e1z = frame[0]
+    e2x, e2y, e2z = frame[1]
+    e3x, e3y, e3z = frame[2]
+    fx = mfx + gam * hg0
+    fy = mfy + gam * hg1
+    fz = area * (b1i * qx + b2i * qy) + gam * hg2 + fzs
+    mx = area * (-b2i * myy - b1i * mxy - 0.25 * qy) + gam * hg3
+    my = area * (b1i * mxx + b2i * mxy + 0.25 * qx) + gam * hg4
+    return (fx * e1x + fy * e2x + fz * e3x, fx * e1y + fy * e2y + fz * e3y,
+            fx * e1z + fy * e2z + fz * e3z, mx * e1x + my * e2x, mx * e1y + my * e2y,
+            mx * e1z + my * e2z)
 
 
 @inline_kernel
@@ -933,6 +946,16 @@ def finish_element(e, st, er, dt_check, el_out, blocks, status, eroded_now, aliv
     return (0 if st == EL_OK else 1), er, min(el_out[e, E_DT], el_out[e, E_DT_KIN])
 
 
+@kernel
+def scalar_element(e, mesh, motion, dt, tables, point_blocks, blocks, status, eroded_now,
+                   alive, dt_erode, erode_inverted):
+    """``shell_force`` of element e, then :func:`finish_element`; returns the latter's
+    (failed, eroded, own step)."""
+    st, er, dt_check = shell_force(e, mesh, motion, dt, tables, point_blocks, blocks)
+    return finish_element(e, st, er, dt_check, tables.el_out, blocks, status, eroded_now,
+                          alive, dt_erode, erode_inverted)
+
+
 @loop_kernel
 def internal_force_for_shells(mesh, motion, dt, tables, results, dt_erode, erode_inverted):
     """``shell_force`` for every element (prange; each element writes its own rows).
@@ -985,10 +1008,9 @@ def internal_force_for_shells(mesh, motion, dt, tables, results, dt_erode, erode
         point_blocks = 1
     rows = ElementTables(tables.el_in, el_out, rows_in, rows_out)
     for e in prange(ne):
-        st, er, dt_check = shell_force(np.uint64(e), mesh, motion, dt, rows, point_blocks,
-                                       blocks)
-        failed, er, dt_own = finish_element(e, st, er, dt_check, el_out, blocks, status,
-                                            eroded_now, alive, dt_erode, erode_inverted)
+        failed, er, dt_own = scalar_element(np.uint64(e), mesh, motion, dt, rows, point_blocks,
+                                            blocks, status, eroded_now, alive, dt_erode,
+                                            erode_inverted)
         dt_min = min(dt_min, dt_own)
         n_failed += failed
         n_eroded += er

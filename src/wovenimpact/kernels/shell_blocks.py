@@ -44,10 +44,11 @@ from numba import get_thread_id, prange
 
 from wovenimpact.jit import block_kernel, inline_kernel, loop_kernel
 from wovenimpact.kernels import fabric_layout as FL
-from wovenimpact.kernels.fabric import SLACK_MARGIN, shear_modulus_true
+from wovenimpact.kernels.fabric import family_stiffness, shear_modulus_true, shear_resultant
 from wovenimpact.kernels.fabric_table import hermite_basis, hermite_terms, knot_interval
 from wovenimpact.kernels.shell import (
     centre_gradient,
+    corner_global,
     corotational_frame,
     element_stable_step,
     family_stable_step,
@@ -58,7 +59,7 @@ from wovenimpact.kernels.shell import (
     kinematic_step,
     midpoint_frame,
     midpoint_rates,
-    shell_force,
+    scalar_element,
     through_thickness_f,
     warp_forces,
 )
@@ -327,11 +328,8 @@ def crossover_points(tid, kin, coef, geo, res, mc):
         den_w = 2.0 * ell_f * sin_t
         den_f = 2.0 * ell_w * sin_t
         scale = 1.0
-        stiff = scale * max((yarn_w + t_w) / den_w, (yarn_f + t_f) / den_f)
-        taut_w = 1.0 if l_w >= (1.0 - SLACK_MARGIN) * lt0_w else 0.0
-        taut_f = 1.0 if l_f >= (1.0 - SLACK_MARGIN) * lt0_f else 0.0
-        k_w = scale * (taut_w * yarn_w + t_w) / den_w * (lam_f * sin_t / lam_w)
-        k_f = scale * (taut_f * yarn_f + t_f) / den_f * (lam_w * sin_t / lam_f)
+        stiff, k_w, k_f = family_stiffness(scale, yarn_w, yarn_f, t_w, t_f, den_w, den_f, l_w,
+                                           l_f, lt0_w, lt0_f, lam_w, lam_f, sin_t)
         n_xx = c_w * ewx * ewx + c_f * efx * efx
         n_yy = c_w * ewy * ewy + c_f * efy * efy
         n_xy = c_w * ewx * ewy + c_f * efx * efy
@@ -339,11 +337,8 @@ def crossover_points(tid, kin, coef, geo, res, mc):
         gs, g_tan, e_dens = shear_modulus_true(abs(gamma), g1, g2, gam1, gam2)
         tau = gs * gamma
         e_shear = thick * e_dens
-        jac = lam_w * lam_f * sin_t
-        cs = thick * tau / (jac * sin_t)
-        n_xx += cs * (2.0 * ewx * efx - cos_t * (ewx * ewx + efx * efx))
-        n_yy += cs * (2.0 * ewy * efy - cos_t * (ewy * ewy + efy * efy))
-        n_xy += cs * (ewx * efy + ewy * efx - cos_t * (ewx * ewy + efx * efy))
+        n_xx, n_yy, n_xy, cs = shear_resultant(n_xx, n_yy, n_xy, thick, tau, lam_w, lam_f, ewx,
+                                               ewy, efx, efy, cos_t, sin_t)
         k_shear = 2.0 * (thick * g_tan + abs(cs))
         stiff += thick * g_tan
         # 5. fabric.stored_energy, the table's
@@ -375,23 +370,6 @@ def material_lanes(p, m):
             p[m, FL.P_E + 1] * p[m, FL.P_AREA + 1], p[m, FL.P_TU], p[m, FL.P_TU + 1],
             p[m, FL.P_G1], p[m, FL.P_G2], p[m, FL.P_GAMMA1], p[m, FL.P_GAMMA2],
             p[m, FL.P_ERODE_INTACT])
-
-
-@inline_kernel
-def corner_global(frame, area, b1i, b2i, mfx, mfy, gam, fzs, hg0, hg1, hg2, hg3, hg4, mxx, myy,
-                  mxy, qx, qy):
-    """One corner's force and moment in global axes (``shell.corner_forces``' terms)."""
-    e1x, e1y, e1z = frame[0]
-    e2x, e2y, e2z = frame[1]
-    e3x, e3y, e3z = frame[2]
-    fx = mfx + gam * hg0
-    fy = mfy + gam * hg1
-    fz = area * (b1i * qx + b2i * qy) + gam * hg2 + fzs
-    mx = area * (-b2i * myy - b1i * mxy - 0.25 * qy) + gam * hg3
-    my = area * (b1i * mxx + b2i * mxy + 0.25 * qx) + gam * hg4
-    return (fx * e1x + fy * e2x + fz * e3x, fx * e1y + fy * e2y + fz * e3y,
-            fx * e1z + fy * e2z + fz * e3z, mx * e1x + my * e2x, mx * e1y + my * e2y,
-            mx * e1z + my * e2z)
 
 
 @inline_kernel
@@ -735,18 +713,16 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
             k = bi * LANES + ll
             if pending[k] == 0:
                 continue
-            e = _U(elems[k])
-            st, er, dt_check = shell_force(e, mesh, motion, dt, rows, point_blocks, blocks)
-            failed, er, dt_own = finish_element(e, st, er, dt_check, el_out, blocks, status,
-                                                eroded_now, alive, dt_erode, erode_inverted)
+            failed, er, dt_own = scalar_element(_U(elems[k]), mesh, motion, dt, rows,
+                                                point_blocks, blocks, status, eroded_now,
+                                                alive, dt_erode, erode_inverted)
             dt_min = min(dt_min, dt_own)
             n_failed += failed
             n_eroded += er
     for k in prange(others.shape[0]):
-        e = _U(others[k])
-        st, er, dt_check = shell_force(e, mesh, motion, dt, rows, point_blocks, blocks)
-        failed, er, dt_own = finish_element(e, st, er, dt_check, el_out, blocks, status,
-                                            eroded_now, alive, dt_erode, erode_inverted)
+        failed, er, dt_own = scalar_element(_U(others[k]), mesh, motion, dt, rows,
+                                            point_blocks, blocks, status, eroded_now, alive,
+                                            dt_erode, erode_inverted)
         dt_min = min(dt_min, dt_own)
         n_failed += failed
         n_eroded += er

@@ -99,10 +99,12 @@ def block_scratch(plan: BlockPlan) -> BlockScratch:
     t = max(numba.config.NUMBA_NUM_THREADS, numba.get_num_threads(), os.cpu_count() or 1)
 
     def rows(values: int) -> np.ndarray:
-        return np.zeros((t, values * LANES))
+        # each thread's row padded by 16 doubles (two cache lines): threads writing
+        # neighbouring rows would otherwise share a line
+        return np.zeros((t, values * LANES + 16))
 
     return BlockScratch(
         corners=rows(SB.N_CORNER), old=rows(SB.N_OLD), kin=rows(4 * SB.N_KIN),
-        coef=rows(4 * SB.N_COEF), geo=rows(4 * SB.N_GEO), flag=np.zeros((t, LANES)),
+        coef=rows(4 * SB.N_COEF), geo=rows(4 * SB.N_GEO), flag=rows(1),
         res=rows(4 * SB.N_RES), out_el=rows(SB.N_OUT_EL), out_blk=rows(SB.N_BLK),
         pending=np.zeros(plan.elems.size, dtype=np.int8))

@@ -1,0 +1,59 @@
+"""The element stage with and without the blocks (kernels.shell_blocks) on a case's state.
+
+A diagnostic (not a test): compiles CASE, steps it to T (seconds), then prints how many
+lanes the block stage left to ``shell_force`` in the last step, how many crossover
+points were solved exactly, and ns per element of ``shell_forces`` (best of 20) with the
+blocks and without (docs/theory.md §4.6, "The element stage in blocks").
+
+Usage: ``python benchmarks/bench_block_stage.py CASE T THREADS``, e.g.
+``python benchmarks/bench_block_stage.py examples/plate_impact/plies4_120.toml 1e-4 1``.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+
+from wovenimpact.jit import configure_threading, set_threads
+from wovenimpact.kernels import fabric_layout as FL
+from wovenimpact.model.compile import compile_case
+from wovenimpact.solver.explicit import Workspace, shell_forces, step
+from wovenimpact.spec.case import load_case
+
+
+def best_seconds(f, repeats: int = 20) -> float:
+    t = float("inf")
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        f()
+        t = min(t, time.perf_counter() - t0)
+    return t
+
+
+def main(argv: list[str]) -> None:
+    case, t_end, threads = argv[0], float(argv[1]), int(argv[2])
+    configure_threading()
+    set_threads(threads)
+    spec, base = load_case(case, [])
+    compiled = compile_case(spec, base)
+    model, state = compiled.model, compiled.state
+    ws = Workspace.for_model(model, state)
+    if ws.plan is None:
+        print("no element of this case goes into blocks (or WOVENIMPACT_BLOCKS=0)")
+        return
+    while state.t < t_end:
+        step(model, state, ws)
+    rows = state.mat.reshape(-1, model.point_width)
+    print(f"t = {state.t:.3e} s: {int(ws.scratch.pending.sum())} of {ws.plan.elems.size} block "
+          f"lanes left to shell_force; {int((rows[:, FL.S_ITER] > 0).sum())} of {rows.shape[0]} "
+          "points solved exactly")
+    with_blocks = best_seconds(lambda: shell_forces(model, state, ws))
+    ws.plan = None
+    without = best_seconds(lambda: shell_forces(model, state, ws))
+    n = model.n_elems
+    print(f"element stage, {threads} thread(s): blocks {with_blocks / n * 1e9:.0f} ns, "
+          f"shell_force {without / n * 1e9:.0f} ns per element ({without / with_blocks:.2f}x)")
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

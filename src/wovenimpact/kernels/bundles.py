@@ -128,6 +128,7 @@ class BlockScratch(NamedTuple):
     coef: np.ndarray  # each point's table cell
     geo: np.ndarray
     flag: np.ndarray  # > 0: the lane goes to shell_force
+    exact: np.ndarray  # 1.0: the point is solved by fabric_point (outside the table's cells)
     res: np.ndarray  # each point's crossover results
     out_el: np.ndarray  # the element state and the isotropic step
     out_blk: np.ndarray  # corner forces

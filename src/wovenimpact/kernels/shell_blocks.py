@@ -44,7 +44,12 @@ from numba import get_thread_id, prange
 
 from wovenimpact.jit import block_kernel, inline_kernel, loop_kernel
 from wovenimpact.kernels import fabric_layout as FL
-from wovenimpact.kernels.fabric import family_stiffness, shear_modulus_true, shear_resultant
+from wovenimpact.kernels.fabric import (
+    fabric_point,
+    family_stiffness,
+    shear_modulus_true,
+    shear_resultant,
+)
 from wovenimpact.kernels.fabric_table import hermite_basis, hermite_terms, knot_interval
 from wovenimpact.kernels.shell import (
     centre_gradient,
@@ -217,10 +222,11 @@ def kinematics_lanes(tid, bu, cn, old, gg, rg, dt, kin, flag):
 
 
 @block_kernel
-def table_lookup(p, m, tid, kin, coef, geo, flag):
+def table_lookup(p, m, tid, kin, coef, geo, exact):
     """Stage 3 (scalar): each point's knot cell (``fabric_table.crossover_from_table``'s
     look-up) and its four corners' coefficients into coef, the cell into geo; a point
-    outside the knots or in an exactly-solved cell flags its lane."""
+    outside the knots or in an exactly-solved cell is marked in exact (1.0; the gather
+    marked those with a yarn damaged), for the scalar crossover (:func:`exact_points`)."""
     nw = int(p[m, FL.P_TAB_NW])
     nf = int(p[m, FL.P_TAB_NF])
     nbw = int(p[m, FL.P_TAB_NBW])
@@ -229,18 +235,17 @@ def table_lookup(p, m, tid, kin, coef, geo, flag):
     stride = _U(FL.TAB_STRIDE)
     for qi in range(POINTS):
         q = _U(qi)
-        lu = _U(qi % LANES)
         i = knot_interval(p, m, kw, nw, kf + _U(nf), nbw, p[m, FL.P_TAB_IBW],
                           kin[tid, atq(Q_LAM, q)])
         j = knot_interval(p, m, kf, nf, kf + _U(nf + nbw), int(p[m, FL.P_TAB_NBF]),
                           p[m, FL.P_TAB_IBF], kin[tid, atq(Q_LAM + 1, q)])
-        if i < 0 or j < 0:
-            flag[tid, lu] = 1.0
+        outside = i < 0 or j < 0
+        if outside:
             i = 0
             j = 0
         u00 = _U(int(p[m, FL.P_TAB_DATA]) + FL.TAB_STRIDE * (i * nf + j))
-        if p[m, u00 + _U(FL.T_EXACT)] != 0.0:
-            flag[tid, lu] = 1.0
+        if outside or p[m, u00 + _U(FL.T_EXACT)] != 0.0:
+            exact[tid, q] = 1.0
         geo[tid, atq(0, q)] = p[m, kw + _U(i)]
         geo[tid, atq(1, q)] = p[m, kw + _U(i + 1)] - p[m, kw + _U(i)]
         geo[tid, atq(2, q)] = p[m, kf + _U(j)]
@@ -360,6 +365,41 @@ def crossover_points(tid, kin, coef, geo, res, mc):
         res[tid, atq(R_T_F, q)] = t_f
         res[tid, atq(R_TAU, q)] = tau
         res[tid, atq(R_E_SHEAR, q)] = e_shear
+
+
+@block_kernel
+def exact_points(p, m, tid, b, elems, point_blocks, el_in, rows_in, rows_out, kin, exact, flag,
+                 res):
+    """Stage 4′ (scalar): the points marked in exact (a yarn damaged, outside the table or
+    in an exactly-solved cell) by ``fabric.fabric_point`` itself, as ``section_response``
+    calls it — its row of rows_out written, its results into res in place of the
+    vector stage's (lanes already flagged are left alone). A point whose yarns then both broke, or that failed, marks its lane
+    bad (R_BAD): the element goes to ``shell_force``, which writes the row again."""
+    for qi in range(POINTS):
+        q = _U(qi)
+        # (not in a lane already flagged: shell_force may not write an eroded element's
+        # rows again, and would keep these)
+        if exact[tid, q] == 0.0 or flag[tid, _U(qi % LANES)] != 0.0:
+            continue
+        g = qi // LANES
+        e = _U(elems[b * _U(LANES) + _U(qi % LANES)])
+        col = E_FG + 4 * g
+        o11, o12, o21, o22 = through_thickness_f(
+            0.0, el_in[e, E_KAPPA], el_in[e, E_KAPPA + 1], el_in[e, E_KAPPA + 2],
+            el_in[e, col], el_in[e, col + 1], el_in[e, col + 2], el_in[e, col + 3])
+        row = e * _U(point_blocks) + _U(g)
+        st, stiff, n_xx, n_yy, n_xy, k_shear, k_w, k_f = fabric_point(
+            p, m, o11, o12, o21, o22, kin[tid, atq(0, q)], kin[tid, atq(1, q)],
+            kin[tid, atq(2, q)], kin[tid, atq(3, q)], rows_in, rows_out, row)
+        res[tid, atq(R_BAD, q)] = 0.0 if st == 0 and rows_out[row, FL.S_ALIVE] != 0.0 else 1.0
+        res[tid, atq(R_STIFF, q)] = stiff
+        res[tid, atq(R_NXX, q)] = n_xx
+        res[tid, atq(R_NYY, q)] = n_yy
+        res[tid, atq(R_NXY, q)] = n_xy
+        res[tid, atq(R_KSHEAR, q)] = k_shear
+        res[tid, atq(R_KW, q)] = k_w
+        res[tid, atq(R_KF, q)] = k_f
+        res[tid, atq(R_ENERGY, q)] = rows_out[row, FL.S_ENERGY]
 
 
 @block_kernel
@@ -589,6 +629,7 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
     coef = scratch.coef
     geo = scratch.geo
     flag = scratch.flag
+    exact = scratch.exact
     res = scratch.res
     out_el = scratch.out_el
     out_blk = scratch.out_blk
@@ -642,18 +683,23 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
             old[tid, at(V_U_HG, lu)] = el_in[e, E_U_HG]
             # (counted in floats: a bool assigned in a parallel loop's body counts as an
             # alias for Numba, which then gives the body's arrays no ``noalias``)
+            # an eroded element or point: the lane goes to shell_force; a point with a
+            # yarn damaged: to fabric_point (its exact solve), the rest of the lane stays
             worn = 0.0 if el_in[e, E_ALIVE] != 0.0 else 1.0
             row0 = e * _U(point_blocks)
             for g in range(4):
                 r = row0 + _U(g)
                 worn += 0.0 if rows_in[r, FL.S_ALIVE] != 0.0 else 1.0
-                worn += 0.0 if rows_in[r, FL.S_DAMAGE] == 0.0 else 1.0
-                worn += 0.0 if rows_in[r, FL.S_DAMAGE + 1] == 0.0 else 1.0
+                exact[tid, _U(g * LANES) + lu] = (
+                    (0.0 if rows_in[r, FL.S_DAMAGE] == 0.0 else 1.0)
+                    + (0.0 if rows_in[r, FL.S_DAMAGE + 1] == 0.0 else 1.0))
             flag[tid, lu] = worn
         # 2.–5.
         kinematics_lanes(tid, b, cn, old, gg, rg, dt, kin, flag)
-        table_lookup(mat_params, m, tid, kin, coef, geo, flag)
+        table_lookup(mat_params, m, tid, kin, coef, geo, exact)
         crossover_points(tid, kin, coef, geo, res, material_lanes(mat_params, m))
+        exact_points(mat_params, m, tid, b, elems, point_blocks, el_in, rows_in, rows_out, kin,
+                     exact, flag, res)
         element_lanes(tid, b, cn, old, res, flag, gg, gw, rg, a0s, inert, out_el, out_blk, dt,
                       thick, sections[sec, C_AREAL_MASS], sections[sec, C_BEND_E],
                       sections[sec, C_BEND_NU],
@@ -677,9 +723,13 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
             row0 = e * _U(point_blocks)
             for g in range(4):
                 r = row0 + _U(g)
+                q = _U(g * LANES) + lu
+                if exact[tid, q] != 0.0:  # fabric_point wrote its state columns
+                    for j in range(FL.N_STATE, pw):
+                        rows_out[r, j] = rows_in[r, j]
+                    continue
                 for j in range(pw):
                     rows_out[r, j] = rows_in[r, j]
-                q = _U(g * LANES) + lu
                 rows_out[r, FL.S_LAMBDA] = res[tid, atq(R_LAM_W, q)]
                 rows_out[r, FL.S_LAMBDA + 1] = res[tid, atq(R_LAM_F, q)]
                 rows_out[r, FL.S_GAMMA] = res[tid, atq(R_GAMMA, q)]

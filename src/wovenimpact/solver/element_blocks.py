@@ -105,6 +105,6 @@ def block_scratch(plan: BlockPlan) -> BlockScratch:
 
     return BlockScratch(
         corners=rows(SB.N_CORNER), old=rows(SB.N_OLD), kin=rows(4 * SB.N_KIN),
-        coef=rows(4 * SB.N_COEF), geo=rows(4 * SB.N_GEO), flag=rows(1),
+        coef=rows(4 * SB.N_COEF), geo=rows(4 * SB.N_GEO), flag=rows(1), exact=rows(4),
         res=rows(4 * SB.N_RES), out_el=rows(SB.N_OUT_EL), out_blk=rows(SB.N_BLK),
         pending=np.zeros(plan.elems.size, dtype=np.int8))

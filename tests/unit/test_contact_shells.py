@@ -691,7 +691,10 @@ def test_incremental_updates_keep_every_pair_that_can_act(seed, fast, speed):
     zero = np.zeros(model.n_nodes)
     h_seg = 0.5 * t * np.ones(model.n_elems)
     m = model.node_mass[:, None]
-    for _ in range(80):  # 80 Δt: 0.32–2.4 mm, past the 0.125 mm skin of a node at rest
+    left = False  # whether a node was beyond its skin at a call after the first search
+    for k in range(80):  # 80 Δt: 0.32–2.4 mm, past the 0.125 mm skin of a node at rest
+        if k > 0:
+            left |= bool(np.any(np.linalg.norm(x - reuse.x_search, axis=1) > reuse.sigma))
         fa, ea, na = contact_forces(reuse, model, x, v=v)
         fb, eb, nb = contact_forces(fresh, model, x, v=v)
         assert fa.tobytes() == fb.tobytes() and ea == eb and na == nb
@@ -701,7 +704,9 @@ def test_incremental_updates_keep_every_pair_that_can_act(seed, fast, speed):
         assert can_act <= listed_pairs(reuse)
         v[movers] += DT * fa[movers] / m[movers]
         x += DT * v
-    assert reuse.updates > 0
+    # a mover the contact stops within its skin (seed 1, one mover at 40 m/s) leaves
+    # nothing to update; one that leaves its skin must have been updated around
+    assert reuse.updates > 0 or not left
     assert reuse.searches < 0.5 * (reuse.searches + reuse.updates) + 1
 
 

@@ -18,7 +18,6 @@ import pytest
 
 from wovenimpact.benchmark import REFERENCE_FABRIC, REFERENCE_METAL
 from wovenimpact.kernels import fabric_layout as FL
-from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.kernels.vecmath import atan2_upper, sqrt as vsqrt
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.model.mesh import plate_mesh

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import math
 
-from llvmlite import ir
 from numba import types
 from numba.extending import intrinsic
 

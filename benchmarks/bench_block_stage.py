@@ -30,8 +30,9 @@ def best_seconds(f, repeats: int = 20) -> float:
     return t
 
 
-def main(argv: list[str]) -> None:
-    case, t_end, threads = argv[0], float(argv[1]), int(argv[2])
+def case_state(case: str, t_end: float, threads: int):
+    """CASE compiled and stepped to t_end on ``threads`` threads: (model, state, workspace),
+    or None when no element of the case goes into blocks."""
     configure_threading()
     set_threads(threads)
     spec, base = load_case(case, [])
@@ -40,9 +41,18 @@ def main(argv: list[str]) -> None:
     ws = Workspace.for_model(model, state)
     if ws.plan is None:
         print("no element of this case goes into blocks (or WOVENIMPACT_BLOCKS=0)")
-        return
+        return None
     while state.t < t_end:
         step(model, state, ws)
+    return model, state, ws
+
+
+def main(argv: list[str]) -> None:
+    case, t_end, threads = argv[0], float(argv[1]), int(argv[2])
+    found = case_state(case, t_end, threads)
+    if found is None:
+        return
+    model, state, ws = found
     rows = state.mat.reshape(-1, model.point_width)
     print(f"t = {state.t:.3e} s: {int(ws.scratch.pending.sum())} of {ws.plan.elems.size} block "
           f"lanes left to shell_force; {int((rows[:, FL.S_ITER] > 0).sum())} of {rows.shape[0]} "

@@ -15,17 +15,17 @@ from __future__ import annotations
 
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 from numba import get_thread_id, njit, prange
 
-from wovenimpact.jit import configure_threading, set_threads
 from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels import shell_blocks as SB
 from wovenimpact.kernels import shell_layout as SL
-from wovenimpact.model.compile import compile_case
-from wovenimpact.solver.explicit import Workspace, step
-from wovenimpact.spec.case import load_case
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from bench_block_stage import case_state  # noqa: E402
 
 _U = np.uint64
 STAGES = ("gather", "kinematics", "look-up", "crossover points", "marked points", "element",
@@ -115,17 +115,10 @@ def stages(upto, quads, sections, mat_params, step_yarn, x, v, omega, el_in, el_
 
 def main(argv: list[str]) -> None:
     case, t_end, threads = argv[0], float(argv[1]), int(argv[2])
-    configure_threading()
-    set_threads(threads)
-    spec, base = load_case(case, [])
-    compiled = compile_case(spec, base)
-    model, state = compiled.model, compiled.state
-    ws = Workspace.for_model(model, state)
-    if ws.plan is None:
-        print("no element of this case goes into blocks (or WOVENIMPACT_BLOCKS=0)")
+    found = case_state(case, t_end, threads)
+    if found is None:
         return
-    while state.t < t_end:
-        step(model, state, ws)
+    model, state, ws = found
     p, s, mesh = ws.plan, ws.scratch, ws.mesh
     width = state.mat.shape[1]
     point_blocks = width // mesh.point_width

@@ -657,12 +657,8 @@ def yarn_resultant(p, m, use_table, lam_w, lam_f, sin_t, d_w, d_f, t_w, t_f, l_w
         den_f = p[m, P_AREA + 1]
         scale = 0.5 * thick
     elif use_table:  # virial from the table: c_i = λ_i ∂W/∂λ_i / J, J = λ_w λ_f sinθ
-        c_w = gw_cross / (lam_f * sin_t)
-        c_f = gf_cross / (lam_w * sin_t)
-        yarn_w = ea_w * ell_w / lt0_w
-        yarn_f = ea_f * ell_f / lt0_f
-        den_w = 2.0 * ell_f * sin_t
-        den_f = 2.0 * ell_w * sin_t
+        c_w, c_f, yarn_w, yarn_f, den_w, den_f = table_virial(
+            gw_cross, gf_cross, lam_w, lam_f, sin_t, ell_w, ell_f, ea_w, ea_f, lt0_w, lt0_f)
         scale = 1.0
     else:  # virial: N = Σ 2 T_i ℓ_i cosψ_i e_i⊗e_i / A_cell
         a_cell = 4.0 * ell_w * ell_f * sin_t
@@ -678,6 +674,21 @@ def yarn_resultant(p, m, use_table, lam_w, lam_f, sin_t, d_w, d_f, t_w, t_f, l_w
     stiff, k_w, k_f = family_stiffness(scale, yarn_w, yarn_f, t_w, t_f, den_w, den_f, l_w,
                                        l_f, lt0_w, lt0_f, lam_w, lam_f, sin_t)
     return c_w, c_f, stiff, k_w, k_f
+
+
+@inline_kernel
+def table_virial(gw, gf, lam_w, lam_f, sin_t, ell_w, ell_f, ea_w, ea_f, lt0_w, lt0_f):
+    """:func:`yarn_resultant`'s table branch: the families' resultants c_i = λ_i ∂W/∂λ_i / J
+    from the table's gradient (∂W/∂λ_w, ∂W/∂λ_f), and their yarn stiffness terms and
+    denominators for :func:`family_stiffness`. Returns (c_w, c_f, yarn_w, yarn_f, den_w,
+    den_f)."""
+    c_w = gw / (lam_f * sin_t)
+    c_f = gf / (lam_w * sin_t)
+    yarn_w = ea_w * ell_w / lt0_w
+    yarn_f = ea_f * ell_f / lt0_f
+    den_w = 2.0 * ell_f * sin_t
+    den_f = 2.0 * ell_w * sin_t
+    return c_w, c_f, yarn_w, yarn_f, den_w, den_f
 
 
 @inline_kernel

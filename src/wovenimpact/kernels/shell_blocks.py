@@ -49,6 +49,7 @@ from wovenimpact.kernels.fabric import (
     family_stiffness,
     shear_modulus_true,
     shear_resultant,
+    table_virial,
 )
 from wovenimpact.kernels.fabric_table import hermite_basis, hermite_terms, knot_interval
 from wovenimpact.kernels.shell import (
@@ -271,6 +272,21 @@ def cell_corner(coef, tid, c, q, ax, bx, dax, dbx, ay, by, day, dby):
         ax, bx, dax, dbx, ay, by, day, dby)
 
 
+@inline_kernel
+def point_response_into(res, tid, q, bad, stiff, n_xx, n_yy, n_xy, k_shear, k_w, k_f, energy):
+    """Point q's response — what ``shell.point_response`` returns of ``fabric_point`` — into
+    res (R_BAD … R_ENERGY)."""
+    res[tid, atq(R_BAD, q)] = bad
+    res[tid, atq(R_STIFF, q)] = stiff
+    res[tid, atq(R_NXX, q)] = n_xx
+    res[tid, atq(R_NYY, q)] = n_yy
+    res[tid, atq(R_NXY, q)] = n_xy
+    res[tid, atq(R_KSHEAR, q)] = k_shear
+    res[tid, atq(R_KW, q)] = k_w
+    res[tid, atq(R_KF, q)] = k_f
+    res[tid, atq(R_ENERGY, q)] = energy
+
+
 @block_kernel
 def crossover_points(tid, kin, coef, geo, res, mc):
     """Stage 4: ``fabric.fabric_point`` on its default path (fibre frame, both yarns
@@ -326,12 +342,8 @@ def crossover_points(tid, kin, coef, geo, res, mc):
         bad = bad | (t_w >= tu_w) | (t_f >= tu_f) | (t_w / ea_w >= tu_w / ea_w) | (
             t_f / ea_f >= tu_f / ea_f) | ((intact > 0.0) & (lam_w * lam_f < intact))
         # 4a. fabric.yarn_resultant, the table's virial branch
-        c_w = gw_tab / (lam_f * sin_t)
-        c_f = gf_tab / (lam_w * sin_t)
-        yarn_w = ea_w * ell_w / lt0_w
-        yarn_f = ea_f * ell_f / lt0_f
-        den_w = 2.0 * ell_f * sin_t
-        den_f = 2.0 * ell_w * sin_t
+        c_w, c_f, yarn_w, yarn_f, den_w, den_f = table_virial(
+            gw_tab, gf_tab, lam_w, lam_f, sin_t, ell_w, ell_f, ea_w, ea_f, lt0_w, lt0_f)
         scale = 1.0
         stiff, k_w, k_f = family_stiffness(scale, yarn_w, yarn_f, t_w, t_f, den_w, den_f, l_w,
                                            l_f, lt0_w, lt0_f, lam_w, lam_f, sin_t)
@@ -347,15 +359,8 @@ def crossover_points(tid, kin, coef, geo, res, mc):
         k_shear = 2.0 * (thick * g_tan + abs(cs))
         stiff += thick * g_tan
         # 5. fabric.stored_energy, the table's
-        res[tid, atq(R_BAD, q)] = 1.0 if bad else 0.0
-        res[tid, atq(R_STIFF, q)] = stiff
-        res[tid, atq(R_NXX, q)] = n_xx
-        res[tid, atq(R_NYY, q)] = n_yy
-        res[tid, atq(R_NXY, q)] = n_xy
-        res[tid, atq(R_KSHEAR, q)] = k_shear
-        res[tid, atq(R_KW, q)] = k_w
-        res[tid, atq(R_KF, q)] = k_f
-        res[tid, atq(R_ENERGY, q)] = w_tab + e_shear
+        point_response_into(res, tid, q, 1.0 if bad else 0.0, stiff, n_xx, n_yy, n_xy, k_shear,
+                            k_w, k_f, w_tab + e_shear)
         res[tid, atq(R_LAM_W, q)] = lam_w
         res[tid, atq(R_LAM_F, q)] = lam_f
         res[tid, atq(R_GAMMA, q)] = gamma
@@ -391,15 +396,9 @@ def exact_points(p, m, tid, b, elems, point_blocks, el_in, rows_in, rows_out, ki
         st, stiff, n_xx, n_yy, n_xy, k_shear, k_w, k_f = fabric_point(
             p, m, o11, o12, o21, o22, kin[tid, atq(0, q)], kin[tid, atq(1, q)],
             kin[tid, atq(2, q)], kin[tid, atq(3, q)], rows_in, rows_out, row)
-        res[tid, atq(R_BAD, q)] = 0.0 if st == 0 and rows_out[row, FL.S_ALIVE] != 0.0 else 1.0
-        res[tid, atq(R_STIFF, q)] = stiff
-        res[tid, atq(R_NXX, q)] = n_xx
-        res[tid, atq(R_NYY, q)] = n_yy
-        res[tid, atq(R_NXY, q)] = n_xy
-        res[tid, atq(R_KSHEAR, q)] = k_shear
-        res[tid, atq(R_KW, q)] = k_w
-        res[tid, atq(R_KF, q)] = k_f
-        res[tid, atq(R_ENERGY, q)] = rows_out[row, FL.S_ENERGY]
+        point_response_into(
+            res, tid, q, 0.0 if st == 0 and rows_out[row, FL.S_ALIVE] != 0.0 else 1.0, stiff,
+            n_xx, n_yy, n_xy, k_shear, k_w, k_f, rows_out[row, FL.S_ENERGY])
 
 
 @block_kernel

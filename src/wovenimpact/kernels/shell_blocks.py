@@ -10,29 +10,37 @@ all lanes at once. Per block (one iteration of the parallel loop; every table be
 the thread's own scratch row):
 
 1. *gather* (scalar): the corners' x, v, ω and the element state the step reads; a lane
-   whose element is eroded, or has a point eroded or a yarn damaged, is flagged;
-2. *stretches* (vector): the corotational frame and F at the four Gauss points, the
-   yarn stretches λ_w, λ_f there;
-3. *look-up* (scalar): each point's knot cell in the crossover table
-   (``fabric_table.knot_interval``) and its 48 coefficients copied lane-major; a point
-   outside the table or in an exactly-solved cell flags its lane;
-4. *element* (vector): everything else of ``shell_force`` — frames and rates, the four
-   crossover points (Hermite W, ∇W and heights, tensions, resultant, trellis shear,
-   energy), the membrane's corner forces, bending and transverse shear, hourglass, the
-   stable steps. A lane flags itself where the scalar kernel would branch off the
-   default path: an inverted or degenerate element, a yarn reaching T_u (or its strain
-   ε_u), a sliver, a non-finite force;
-5. *scatter* (scalar): a lane's results into the solver's row tables, or, for a flagged
-   lane, ``shell_force`` itself (its inputs are the start-of-step tables, untouched).
+   whose element or one of whose points is eroded is flagged, a point with a yarn
+   damaged is marked for 4′;
+2. *kinematics* (vector, :func:`kinematics_lanes`): frames, rates, curvature, F at the
+   four Gauss points and the F the section's point sees, its yarn stretches; a
+   degenerate or inverted element flags its lane;
+3. *look-up* (scalar, :func:`table_lookup`): each point's knot cell in the crossover
+   table and its 48 coefficients, copied point-major; a point outside the table or in
+   an exactly-solved cell is marked for 4′;
+4. *crossover* (vector over the block's 32 points, :func:`crossover_points`):
+   ``fabric_point``'s default path — fibre frame, Hermite W, ∇W and heights, tensions,
+   resultant, trellis shear, energy; a yarn at T_u (or at its strain ε_u) or a sliver
+   marks the point bad;
+   4′. *marked points* (scalar, :func:`exact_points`): ``fabric_point`` itself, which
+   writes the point's row; a point that erodes or fails marks itself bad;
+5. *element* (vector, :func:`element_lanes`): the rest of ``shell_force`` — the
+   membrane's corner forces, bending and transverse shear, hourglass, corner forces,
+   both stable steps; a bad point or a non-finite force or step flags the lane;
+6. *scatter* (scalar): a lane's results into the solver's row tables. A flagged lane is
+   left to ``shell_force`` in a second loop (its inputs, the start-of-step tables, are
+   untouched), and the elements outside the blocks go through it in a third.
 
 The results are bitwise those of ``shell_force`` (tests/unit/test_shell_blocks.py), so a
 run does not depend on which elements went through the blocks, nor on the thread count.
-What LLVM needs to vectorise the two vector stages (found with
+What LLVM needs to vectorise the three vector stages (found with
 ``--pass-remarks-missed=loop-vectorize``; the prototypes in benchmarks/simd_*.py):
 lane-major scratch with unsigned affine indices (:func:`at`), no gathers inside the
 loop, no calls (``vecmath.atan2_upper``), selects instead of branches, and no alias
 checks — each stage is compiled with ``forceinline=True`` so that LLVM inlines it into
-the parallel loop's body, whose array arguments Numba marks ``noalias``.
+the parallel loop's body, whose array arguments Numba marks ``noalias`` as long as it
+finds no alias there (no bool assigned from another, no tuple of the same arrays:
+theory §4.6, item 6).
 """
 
 from __future__ import annotations

@@ -472,6 +472,16 @@ def tabulated_crossover(p, m, lam_w, lam_f, yc):
     inside, w_tab, gw_tab, gf_tab, hw_tab, hf_tab = crossover_from_table(p, m, lam_w, lam_f)
     if not inside:
         return False, 0.0, 0.0, 0.0, 0.0, 1.0, 1.0, 0.0, 0.0, 0.0
+    _, _, h_w, h_f, l_w, l_f, t_w, t_f = table_tensions(lam_w, lam_f, ell0_w, ell0_f, hw_tab,
+                                                        hf_tab, gw_tab, gf_tab)
+    return True, h_w, h_f, t_w, t_f, l_w, l_f, w_tab, gw_tab, gf_tab
+
+
+@inline_kernel
+def table_tensions(lam_w, lam_f, ell0_w, ell0_f, hw_tab, hf_tab, gw_tab, gf_tab):
+    """The table's heights (clipped at 0), truss lengths and tensions from ∂W/∂λ_i =
+    2 T_i cos ψ_i ℓ_i0 / A0 (:func:`tabulated_crossover`; the element stage in blocks
+    too). Returns (ℓ_w, ℓ_f, H_w, H_f, L_w, L_f, T_w, T_f)."""
     ell_w = lam_w * ell0_w
     ell_f = lam_f * ell0_f
     area0 = 4.0 * ell0_w * ell0_f
@@ -481,7 +491,7 @@ def tabulated_crossover(p, m, lam_w, lam_f, yc):
     l_f = math.sqrt(ell_f * ell_f + h_f * h_f)
     t_w = max(gw_tab * area0 * l_w / (2.0 * ell0_w * ell_w), 0.0)
     t_f = max(gf_tab * area0 * l_f / (2.0 * ell0_f * ell_f), 0.0)
-    return True, h_w, h_f, t_w, t_f, l_w, l_f, w_tab, gw_tab, gf_tab
+    return ell_w, ell_f, h_w, h_f, l_w, l_f, t_w, t_f
 
 
 @inline_kernel

@@ -57,6 +57,7 @@ from wovenimpact.kernels.fabric import (
     family_stiffness,
     shear_modulus_true,
     shear_resultant,
+    table_tensions,
     table_virial,
 )
 from wovenimpact.kernels.fabric_table import hermite_basis, hermite_terms, knot_interval
@@ -304,7 +305,6 @@ def crossover_points(tid, kin, coef, geo, res, mc):
     yarn at T_u or at ε_u, a sliver)."""
     (thick, ell0_w, ell0_f, lt0_w, lt0_f, ea_w, ea_f, tu_w, tu_f, g1, g2, gam1, gam2,
      intact) = mc
-    area0 = 4.0 * ell0_w * ell0_f
     for qi in range(POINTS):
         q = _U(qi)
         g11, g12 = kin[tid, atq(0, q)], kin[tid, atq(1, q)]
@@ -337,14 +337,8 @@ def crossover_points(tid, kin, coef, geo, res, mc):
         hw_tab = (hw0 + hw1) + (hw2 + hw3)
         hf_tab = (hf0 + hf1) + (hf2 + hf3)
         # fabric.tabulated_crossover
-        ell_w = lam_w * ell0_w
-        ell_f = lam_f * ell0_f
-        h_w = max(hw_tab, 0.0)
-        h_f = max(hf_tab, 0.0)
-        l_w = math.sqrt(ell_w * ell_w + h_w * h_w)
-        l_f = math.sqrt(ell_f * ell_f + h_f * h_f)
-        t_w = max(gw_tab * area0 * l_w / (2.0 * ell0_w * ell_w), 0.0)
-        t_f = max(gf_tab * area0 * l_f / (2.0 * ell0_f * ell_f), 0.0)
+        ell_w, ell_f, h_w, h_f, l_w, l_f, t_w, t_f = table_tensions(
+            lam_w, lam_f, ell0_w, ell0_f, hw_tab, hf_tab, gw_tab, gf_tab)
         # 3. failure (fabric.yarn_damage: instant at T_u, progressive from ε_u = T_u/EA)
         # and the intact sliver test (fabric.sliver_erodes): the scalar kernel's
         bad = bad | (t_w >= tu_w) | (t_f >= tu_f) | (t_w / ea_w >= tu_w / ea_w) | (

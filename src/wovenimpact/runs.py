@@ -59,6 +59,7 @@ from wovenimpact.quantities import (
 )
 from wovenimpact.containment import (
     CONTAINMENT_COLUMNS,
+    CasingWatch,
     casing_inner_radius,
     casing_outer_radius,
     casing_summary,
@@ -117,9 +118,12 @@ def history_columns(model) -> tuple[str, ...]:
             + (CONTAINMENT_COLUMNS if is_containment(model) else ()))
 
 
-def history_row(model, state: State, normaliser: float = 0.0) -> dict:
+def history_row(model, state: State, normaliser: float = 0.0,
+                watch: CasingWatch | None = None) -> dict:
     """One history.csv row of ``state`` (columns :func:`history_columns`); ``normaliser``
-    is the previous row's ``energy_normaliser_part_J`` (0 for the first row)."""
+    is the previous row's ``energy_normaliser_part_J`` (0 for the first row); ``watch``
+    the run's :class:`~wovenimpact.containment.CasingWatch` (containment models; made
+    for the row when not given)."""
     eb = energy_balance(model, state)
     scale = max(normaliser, eb["scale_J"])
     disp = np.sqrt(np.max(np.sum((state.x - model.x0) ** 2, axis=1)))
@@ -128,7 +132,7 @@ def history_row(model, state: State, normaliser: float = 0.0) -> dict:
         impact = {**impactor_row(model, state), **intact_material_ahead(model, state),
                   "impactor_kinetic_energy_part_J": eb["impactor_kinetic_J"]}
     if is_containment(model):
-        impact.update(fragment_row(model, state))
+        impact.update(fragment_row(model, state, watch))
     if has_metal(model):
         impact["plastic_work_part_J"] = plastic_work(model, state)
     if model.mass_scaling_fraction > 0.0:
@@ -257,6 +261,7 @@ def run_spec(
             "wall_time_s": 0.0, "restarted_from_step": None}
     run = spec.run
     ckpt_dir = out / "checkpoints"
+    casing_watch = CasingWatch(model) if is_containment(model) else None
     if restart:
         state, history, fields, wall_before = resume(out, model, digest, parts, run.end_time)
         meta["restarted_from_step"] = state.step
@@ -265,7 +270,7 @@ def run_spec(
         state, wall_before = compiled.state, 0.0
         history = History(history_columns(model))
         fields = FieldWriter(out / "fields", model)
-        history.append(history_row(model, state))
+        history.append(history_row(model, state, watch=casing_watch))
         fields.write(state)
     h_sched = Schedule(_interval(run.history_interval, run.end_time, DEFAULT_OUTPUTS["history"]), state.t)
     f_sched = Schedule(_interval(run.field_interval, run.end_time, DEFAULT_OUTPUTS["field"]), state.t)
@@ -295,7 +300,7 @@ def run_spec(
             raise
         taken += 1
         if h_sched.due(state.t) or state.t >= run.end_time:
-            row = history_row(model, state, normaliser)
+            row = history_row(model, state, normaliser, casing_watch)
             normaliser = row["energy_normaliser_part_J"]
             history.append(row)
             decided = watch(history) if watch else None

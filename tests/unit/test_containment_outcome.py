@@ -290,17 +290,26 @@ def coarse_two_ply_casing(sector: bool = False):
     return compiled.model, compiled.state
 
 
-def test_a_piece_of_ply_torn_free_ahead_of_the_fragment_does_not_hold_it():
+@pytest.mark.parametrize("one_watch", [False, True])
+def test_a_piece_of_ply_torn_free_ahead_of_the_fragment_does_not_hold_it(one_watch):
     """Only casing material joined to the supports through live elements counts as
     intact: a patch of the outer ply cut free (every element round it eroded) and lying
     beyond the fragment does not keep a run undecided, nor is it the layer's bulge; the
-    same patch still part of its ply does both."""
+    same patch still part of its ply does both. Each row computed afresh, and with one
+    CasingWatch for all of them, as a run does (its anchored mask must follow the
+    erosion between rows)."""
     import math
 
-    from wovenimpact.containment import FRAGMENT, fragment_row, layer_elements
+    from wovenimpact.containment import FRAGMENT, CasingWatch, layer_elements
+    from wovenimpact.containment import fragment_row as row_of
     from wovenimpact.kernels import shell_layout as SL
 
     model, state = coarse_two_ply_casing()
+    watch = CasingWatch(model) if one_watch else None
+
+    def fragment_row(model, state):
+        return row_of(model, state, watch)
+
     nodes = model.node_sets[FRAGMENT]
     cm = model.node_mass[nodes] @ state.x[nodes] / model.node_mass[nodes].sum()
     phi_cm = math.atan2(cm[1], cm[0])

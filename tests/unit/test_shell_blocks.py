@@ -16,9 +16,11 @@ import math
 import numpy as np
 import pytest
 
-from wovenimpact.benchmark import REFERENCE_FABRIC, REFERENCE_METAL
+from wovenimpact.benchmark import REFERENCE_FABRIC, REFERENCE_METAL, plate_model
+from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels.vecmath import atan2_upper, sqrt as vsqrt
+from wovenimpact.materials.metal import MetalParameters
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.model.mesh import plate_mesh
 from wovenimpact.solver import Workspace, step
@@ -28,10 +30,11 @@ from wovenimpact.state import initial_state
 
 
 def fabric_plate(per_edge: int, ultimate_tension: float | None = None, stable_step="isotropic",
-                 metal_rows: int = 0, crossover: str = "table"):
+                 metal_rows: int = 0, crossover: str = "table", elastic_rows: int = 0):
     """A fabric plate (the benchmark's, 0.94 mm cells) struck by a velocity bump; its
-    yarns' T_u lowered to make them break; optionally its first rows of elements metal
-    (two sections: the metal ones stay with shell_force)."""
+    yarns' T_u lowered to make them break; optionally its first rows of elements J2
+    metal (they stay with shell_force) and its last rows elastic steel (a resultant
+    section with the one-point membrane: blocks of their own)."""
     fabric = load_material(REFERENCE_FABRIC)
     if ultimate_tension is not None:
         fabric = dataclasses.replace(
@@ -46,6 +49,9 @@ def fabric_plate(per_edge: int, ultimate_tension: float | None = None, stable_st
     if metal_rows:
         sections["metal"] = Section(load_material(REFERENCE_METAL), thickness=1e-3)
         which[: metal_rows * per_edge] = 1
+    if elastic_rows:
+        sections["steel"] = Section(STEEL, thickness=1e-3)
+        which[mesh.n_elems - elastic_rows * per_edge:] = len(sections) - 1
     bc = BoundaryConditions(mesh.n_nodes).fix(mesh.node_sets["edge_outer"])
     model = build_model(mesh.nodes, mesh.quads, sections, which, bcs=bc,
                         stable_step=stable_step)
@@ -55,6 +61,10 @@ def fabric_plate(per_edge: int, ultimate_tension: float | None = None, stable_st
     st = initial_state(model, velocity=v0)
     st.x[:, :2] *= 1.02
     return model, st
+
+
+STEEL = MetalParameters(name="steel", kind="elastic", density=7850.0, modulus=210e9,
+                        poisson=0.3)
 
 
 def run_both(model, st, steps: int):
@@ -113,6 +123,38 @@ def test_mixed_sections_and_exact_crossover():
     assert_same(a, b, wa, wb)
     model, st = fabric_plate(6, crossover="exact")
     assert block_plan(model, st) is None
+
+
+@pytest.mark.parametrize("stable_step", ["isotropic", "yarn"])
+def test_elastic_plate_bitwise(stable_step):
+    """The benchmark's elastic steel plate (resultant section, one-point membrane with
+    hourglass springs) in blocks of its own, every lane on the block path, bitwise the
+    scalar kernel's state after the steps; in both stable-step options."""
+    model, st = plate_model("elastic", 170)  # 13 × 13
+    model = dataclasses.replace(model, stable_step=stable_step)
+    assert model.n_elems % LANES != 0
+    a, b, wa, wb, pending = run_both(model, st, 15)
+    assert wa.plan.others.size == 0
+    assert pending == 0, "lanes left to shell_force: the blocks would not be what is compared"
+    assert np.any(a.elem[:, SL.E_HG] != 0.0), "no hourglass force: the test would not see it"
+    assert_same(a, b, wa, wb)
+
+
+def test_fabric_elastic_and_j2_sections_together():
+    """Fabric and elastic blocks and J2 elements (shell_force) in one model: the plan
+    takes the fabric and the elastic sections, and the state is bitwise the scalar one."""
+    model, st = fabric_plate(10, metal_rows=2, elastic_rows=3, stable_step="yarn")
+    plan = block_plan(model, st)
+    for s in (0, 2):  # fabric, steel
+        ids = np.flatnonzero(model.elem_section == s)
+        assert set(ids) <= set(plan.elems) and not set(ids) & set(plan.others)
+    assert set(np.flatnonzero(model.elem_section == 1)) <= set(plan.others)
+    a, b, wa, wb, _ = run_both(model, st, 12)
+    assert_same(a, b, wa, wb)
+    # the steel lanes all stayed on the block path (the struck fabric may leave it)
+    steel = model.elem_section[plan.elems] == 2
+    step(model, a, wa)
+    assert steel.any() and not wa.scratch.pending[steel].any()
 
 
 def test_blocks_can_be_switched_off(monkeypatch):

@@ -63,8 +63,10 @@ from wovenimpact.kernels.fabric import (
 from wovenimpact.kernels.fabric_table import hermite_basis, hermite_terms, knot_interval
 from wovenimpact.kernels.shell import (
     centre_gradient,
+    centre_membrane_forces,
     corner_global,
     corotational_frame,
+    elastic_membrane,
     element_stable_step,
     family_stable_step,
     finish_element,
@@ -101,6 +103,9 @@ from wovenimpact.kernels.shell_layout import (
     E_U_BEND,
     E_U_HG,
     E_U_MEMB,
+    ELASTIC_MODULUS,
+    ELASTIC_POISSON,
+    MAT_ELASTIC,
     N_ELEM_STATE,
     STEP_YARN,
 )
@@ -459,6 +464,92 @@ def membrane_point(tid, bu, lu, g, gg, gw, res, lx, ly, out_el):
 
 
 @block_kernel
+def element_tail(tid, bu, lu, old, out_el, out_blk, inert, dt, px, py, pz, vx_, vy_, vz_,
+                 frame, mid, rates, g1, g2, mf_x, mf_y, c_memb, cs_max, kw_max, kf_max,
+                 full, thick, mu, e_b, nu_b, kgt, r_hg, step_yarn):
+    """Steps 4–7 of ``shell_force`` for lane lu, on its membrane's results: bending and
+    transverse shear of a resultant section, hourglass (in-plane modes too unless
+    ``full``: a 2×2 membrane has none), the corner forces into out_blk, the element
+    state's columns and both stable steps into out_el. Returns 1.0 if the corner forces
+    and the step are finite, else 0.0."""
+    area = frame[4]
+    lx, ly = frame[3]
+    b1, b2 = frame[5]
+    vx, vy, vz, tx, ty, dkx, dky, dkxy2, dgxz, dgyz = rates
+    # 4. bending and transverse shear (shell.bending_and_shear, resultant section)
+    m_old0 = old[tid, at(V_M, lu)]
+    m_old1 = old[tid, at(V_M + 1, lu)]
+    m_old2 = old[tid, at(V_M + 2, lu)]
+    q_old0 = old[tid, at(V_Q, lu)]
+    q_old1 = old[tid, at(V_Q + 1, lu)]
+    d_b = e_b * thick * thick * thick / (12.0 * (1.0 - nu_b * nu_b))
+    mxx = m_old0 + d_b * (dkx + nu_b * dky)
+    myy = m_old1 + d_b * (dky + nu_b * dkx)
+    mxy = m_old2 + d_b * 0.5 * (1.0 - nu_b) * dkxy2
+    w_bend = 1.0
+    qx = q_old0 + kgt * dgxz
+    qy = q_old1 + kgt * dgyz
+    out_el[tid, at(E_M, lu)] = mxx
+    out_el[tid, at(E_M + 1, lu)] = myy
+    out_el[tid, at(E_M + 2, lu)] = mxy
+    out_el[tid, at(E_Q, lu)] = qx
+    out_el[tid, at(E_Q + 1, lu)] = qy
+    out_el[tid, at(E_U_BEND, lu)] = old[tid, at(V_U_BEND, lu)] + area * (
+        w_bend * (0.5 * (m_old0 + mxx) * dkx + 0.5 * (m_old1 + myy) * dky
+                  + 0.5 * (m_old2 + mxy) * dkxy2)
+        + 0.5 * (q_old0 + qx) * dgxz + 0.5 * (q_old1 + qy) * dgyz
+    )
+    # 5. hourglass (shell.hourglass_resultants)
+    gam, bb = hourglass_vectors(lx, ly, b1, b2)
+    gam_mid = hourglass_vectors(mid[3][0], mid[3][1], mid[5][0], mid[5][1])[0]
+    k_m = 0.0 if full else r_hg * c_memb * area * bb
+    k_wm = r_hg * 16.0 * d_b * bb
+    k_t = r_hg * d_b * area * bb
+    hg0, e_hg = hourglass_mode(old[tid, at(V_HG, lu)], k_m, gam_mid, vx, dt)
+    hg1, de = hourglass_mode(old[tid, at(V_HG + 1, lu)], k_m, gam_mid, vy, dt)
+    e_hg += de
+    hg2, de = hourglass_mode(old[tid, at(V_HG + 2, lu)], k_wm, gam_mid, vz, dt)
+    e_hg += de
+    hg3, de = hourglass_mode(old[tid, at(V_HG + 3, lu)], k_t, gam_mid, tx, dt)
+    e_hg += de
+    hg4, de = hourglass_mode(old[tid, at(V_HG + 4, lu)], k_t, gam_mid, ty, dt)
+    e_hg += de
+    out_el[tid, at(E_HG, lu)] = hg0
+    out_el[tid, at(E_HG + 1, lu)] = hg1
+    out_el[tid, at(E_HG + 2, lu)] = hg2
+    out_el[tid, at(E_HG + 3, lu)] = hg3
+    out_el[tid, at(E_HG + 4, lu)] = hg4
+    out_el[tid, at(E_U_HG, lu)] = old[tid, at(V_U_HG, lu)] + e_hg
+    # 6. corner forces (shell.warp_forces, shell.corner_forces)
+    fzs = warp_forces(mf_x, mf_y, lx, ly, frame[6], area)
+    fsum = 0.0
+    fsum += store_corner(out_blk, tid, 0, lu, corner_global(
+        frame, area, b1[0], b2[0], mf_x[0], mf_y[0], gam[0], fzs[0], hg0, hg1, hg2, hg3,
+        hg4, mxx, myy, mxy, qx, qy))
+    fsum += store_corner(out_blk, tid, 1, lu, corner_global(
+        frame, area, b1[1], b2[1], mf_x[1], mf_y[1], gam[1], fzs[1], hg0, hg1, hg2, hg3,
+        hg4, mxx, myy, mxy, qx, qy))
+    fsum += store_corner(out_blk, tid, 2, lu, corner_global(
+        frame, area, b1[2], b2[2], mf_x[2], mf_y[2], gam[2], fzs[2], hg0, hg1, hg2, hg3,
+        hg4, mxx, myy, mxy, qx, qy))
+    fsum += store_corner(out_blk, tid, 3, lu, corner_global(
+        frame, area, b1[3], b2[3], mf_x[3], mf_y[3], gam[3], fzs[3], hg0, hg1, hg2, hg3,
+        hg4, mxx, myy, mxy, qx, qy))
+    # 7. stable steps (both options computed, one selected: a select vectorises)
+    inertia = inert[gb(bu, 1, 0, lu)]
+    dt_iso = element_stable_step(px, py, pz, area, c_memb, kgt, mu, inertia, d_b, bb)
+    dt_yarn = min(element_stable_step(px, py, pz, area, cs_max, kgt, mu, inertia, d_b, bb),
+                  family_stable_step(kw_max, cs_max, mu, g1),
+                  family_stable_step(kf_max, cs_max, mu, g2))
+    dt_kin = kinematic_step(px, py, pz, vx_, vy_, vz_)
+    dt_e = dt_yarn if step_yarn else dt_iso
+    out_el[tid, at(E_DT, lu)] = dt_e
+    out_el[tid, at(E_DT_KIN, lu)] = dt_kin if step_yarn else math.inf
+    out_el[tid, at(N_ELEM_STATE, lu)] = dt_iso
+    return 1.0 if fsum + dt_e - (fsum + dt_e) == 0.0 else 0.0
+
+
+@block_kernel
 def element_lanes(tid, bu, cn, old, res, flag, gg, gw, rg, a0s, inert, out_el, out_blk, dt,
                   thick, mu, e_b, nu_b, kgt, r_hg, step_yarn):
     """Stage 5: the rest of ``shell_force`` for every lane of the block (see the module
@@ -468,10 +559,7 @@ def element_lanes(tid, bu, cn, old, res, flag, gg, gw, rg, a0s, inert, out_el, o
     for ll in range(LANES):
         lu = _U(ll)
         px, py, pz, vx_, vy_, vz_, frame, mid, rates, kap = lane_motion(cn, old, tid, lu, dt)
-        area = frame[4]
         lx, ly = frame[3]
-        b1, b2 = frame[5]
-        vx, vy, vz, tx, ty, dkx, dky, dkxy2, dgxz, dgyz = rates
         out_el[tid, at(E_KAPPA, lu)] = kap[0]
         out_el[tid, at(E_KAPPA + 1, lu)] = kap[1]
         out_el[tid, at(E_KAPPA + 2, lu)] = kap[2]
@@ -515,79 +603,90 @@ def element_lanes(tid, bu, cn, old, res, flag, gg, gw, rg, a0s, inert, out_el, o
         out_el[tid, at(E_N + 1, lu)] = n_yy * inv
         out_el[tid, at(E_N + 2, lu)] = n_xy * inv
         out_el[tid, at(E_U_MEMB, lu)] = u
-        # 4. bending and transverse shear (shell.bending_and_shear, resultant section)
-        m_old0 = old[tid, at(V_M, lu)]
-        m_old1 = old[tid, at(V_M + 1, lu)]
-        m_old2 = old[tid, at(V_M + 2, lu)]
-        q_old0 = old[tid, at(V_Q, lu)]
-        q_old1 = old[tid, at(V_Q + 1, lu)]
-        d_b = e_b * thick * thick * thick / (12.0 * (1.0 - nu_b * nu_b))
-        mxx = m_old0 + d_b * (dkx + nu_b * dky)
-        myy = m_old1 + d_b * (dky + nu_b * dkx)
-        mxy = m_old2 + d_b * 0.5 * (1.0 - nu_b) * dkxy2
-        w_bend = 1.0
-        qx = q_old0 + kgt * dgxz
-        qy = q_old1 + kgt * dgyz
-        out_el[tid, at(E_M, lu)] = mxx
-        out_el[tid, at(E_M + 1, lu)] = myy
-        out_el[tid, at(E_M + 2, lu)] = mxy
-        out_el[tid, at(E_Q, lu)] = qx
-        out_el[tid, at(E_Q + 1, lu)] = qy
-        out_el[tid, at(E_U_BEND, lu)] = old[tid, at(V_U_BEND, lu)] + area * (
-            w_bend * (0.5 * (m_old0 + mxx) * dkx + 0.5 * (m_old1 + myy) * dky
-                      + 0.5 * (m_old2 + mxy) * dkxy2)
-            + 0.5 * (q_old0 + qx) * dgxz + 0.5 * (q_old1 + qy) * dgyz
-        )
-        # 5. hourglass (shell.hourglass_resultants; a 2×2 membrane has no in-plane modes)
-        gam, bb = hourglass_vectors(lx, ly, b1, b2)
-        gam_mid = hourglass_vectors(mid[3][0], mid[3][1], mid[5][0], mid[5][1])[0]
-        k_m = 0.0
-        k_wm = r_hg * 16.0 * d_b * bb
-        k_t = r_hg * d_b * area * bb
-        hg0, e_hg = hourglass_mode(old[tid, at(V_HG, lu)], k_m, gam_mid, vx, dt)
-        hg1, de = hourglass_mode(old[tid, at(V_HG + 1, lu)], k_m, gam_mid, vy, dt)
-        e_hg += de
-        hg2, de = hourglass_mode(old[tid, at(V_HG + 2, lu)], k_wm, gam_mid, vz, dt)
-        e_hg += de
-        hg3, de = hourglass_mode(old[tid, at(V_HG + 3, lu)], k_t, gam_mid, tx, dt)
-        e_hg += de
-        hg4, de = hourglass_mode(old[tid, at(V_HG + 4, lu)], k_t, gam_mid, ty, dt)
-        e_hg += de
-        out_el[tid, at(E_HG, lu)] = hg0
-        out_el[tid, at(E_HG + 1, lu)] = hg1
-        out_el[tid, at(E_HG + 2, lu)] = hg2
-        out_el[tid, at(E_HG + 3, lu)] = hg3
-        out_el[tid, at(E_HG + 4, lu)] = hg4
-        out_el[tid, at(E_U_HG, lu)] = old[tid, at(V_U_HG, lu)] + e_hg
-        # 6. corner forces (shell.warp_forces, shell.corner_forces)
-        fzs = warp_forces(mf_x, mf_y, lx, ly, frame[6], area)
-        fsum = 0.0
-        fsum += store_corner(out_blk, tid, 0, lu, corner_global(
-            frame, area, b1[0], b2[0], mf_x[0], mf_y[0], gam[0], fzs[0], hg0, hg1, hg2, hg3,
-            hg4, mxx, myy, mxy, qx, qy))
-        fsum += store_corner(out_blk, tid, 1, lu, corner_global(
-            frame, area, b1[1], b2[1], mf_x[1], mf_y[1], gam[1], fzs[1], hg0, hg1, hg2, hg3,
-            hg4, mxx, myy, mxy, qx, qy))
-        fsum += store_corner(out_blk, tid, 2, lu, corner_global(
-            frame, area, b1[2], b2[2], mf_x[2], mf_y[2], gam[2], fzs[2], hg0, hg1, hg2, hg3,
-            hg4, mxx, myy, mxy, qx, qy))
-        fsum += store_corner(out_blk, tid, 3, lu, corner_global(
-            frame, area, b1[3], b2[3], mf_x[3], mf_y[3], gam[3], fzs[3], hg0, hg1, hg2, hg3,
-            hg4, mxx, myy, mxy, qx, qy))
-        # 7. stable steps (both options computed, one selected: a select vectorises)
-        inertia = inert[gb(bu, 1, 0, lu)]
-        dt_iso = element_stable_step(px, py, pz, area, c_memb, kgt, mu, inertia, d_b, bb)
-        dt_yarn = min(element_stable_step(px, py, pz, area, cs_max, kgt, mu, inertia, d_b, bb),
-                      family_stable_step(kw_max, cs_max, mu, g1),
-                      family_stable_step(kf_max, cs_max, mu, g2))
-        dt_kin = kinematic_step(px, py, pz, vx_, vy_, vz_)
-        dt_e = dt_yarn if step_yarn else dt_iso
-        out_el[tid, at(E_DT, lu)] = dt_e
-        out_el[tid, at(E_DT_KIN, lu)] = dt_kin if step_yarn else math.inf
-        out_el[tid, at(N_ELEM_STATE, lu)] = dt_iso
-        finite = fsum + dt_e - (fsum + dt_e) == 0.0
+        finite = element_tail(tid, bu, lu, old, out_el, out_blk, inert, dt, px, py, pz, vx_,
+                              vy_, vz_, frame, mid, rates, g1, g2, mf_x, mf_y, c_memb, cs_max,
+                              kw_max, kf_max, True, thick, mu, e_b, nu_b, kgt, r_hg, step_yarn)
         # a count, not a conditional store (which LLVM would not vectorise): > 0 flags
-        flag[tid, lu] = flag[tid, lu] + bad_points + (0.0 if finite else 1.0)
+        flag[tid, lu] = flag[tid, lu] + bad_points + (1.0 - finite)
+
+
+# --- elastic sections: the one-point membrane of a resultant section ---------------------
+# per lane, in res (lane-major, :func:`at`): what elastic_membrane_lanes hands on
+(L_F, L_N, L_W, L_C, L_MFX, L_MFY) = (0, 4, 7, 8, 9, 13)
+N_LANE_MEMB = 17
+
+
+@block_kernel
+def elastic_membrane_lanes(tid, bu, cn, old, rg, a0s, dt, res, flag, modulus, poisson, thick):
+    """Stages 2–4 of an elastic block (``shell_force`` with a one-point membrane and a
+    resultant section of ``MAT_ELASTIC``: ``section_response`` with n = 1 on
+    ``elastic_membrane``, then ``centre_membrane_forces``): each lane's centre F, its
+    resultant N, membrane energy and tangent and corner forces into res; a degenerate or
+    inverted element adds to its lane's flag."""
+    for ll in range(LANES):
+        lu = _U(ll)
+        px, py, pz, vx_, vy_, vz_, frame, mid, rates, kap = lane_motion(cn, old, tid, lu, dt)
+        lx, ly = frame[3]
+        g1 = (rg[gb(bu, N_RG, 0, lu)], rg[gb(bu, N_RG, 1, lu)], rg[gb(bu, N_RG, 2, lu)],
+              rg[gb(bu, N_RG, 3, lu)])
+        g2 = (rg[gb(bu, N_RG, 4, lu)], rg[gb(bu, N_RG, 5, lu)], rg[gb(bu, N_RG, 6, lu)],
+              rg[gb(bu, N_RG, 7, lu)])
+        f11, f12, f21, f22 = centre_gradient(lx, ly, g1, g2)
+        h11, h12, h21, h22 = through_thickness_f(0.0, kap[0], kap[1], kap[2], f11, f12, f21,
+                                                 f22)
+        bad = not ((frame[4] > 0.0) & (mid[4] > 0.0) & (f11 * f22 - f12 * f21 > 0.0)
+                   & (h11 * h22 - h12 * h21 > 0.0))
+        energy, c, a, b, c12 = elastic_membrane(h11, h12, h21, h22, modulus, poisson, thick)
+        # section_response's sums over its one point (z = 0, weight 1)
+        n_xx = 0.0 + 1.0 * a
+        n_yy = 0.0 + 1.0 * b
+        n_xy = 0.0 + 1.0 * c12
+        a0 = a0s[gb(bu, 1, 0, lu)]
+        mf_x, mf_y = centre_membrane_forces(a0, n_xx, n_yy, n_xy, f11, f12, f21, f22, g1, g2)
+        res[tid, at(L_F, lu)] = f11
+        res[tid, at(L_F + 1, lu)] = f12
+        res[tid, at(L_F + 2, lu)] = f21
+        res[tid, at(L_F + 3, lu)] = f22
+        res[tid, at(L_N, lu)] = n_xx
+        res[tid, at(L_N + 1, lu)] = n_yy
+        res[tid, at(L_N + 2, lu)] = n_xy
+        res[tid, at(L_W, lu)] = (0.0 + 1.0 * energy) * a0
+        res[tid, at(L_C, lu)] = max(0.0, c)
+        for i in range(4):
+            res[tid, at(L_MFX + i, lu)] = mf_x[i]
+            res[tid, at(L_MFY + i, lu)] = mf_y[i]
+        flag[tid, lu] = flag[tid, lu] + (1.0 if bad else 0.0)
+
+
+@block_kernel
+def elastic_element_lanes(tid, bu, cn, old, res, flag, rg, inert, out_el, out_blk, dt, thick,
+                          mu, e_b, nu_b, kgt, r_hg, step_yarn):
+    """Stage 5 of an elastic block: the element state's membrane columns from res, then
+    :func:`element_tail` with the in-plane hourglass modes."""
+    for ll in range(LANES):
+        lu = _U(ll)
+        px, py, pz, vx_, vy_, vz_, frame, mid, rates, kap = lane_motion(cn, old, tid, lu, dt)
+        out_el[tid, at(E_KAPPA, lu)] = kap[0]
+        out_el[tid, at(E_KAPPA + 1, lu)] = kap[1]
+        out_el[tid, at(E_KAPPA + 2, lu)] = kap[2]
+        for k in range(4):
+            out_el[tid, at(E_F + k, lu)] = res[tid, at(L_F + k, lu)]
+        for k in range(3):
+            out_el[tid, at(E_N + k, lu)] = res[tid, at(L_N + k, lu)]
+        out_el[tid, at(E_U_MEMB, lu)] = res[tid, at(L_W, lu)]
+        g1 = (rg[gb(bu, N_RG, 0, lu)], rg[gb(bu, N_RG, 1, lu)], rg[gb(bu, N_RG, 2, lu)],
+              rg[gb(bu, N_RG, 3, lu)])
+        g2 = (rg[gb(bu, N_RG, 4, lu)], rg[gb(bu, N_RG, 5, lu)], rg[gb(bu, N_RG, 6, lu)],
+              rg[gb(bu, N_RG, 7, lu)])
+        mf_x = (res[tid, at(L_MFX, lu)], res[tid, at(L_MFX + 1, lu)],
+                res[tid, at(L_MFX + 2, lu)], res[tid, at(L_MFX + 3, lu)])
+        mf_y = (res[tid, at(L_MFY, lu)], res[tid, at(L_MFY + 1, lu)],
+                res[tid, at(L_MFY + 2, lu)], res[tid, at(L_MFY + 3, lu)])
+        c_memb = res[tid, at(L_C, lu)]
+        finite = element_tail(tid, bu, lu, old, out_el, out_blk, inert, dt, px, py, pz, vx_,
+                              vy_, vz_, frame, mid, rates, g1, g2, mf_x, mf_y, c_memb, c_memb,
+                              0.0, 0.0, False, thick, mu, e_b, nu_b, kgt, r_hg, step_yarn)
+        flag[tid, lu] = flag[tid, lu] + (1.0 - finite)
 
 
 @loop_kernel
@@ -604,6 +703,7 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
     ne = mesh.quads.shape[0]
     quads = mesh.quads
     sections = mesh.sections
+    mat_kind = mesh.mat_kind
     mat_params = mesh.mat_params
     step_yarn = mesh.step_mode == STEP_YARN
     x = motion.x
@@ -663,6 +763,7 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
         sec = _U(block_sec[b])
         thick = sections[sec, C_THICK]
         m = _U(sections[sec, C_MAT])
+        kind = mat_kind[m]
         # 1. gather
         for ll in range(LANES):
             lu = _U(ll)
@@ -687,25 +788,39 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
             # an eroded element or point: the lane goes to shell_force; a point with a
             # yarn damaged: to fabric_point (its exact solve), the rest of the lane stays
             worn = 0.0 if el_in[e, E_ALIVE] != 0.0 else 1.0
-            row0 = e * _U(point_blocks)
-            for g in range(4):
-                r = row0 + _U(g)
-                worn += 0.0 if rows_in[r, FL.S_ALIVE] != 0.0 else 1.0
-                exact[tid, _U(g * LANES) + lu] = (
-                    (0.0 if rows_in[r, FL.S_DAMAGE] == 0.0 else 1.0)
-                    + (0.0 if rows_in[r, FL.S_DAMAGE + 1] == 0.0 else 1.0))
+            if kind == MAT_ELASTIC:
+                # the 2×2 membrane's Gauss-point F, which a one-point one carries
+                for k in range(16):
+                    out_el[tid, at(E_FG + k, lu)] = el_in[e, E_FG + k]
+            else:
+                row0 = e * _U(point_blocks)
+                for g in range(4):
+                    r = row0 + _U(g)
+                    worn += 0.0 if rows_in[r, FL.S_ALIVE] != 0.0 else 1.0
+                    exact[tid, _U(g * LANES) + lu] = (
+                        (0.0 if rows_in[r, FL.S_DAMAGE] == 0.0 else 1.0)
+                        + (0.0 if rows_in[r, FL.S_DAMAGE + 1] == 0.0 else 1.0))
             flag[tid, lu] = worn
         # 2.–5.
-        kinematics_lanes(tid, b, cn, old, gg, rg, dt, kin, flag)
-        table_lookup(mat_params, m, tid, kin, coef, geo, exact)
-        crossover_points(tid, kin, coef, geo, res, material_lanes(mat_params, m))
-        exact_points(mat_params, m, tid, b, elems, point_blocks, el_in, rows_in, rows_out, kin,
-                     exact, flag, res)
-        element_lanes(tid, b, cn, old, res, flag, gg, gw, rg, a0s, inert, out_el, out_blk, dt,
-                      thick, sections[sec, C_AREAL_MASS], sections[sec, C_BEND_E],
-                      sections[sec, C_BEND_NU],
-                      sections[sec, C_SHEAR_K] * sections[sec, C_SHEAR_G] * thick,
-                      sections[sec, C_HOURGLASS], step_yarn)
+        mu = sections[sec, C_AREAL_MASS]
+        e_b = sections[sec, C_BEND_E]
+        nu_b = sections[sec, C_BEND_NU]
+        kgt = sections[sec, C_SHEAR_K] * sections[sec, C_SHEAR_G] * thick
+        r_hg = sections[sec, C_HOURGLASS]
+        if kind == MAT_ELASTIC:
+            elastic_membrane_lanes(tid, b, cn, old, rg, a0s, dt, res, flag,
+                                   mat_params[m, ELASTIC_MODULUS],
+                                   mat_params[m, ELASTIC_POISSON], thick)
+            elastic_element_lanes(tid, b, cn, old, res, flag, rg, inert, out_el, out_blk, dt,
+                                  thick, mu, e_b, nu_b, kgt, r_hg, step_yarn)
+        else:
+            kinematics_lanes(tid, b, cn, old, gg, rg, dt, kin, flag)
+            table_lookup(mat_params, m, tid, kin, coef, geo, exact)
+            crossover_points(tid, kin, coef, geo, res, material_lanes(mat_params, m))
+            exact_points(mat_params, m, tid, b, elems, point_blocks, el_in, rows_in, rows_out,
+                         kin, exact, flag, res)
+            element_lanes(tid, b, cn, old, res, flag, gg, gw, rg, a0s, inert, out_el, out_blk,
+                          dt, thick, mu, e_b, nu_b, kgt, r_hg, step_yarn)
         # 6. scatter; a flagged lane is left for the scalar kernel (the next loop)
         for ll in range(lanes[b]):
             lu = _U(ll)
@@ -722,33 +837,37 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
                 for k in range(6):
                     blocks[e, i, k] = out_blk[tid, at(6 * i + k, lu)]
             row0 = e * _U(point_blocks)
-            for g in range(4):
-                r = row0 + _U(g)
-                q = _U(g * LANES) + lu
-                if exact[tid, q] != 0.0:  # fabric_point wrote its state columns
-                    for j in range(FL.N_STATE, pw):
-                        rows_out[r, j] = rows_in[r, j]
-                    continue
+            if kind == MAT_ELASTIC:  # shell.carry_state's one row (an elastic point has none)
                 for j in range(pw):
-                    rows_out[r, j] = rows_in[r, j]
-                rows_out[r, FL.S_LAMBDA] = res[tid, atq(R_LAM_W, q)]
-                rows_out[r, FL.S_LAMBDA + 1] = res[tid, atq(R_LAM_F, q)]
-                rows_out[r, FL.S_GAMMA] = res[tid, atq(R_GAMMA, q)]
-                rows_out[r, FL.S_ITER] = 0.0
-                rows_out[r, FL.S_H] = res[tid, atq(R_H_W, q)]
-                rows_out[r, FL.S_H + 1] = res[tid, atq(R_H_F, q)]
-                rows_out[r, FL.S_TENSION] = res[tid, atq(R_T_W, q)]
-                rows_out[r, FL.S_TENSION + 1] = res[tid, atq(R_T_F, q)]
-                rows_out[r, FL.S_TAU] = res[tid, atq(R_TAU, q)]
-                rows_out[r, FL.S_SHEAR_ENERGY] = res[tid, atq(R_E_SHEAR, q)]
-                rows_out[r, FL.S_ENERGY] = res[tid, atq(R_ENERGY, q)]
-            # shell.sync_yarn_damage
-            for fam in range(2):
-                d = 0.0
+                    rows_out[row0, j] = rows_in[row0, j]
+            else:
                 for g in range(4):
-                    d = max(d, rows_out[row0 + _U(g), FL.S_DAMAGE + fam])
-                for g in range(4):
-                    rows_out[row0 + _U(g), FL.S_DAMAGE + fam] = d
+                    r = row0 + _U(g)
+                    q = _U(g * LANES) + lu
+                    if exact[tid, q] != 0.0:  # fabric_point wrote its state columns
+                        for j in range(FL.N_STATE, pw):
+                            rows_out[r, j] = rows_in[r, j]
+                        continue
+                    for j in range(pw):
+                        rows_out[r, j] = rows_in[r, j]
+                    rows_out[r, FL.S_LAMBDA] = res[tid, atq(R_LAM_W, q)]
+                    rows_out[r, FL.S_LAMBDA + 1] = res[tid, atq(R_LAM_F, q)]
+                    rows_out[r, FL.S_GAMMA] = res[tid, atq(R_GAMMA, q)]
+                    rows_out[r, FL.S_ITER] = 0.0
+                    rows_out[r, FL.S_H] = res[tid, atq(R_H_W, q)]
+                    rows_out[r, FL.S_H + 1] = res[tid, atq(R_H_F, q)]
+                    rows_out[r, FL.S_TENSION] = res[tid, atq(R_T_W, q)]
+                    rows_out[r, FL.S_TENSION + 1] = res[tid, atq(R_T_F, q)]
+                    rows_out[r, FL.S_TAU] = res[tid, atq(R_TAU, q)]
+                    rows_out[r, FL.S_SHEAR_ENERGY] = res[tid, atq(R_E_SHEAR, q)]
+                    rows_out[r, FL.S_ENERGY] = res[tid, atq(R_ENERGY, q)]
+                # shell.sync_yarn_damage
+                for fam in range(2):
+                    d = 0.0
+                    for g in range(4):
+                        d = max(d, rows_out[row0 + _U(g), FL.S_DAMAGE + fam])
+                    for g in range(4):
+                        rows_out[row0 + _U(g), FL.S_DAMAGE + fam] = d
             failed, er, dt_own = finish_element(e, 0, 0, out_el[tid, at(N_ELEM_STATE, lu)],
                                                 el_out, blocks, status, eroded_now, alive,
                                                 dt_erode, erode_inverted)

@@ -4,10 +4,11 @@ scratch rows (docs/theory.md §4.6, "SIMD element pass").
 
 An element goes into a block when its section is the default fabric section — a 2×2
 membrane with one point through the thickness, and its material the crossover model with
-the tabulated crossover, the fibre frame, the true trellis law and the virial resultant.
-A block holds elements of one section; the last block of each section repeats its last
-element into the lanes it does not use (computed, never written). Every other element
-(metal, the blade, fabric with other options) stays with ``shell_force``.
+the tabulated crossover, the fibre frame, the true trellis law and the virial resultant —
+or an elastic resultant section with the one-point membrane (the default for an elastic
+material). A block holds elements of one section; the last block of each section repeats
+its last element into the lanes it does not use (computed, never written). Every other
+element (J2 metal, the blade, fabric with other options) stays with ``shell_force``.
 
 ``WOVENIMPACT_BLOCKS=0`` in the environment keeps every element with ``shell_force`` (the
 results are bitwise the same; for measuring the two against each other).
@@ -33,13 +34,21 @@ def blocks_enabled() -> bool:
     return os.environ.get("WOVENIMPACT_BLOCKS", "1").strip() != "0"
 
 
-def block_sections(model) -> list[int]:
-    """The sections whose elements the block stage can take (the module docstring)."""
+def block_sections(model, width: int) -> list[int]:
+    """The sections whose elements the block stage can take (the module docstring), for
+    material rows ``width`` wide: a fabric section only when those rows are whole blocks
+    of at least four points."""
+    pw = model.point_width
+    fabric_rows = pw > 0 and width % pw == 0 and width // pw >= 4
     out = []
     for s, row in enumerate(model.sections):
         m = int(row[SL.C_MAT])
         p = model.mat_params[m]
-        if (model.mat_kind[m] == SL.MAT_FABRIC and int(row[SL.C_POINTS]) == 1
+        if (model.mat_kind[m] == SL.MAT_ELASTIC and int(row[SL.C_POINTS]) == 1
+                and int(row[SL.C_INPLANE]) == SL.MEMBRANE_REDUCED):
+            out.append(s)
+        elif (fabric_rows and model.mat_kind[m] == SL.MAT_FABRIC
+                and int(row[SL.C_POINTS]) == 1
                 and int(row[SL.C_INPLANE]) == SL.MEMBRANE_FULL
                 and p[FL.P_CROSSOVER] == FL.CROSSOVER_TABLE and p[FL.P_TAB_NW] >= 2
                 and p[FL.P_TAB_NF] >= 2 and p[FL.P_FRAME] == FL.FRAME_FIBRE
@@ -57,14 +66,10 @@ def _to_blocks(values: np.ndarray, elems: np.ndarray) -> np.ndarray:
 
 
 def block_plan(model, state) -> BlockPlan | None:
-    """The plan for ``model`` (None when no element qualifies, the material rows are not
-    whole point blocks, or blocks are disabled)."""
-    if not blocks_enabled() or model.point_width <= 0:
+    """The plan for ``model`` (None when no element qualifies or blocks are disabled)."""
+    if not blocks_enabled():
         return None
-    width = state.mat.shape[1]
-    if width % model.point_width or width // model.point_width < 4:
-        return None
-    secs = block_sections(model)
+    secs = block_sections(model, state.mat.shape[1])
     if not secs:
         return None
     elems, lanes, section = [], [], []

@@ -31,6 +31,12 @@ the thread's own scratch row):
    left to ``shell_force`` in a second loop (its inputs, the start-of-step tables, are
    untouched), and the elements outside the blocks go through it in a third.
 
+Elastic resultant sections with the one-point membrane take blocks of their own: the
+same gather (with the Gauss-point F columns a one-point element carries), then
+:func:`elastic_membrane_lanes` (stages 2–4: ``section_response`` on one point of
+``elastic_membrane``, ``centre_membrane_forces``) and :func:`elastic_element_lanes`;
+both kinds end in :func:`element_tail` (bending, hourglass, corner forces, steps).
+
 The results are bitwise those of ``shell_force`` (tests/unit/test_shell_blocks.py), so a
 run does not depend on which elements went through the blocks, nor on the thread count.
 What LLVM needs to vectorise the three vector stages (found with
@@ -179,6 +185,15 @@ def gauss_f(gg, bu, g, lu, lx, ly):
 
 
 @inline_kernel
+def ref_gradients(rg, bu, lu):
+    """Lane lu's reference gradients at the centre, ∂N_I/∂X and ∂N_I/∂Y (4-tuples)."""
+    return ((rg[gb(bu, N_RG, 0, lu)], rg[gb(bu, N_RG, 1, lu)], rg[gb(bu, N_RG, 2, lu)],
+             rg[gb(bu, N_RG, 3, lu)]),
+            (rg[gb(bu, N_RG, 4, lu)], rg[gb(bu, N_RG, 5, lu)], rg[gb(bu, N_RG, 6, lu)],
+             rg[gb(bu, N_RG, 7, lu)]))
+
+
+@inline_kernel
 def lane_motion(cn, old, tid, lu, dt):
     """Lane lu's frames at x^n and x^{n−1/2}, corner velocities, the step's rates and the
     new curvature (``shell_force`` steps 1–2)."""
@@ -223,10 +238,7 @@ def kinematics_lanes(tid, bu, cn, old, gg, rg, dt, kin, flag):
         lu = _U(ll)
         px, py, pz, vx_, vy_, vz_, frame, mid, rates, kap = lane_motion(cn, old, tid, lu, dt)
         lx, ly = frame[3]
-        g1 = (rg[gb(bu, N_RG, 0, lu)], rg[gb(bu, N_RG, 1, lu)], rg[gb(bu, N_RG, 2, lu)],
-              rg[gb(bu, N_RG, 3, lu)])
-        g2 = (rg[gb(bu, N_RG, 4, lu)], rg[gb(bu, N_RG, 5, lu)], rg[gb(bu, N_RG, 6, lu)],
-              rg[gb(bu, N_RG, 7, lu)])
+        g1, g2 = ref_gradients(rg, bu, lu)
         f11, f12, f21, f22 = centre_gradient(lx, ly, g1, g2)
         bad = not ((frame[4] > 0.0) & (mid[4] > 0.0) & (f11 * f22 - f12 * f21 > 0.0))
         bad = bad | point_kinematics(tid, bu, lu, 0, gg, lx, ly, kap, kin)
@@ -564,10 +576,7 @@ def element_lanes(tid, bu, cn, old, res, flag, gg, gw, rg, a0s, inert, out_el, o
         out_el[tid, at(E_KAPPA + 1, lu)] = kap[1]
         out_el[tid, at(E_KAPPA + 2, lu)] = kap[2]
         # 3. the centre's F (outputs)
-        g1 = (rg[gb(bu, N_RG, 0, lu)], rg[gb(bu, N_RG, 1, lu)], rg[gb(bu, N_RG, 2, lu)],
-              rg[gb(bu, N_RG, 3, lu)])
-        g2 = (rg[gb(bu, N_RG, 4, lu)], rg[gb(bu, N_RG, 5, lu)], rg[gb(bu, N_RG, 6, lu)],
-              rg[gb(bu, N_RG, 7, lu)])
+        g1, g2 = ref_gradients(rg, bu, lu)
         f11, f12, f21, f22 = centre_gradient(lx, ly, g1, g2)
         out_el[tid, at(E_F, lu)] = f11
         out_el[tid, at(E_F + 1, lu)] = f12
@@ -627,10 +636,7 @@ def elastic_membrane_lanes(tid, bu, cn, old, rg, a0s, dt, res, flag, modulus, po
         lu = _U(ll)
         px, py, pz, vx_, vy_, vz_, frame, mid, rates, kap = lane_motion(cn, old, tid, lu, dt)
         lx, ly = frame[3]
-        g1 = (rg[gb(bu, N_RG, 0, lu)], rg[gb(bu, N_RG, 1, lu)], rg[gb(bu, N_RG, 2, lu)],
-              rg[gb(bu, N_RG, 3, lu)])
-        g2 = (rg[gb(bu, N_RG, 4, lu)], rg[gb(bu, N_RG, 5, lu)], rg[gb(bu, N_RG, 6, lu)],
-              rg[gb(bu, N_RG, 7, lu)])
+        g1, g2 = ref_gradients(rg, bu, lu)
         f11, f12, f21, f22 = centre_gradient(lx, ly, g1, g2)
         h11, h12, h21, h22 = through_thickness_f(0.0, kap[0], kap[1], kap[2], f11, f12, f21,
                                                  f22)
@@ -674,10 +680,7 @@ def elastic_element_lanes(tid, bu, cn, old, res, flag, rg, inert, out_el, out_bl
         for k in range(3):
             out_el[tid, at(E_N + k, lu)] = res[tid, at(L_N + k, lu)]
         out_el[tid, at(E_U_MEMB, lu)] = res[tid, at(L_W, lu)]
-        g1 = (rg[gb(bu, N_RG, 0, lu)], rg[gb(bu, N_RG, 1, lu)], rg[gb(bu, N_RG, 2, lu)],
-              rg[gb(bu, N_RG, 3, lu)])
-        g2 = (rg[gb(bu, N_RG, 4, lu)], rg[gb(bu, N_RG, 5, lu)], rg[gb(bu, N_RG, 6, lu)],
-              rg[gb(bu, N_RG, 7, lu)])
+        g1, g2 = ref_gradients(rg, bu, lu)
         mf_x = (res[tid, at(L_MFX, lu)], res[tid, at(L_MFX + 1, lu)],
                 res[tid, at(L_MFX + 2, lu)], res[tid, at(L_MFX + 3, lu)])
         mf_y = (res[tid, at(L_MFY, lu)], res[tid, at(L_MFY + 1, lu)],

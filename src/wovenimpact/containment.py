@@ -83,8 +83,8 @@ def _within_angle(xy: np.ndarray, phi0: float, half_angle: float) -> np.ndarray:
 class CasingWatch:
     """What :func:`fragment_row` reads of a containment model, computed once per run:
     the fragment's nodes and masses, the casing's nodes, the path window's floor (two
-    casing elements), the casing's inner radius and the casing nodes' reference angles
-    and heights; and the casing's anchored-node mask (:func:`anchored_casing_nodes`),
+    casing elements), the casing's inner radius and the casing nodes' reference
+    positions; and the casing's anchored-node mask (:func:`anchored_casing_nodes`),
     recomputed only when a casing element has eroded since it was last computed
     (erosion is permanent, so the count of live casing elements names the live set).
     A history row of the 10-ply casing (57 k elements) took 18 ms with all of it

@@ -623,6 +623,8 @@ def element_lanes(tid, bu, cn, old, res, flag, gg, gw, rg, a0s, inert, out_el, o
 # per lane, in res (lane-major, :func:`at`): what elastic_membrane_lanes hands on
 (L_F, L_N, L_W, L_C, L_MFX, L_MFY) = (0, 4, 7, 8, 9, 13)
 N_LANE_MEMB = 17
+# they go into the res row, whose bounds the kernels do not check
+assert N_LANE_MEMB <= 4 * N_RES
 
 
 @block_kernel

@@ -103,6 +103,7 @@ def contact_parts(sc, state) -> None:
             sc.overlap, sc.beta, sc.damping, sc.friction, float(state.dt), sc.seg_geo,
             sc.seg_on, sc.node_on, sc.pair_ptr, sc.pair_seg, sc.geo, sc.pair_on, sc.pair_f,
             sc.pair_w, sc.pair_e, sc.node_f)
+    sc.geo[:n, GEO_SIDE] = 0.0  # the narrow phase writes the rows of projected pairs only
     t_pen, _ = best_ms(lambda: penalty_forces(*args))
     projected = int((sc.geo[:n, GEO_SIDE] != 0).sum())
     acting = int((sc.pair_on[:n] != 0).sum())

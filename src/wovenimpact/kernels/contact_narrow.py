@@ -66,12 +66,15 @@ import math
 
 from numba import prange
 
-from wovenimpact.jit import kernel, loop_kernel
+from wovenimpact.jit import block_kernel, kernel, loop_kernel
 from wovenimpact.kernels.contact_law import pair_force
 
 GEO_XI, GEO_ETA, GEO_DIST, GEO_N, GEO_SIDE = 0, 1, 2, 3, 6  # columns of the pair table
 N_GEO = 7
 INSIDE_TOL = 1e-10  # |ξ|, |η| ≤ 1 + tol counts as inside the segment
+# codes in ``keep`` while ``evaluate_node_pairs`` selects: a projected candidate's side of
+# the surface (0: not projected), and the flag of the closest of its group
+PROJECTED_ABOVE, PROJECTED_BELOW, SIDE_BITS, CLOSEST = 1, 2, 3, 4
 GN_ITERATIONS = 12
 
 
@@ -209,19 +212,22 @@ def shape_functions(xi, eta):
     )
 
 
-@kernel
+@block_kernel
 def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, seg_on, pair_ptr,
                         pair_seg, geo, keep):
     """Project node p on each of its candidate segments and keep the closest per group.
 
-    Writes, for k in pair_ptr[p] … pair_ptr[p + 1] − 1: geo[k] = (ξ, η, d, n_x, n_y,
-    n_z, side) with d = |p − x_c|, n the unit contact normal pointing from the
-    segment to the node, side = ±1 the node's side of the surface normal; keep[k] = 1
-    for the closest candidate of each (ply, side) group, else 0.
+    Writes, for k in pair_ptr[p] … pair_ptr[p + 1] − 1: keep[k] = 1 for the closest
+    projected candidate of each (ply, side) group, else 0; and for every projected
+    candidate geo[k] = (ξ, η, d, n_x, n_y, n_z, side) with d = |p − x_c|, n the unit
+    contact normal pointing from the segment to the node, side = ±1 the node's side of
+    the surface normal (the rows of the others are not written: most candidates fail
+    the box test, and writing their rows streamed the whole pair table through memory
+    every step).
 
     A candidate whose node is outside the segment's box (``seg``, by
     :func:`segment_geometry` at x) inflated by r = h_p + h_s + margin (the broad phase's
-    test, contact_broad) is passed over (keep 0, side 0, d = ∞): a fresh search at x
+    test, contact_broad) is passed over (keep 0, not projected): a fresh search at x
     would not have listed it, so candidates kept from an earlier search with a skin
     (ShellContact) give the same result. So is one farther than r from the segment by
     its plane bound: every point of the bilinear segment lies within the warp |n̄ · c|
@@ -247,8 +253,6 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, seg_on, pa
                         + seg[s, SG_NORMAL + 1] * (py - seg[s, SG_MID + 1])
                         + seg[s, SG_NORMAL + 2] * (pz - seg[s, SG_MID + 2]))
                 - seg[s, SG_WARP] <= r):
-            geo[k, GEO_DIST] = math.inf
-            geo[k, GEO_SIDE] = 0.0
             keep[k] = 0
             continue
         xi, eta, ox, oy, oz, sx, sy, sz, inside = closest_point_on_quad(
@@ -269,16 +273,19 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, seg_on, pa
         geo[k, GEO_N + 1] = ny
         geo[k, GEO_N + 2] = nz
         geo[k, GEO_SIDE] = side
+        keep[k] = PROJECTED_ABOVE if side > 0.0 else PROJECTED_BELOW
+    # the closest of each (ply, side) group, flagged CLOSEST in keep (its side code stays
+    # readable for the comparisons of the candidates after it), then keep = 1 / 0
     for k in range(k0, k1):
-        side_k = geo[k, GEO_SIDE]
-        if side_k == 0.0:
+        side_k = keep[k] & SIDE_BITS
+        if side_k == 0:
             continue
         sk = pair_seg[k]
         best = True
         for j in range(k0, k1):
-            # the side first: most candidates failed the box test (side 0), and it is
+            # the side first: most candidates failed the box test (code 0), and it is
             # read in order, while ply[pair_seg[j]] is a scattered load
-            if j == k or geo[j, GEO_SIDE] != side_k:
+            if j == k or (keep[j] & SIDE_BITS) != side_k:
                 continue
             sj = pair_seg[j]
             if ply[sj] != ply[sk]:
@@ -287,7 +294,10 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, seg_on, pa
             if dj < dk or (dj == dk and sj < sk):
                 best = False
                 break
-        keep[k] = 1 if best else 0
+        if best:
+            keep[k] |= CLOSEST
+    for k in range(k0, k1):
+        keep[k] = 1 if keep[k] & CLOSEST else 0
 
 
 @loop_kernel

@@ -18,8 +18,7 @@ yarns are slack or one is straight) to 1.02 × the failure stretch of a straight
 around them: the onset of contact through λ = 1 (W ≡ 0 on one side, W ∝ D² on the other:
 ∂²W jumps there) with the knee of the crimp interchange just above it (λ up to L0/ℓ0, where a
 yarn becomes taut when straight), and the onset line of a strongly compressed crossing
-family (its slack height reaches h_w0 + h_f0); ``ONSET_BAND_STEP`` within ``ONSET_BAND`` of
-λ = 1, and the geometric ``REST_STEPS`` onto it.
+family (its slack height reaches h_w0 + h_f0).
 """
 
 from __future__ import annotations
@@ -47,13 +46,6 @@ FINE = 1e-3  # knot spacing around the onset of contact and the knee
 # cells"); the lookup's buckets keep the width of the knots outside the cluster, so a
 # point inside it steps through a few knots
 REST_STEPS = 1e-7 * 2.0 ** np.arange(12)  # 1e-7 … 2.05e-4
-# knots every ONSET_BAND_STEP within ONSET_BAND of λ = 1 along each family (outside the rest
-# cluster): the onset of contact runs through the undeformed state, the cells it crosses
-# are solved exactly, and the points of a casing strained by ~1e-3 gather along it; cells
-# of 2e-4 instead of 1e-3 there halve the points that take the exact solve (theory §1.9,
-# "the band around rest")
-ONSET_BAND = 0.01
-ONSET_BAND_STEP = 2e-4
 
 
 def _exact_parameters(params):
@@ -148,12 +140,9 @@ def family_knots(own, other, coarse=COARSE, dense=FINE) -> np.ndarray:
         fine.append((comp - 0.01, comp + 0.01))
     k = knots(LAMBDA_MIN, hi, fine, coarse, dense, kinks=(taut, comp))
     rest = np.concatenate([1.0 - REST_STEPS, [1.0], 1.0 + REST_STEPS])
-    n_band = int(round(2.0 * ONSET_BAND / ONSET_BAND_STEP))
-    band = 1.0 + ONSET_BAND * np.linspace(-1.0, 1.0, n_band + 1)
-    # regular knots inside the band give way to it, and band knots to the rest cluster
-    k = k[np.abs(k - 1.0) > ONSET_BAND * (1.0 + 1e-9)]
-    band = band[np.abs(band - 1.0) > 1.5 * REST_STEPS[-1]]
-    return np.unique(np.concatenate([k, band, rest]))
+    # regular knots inside the rest cluster's span give way to it
+    k = k[np.abs(k - 1.0) > REST_STEPS[-1] * (1.0 + 1e-9)]
+    return np.unique(np.concatenate([k, rest]))
 
 
 def kink_knots(own, other, k: np.ndarray) -> np.ndarray:
@@ -373,7 +362,7 @@ def _read_table(path: Path, key: str) -> np.ndarray | None:
     return row
 
 
-TABLE_CACHE_FILES = 64  # tables kept on disk (~5.6 MB each); the least recently used go
+TABLE_CACHE_FILES = 64  # tables kept on disk (~2.3 MB each); the least recently used go
 
 
 def _write_table(path: Path, key: str, row: np.ndarray) -> None:

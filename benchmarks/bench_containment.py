@@ -11,8 +11,9 @@ wall time to the 3-minute target (the thesis took more than an hour at this size
 
 Options: ``--case=PATH`` (default the 10-ply hybrid casing), ``--size=5.5mm`` (element
 size), ``--end=4ms`` (end time at most: the example stops once its outcome has held for
-``run.stop_when_decided``, 2.73 ms for the 10-ply casing — the end of the event), ``--threads=N`` (default: all cores), ``--set=KEY=VALUE``
-(repeatable, passed on), ``--out=DIR`` (default a temporary directory), ``--json``.
+``run.stop_when_decided``, at 2.73 ms for the 10-ply casing — the end of the event),
+``--threads=N`` (default: all cores), ``--set=KEY=VALUE`` (repeatable, passed on),
+``--out=DIR`` (default a temporary directory), ``--json``.
 """
 
 from __future__ import annotations

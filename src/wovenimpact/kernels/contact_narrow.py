@@ -222,8 +222,7 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, seg_on, pa
     candidate geo[k] = (ξ, η, d, n_x, n_y, n_z, side) with d = |p − x_c|, n the unit
     contact normal pointing from the segment to the node, side = ±1 the node's side of
     the surface normal (the rows of the others are not written: most candidates fail
-    the box test, and writing their rows streamed the whole pair table through memory
-    every step).
+    the box test).
 
     A candidate whose node is outside the segment's box (``seg``, by
     :func:`segment_geometry` at x) inflated by r = h_p + h_s + margin (the broad phase's

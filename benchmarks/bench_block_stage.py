@@ -6,7 +6,8 @@ points were solved exactly, and ns per element of ``shell_forces`` (best of 20) 
 blocks and without (docs/theory.md §4.6, "The element stage in blocks").
 
 Usage: ``python benchmarks/bench_block_stage.py CASE T THREADS``, e.g.
-``python benchmarks/bench_block_stage.py examples/plate_impact/plies4_120.toml 1e-4 1``.
+``python benchmarks/bench_block_stage.py examples/plate_impact/plies4_120.toml 1e-4 1``;
+CASE ``plate:N`` is ``make bench``'s fabric plate of about N elements.
 """
 
 from __future__ import annotations
@@ -33,12 +34,18 @@ def best_seconds(f, repeats: int = 20) -> float:
 
 def case_state(case: str, t_end: float, threads: int):
     """CASE compiled and stepped to t_end on ``threads`` threads: (model, state, workspace),
-    or None when no element of the case goes into blocks."""
+    or None when no element of the case goes into blocks. CASE ``plate:N`` is ``make
+    bench``'s fabric plate of about N elements (``wovenimpact.benchmark.plate_model``)."""
     configure_threading()
     set_threads(threads)
-    spec, base = load_case(case, [])
-    compiled = compile_case(spec, base)
-    model, state = compiled.model, compiled.state
+    if case.startswith("plate:"):
+        from wovenimpact.benchmark import plate_model
+
+        model, state = plate_model("fabric", int(case.removeprefix("plate:")))
+    else:
+        spec, base = load_case(case, [])
+        compiled = compile_case(spec, base)
+        model, state = compiled.model, compiled.state
     ws = Workspace.for_model(model, state)
     kinds = set() if ws.plan is None else {
         int(model.mat_kind[int(model.sections[s, SL.C_MAT])]) for s in ws.plan.section}

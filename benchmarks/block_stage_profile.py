@@ -115,27 +115,9 @@ def stages(upto, quads, sections, mat_params, step_yarn, x, v, omega, el_in, el_
                     rows_out[r, FL.S_ENERGY] = res[tid, SB.atq(SB.R_ENERGY, q)]
 
 
-def plate_state(n_elements: int, t_end: float, threads: int):
-    """``make bench``'s fabric plate of about ``n_elements``, stepped to ``t_end``."""
-    from wovenimpact.benchmark import plate_model
-    from wovenimpact.jit import configure_threading, set_threads
-    from wovenimpact.solver.explicit import Workspace, step
-
-    configure_threading()
-    set_threads(threads)
-    model, state = plate_model("fabric", n_elements)
-    ws = Workspace.for_model(model, state)
-    while state.t < t_end:
-        step(model, state, ws)
-    return model, state, ws
-
-
 def main(argv: list[str]) -> None:
     case, t_end, threads = argv[0], float(argv[1]), int(argv[2])
-    if case.startswith("plate:"):
-        found = plate_state(int(case.removeprefix("plate:")), t_end, threads)
-    else:
-        found = case_state(case, t_end, threads)
+    found = case_state(case, t_end, threads)
     if found is None:
         return
     model, state, ws = found

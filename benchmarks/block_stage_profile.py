@@ -36,7 +36,7 @@ STAGES = ("gather", "kinematics", "look-up", "crossover points", "marked points"
 
 @njit(parallel=True, boundscheck=False, error_model="numpy")
 def stages(upto, quads, sections, mat_params, step_yarn, x, v, omega, el_in, el_out, rows_in,
-           rows_out, point_blocks, dt, elems, lanes, block_sec, gg, gw, rg, a0s, inert, cn, old,
+           rows_out, mat_row, dt, elems, lanes, block_sec, gg, gw, rg, a0s, inert, cn, old,
            kin, coef, geo, flag, exact, res, out_el, out_blk):
     """``internal_force_blocks``' block loop, its stages 1…upto (the scalar fallback and
     the erosion tests left out)."""
@@ -66,7 +66,7 @@ def stages(upto, quads, sections, mat_params, step_yarn, x, v, omega, el_in, el_
             old[tid, SB.at(SB.V_U_BEND, lu)] = el_in[e, SL.E_U_BEND]
             old[tid, SB.at(SB.V_U_HG, lu)] = el_in[e, SL.E_U_HG]
             worn = 0.0 if el_in[e, SL.E_ALIVE] != 0.0 else 1.0
-            row0 = e * _U(point_blocks)
+            row0 = _U(mat_row[e])
             for g in range(4):
                 r = row0 + _U(g)
                 worn += 0.0 if rows_in[r, FL.S_ALIVE] != 0.0 else 1.0
@@ -81,7 +81,7 @@ def stages(upto, quads, sections, mat_params, step_yarn, x, v, omega, el_in, el_
         if upto >= 4:
             SB.crossover_points(tid, kin, coef, geo, res, SB.material_lanes(mat_params, m))
         if upto >= 5:
-            SB.exact_points(mat_params, m, tid, b, elems, point_blocks, el_in, rows_in, rows_out,
+            SB.exact_points(mat_params, m, tid, b, elems, mat_row, el_in, rows_in, rows_out,
                             kin, exact, flag, res)
         if upto >= 6:
             SB.element_lanes(tid, b, cn, old, res, flag, gg, gw, rg, a0s, inert, out_el,
@@ -97,7 +97,7 @@ def stages(upto, quads, sections, mat_params, step_yarn, x, v, omega, el_in, el_
                     continue
                 for c in range(SL.N_ELEM_STATE):
                     el_out[e, c] = out_el[tid, SB.at(c, lu)]
-                row0 = e * _U(point_blocks)
+                row0 = _U(mat_row[e])
                 for g in range(4):
                     r = row0 + _U(g)
                     q = _U(g * SB.LANES) + lu
@@ -122,16 +122,12 @@ def main(argv: list[str]) -> None:
         return
     model, state, ws = found
     p, s, mesh = ws.plan, ws.scratch, ws.mesh
-    width = state.mat.shape[1]
-    point_blocks = width // mesh.point_width
-    ne = model.n_elems
-    rows_in = state.mat.reshape(ne * point_blocks, mesh.point_width)
-    rows_out = ws.mat.reshape(ne * point_blocks, mesh.point_width)
+    rows_in, rows_out = state.mat, ws.mat
 
     def run(upto):
         stages(upto, mesh.quads, mesh.sections, mesh.mat_params, mesh.step_mode == SL.STEP_YARN,
                state.x, state.v, state.omega, state.elem, ws.elem, rows_in, rows_out,
-               point_blocks, state.dt, p.elems, p.lanes, p.section, p.gauss_grad,
+               mesh.mat_row, state.dt, p.elems, p.lanes, p.section, p.gauss_grad,
                p.gauss_weight, p.ref_grad, p.area0, p.rot_inertia, s.corners, s.old, s.kin,
                s.coef, s.geo, s.flag, s.exact, s.res, s.out_el, s.out_blk)
 

@@ -88,7 +88,7 @@ def main(argv: list[str]) -> None:
         section = model.sections[model.elem_section[e]]
         n_in = 4 if int(section[SL.C_INPLANE]) == SL.MEMBRANE_FULL else 1
         if kind == SL.MAT_FABRIC:
-            pts = state.mat[e, :n_in * width].reshape(n_in, width)
+            pts = state.mat[model.mat_row[e]:model.mat_row[e] + n_in, :width]
             line += (f"; λ_w,f {np.round(pts[:, FL.S_LAMBDA:FL.S_LAMBDA + 2], 2).tolist()}, "
                      f"broken {pts[:, FL.S_DAMAGE:FL.S_DAMAGE + 2].max(axis=0).tolist()}")
         print(line)

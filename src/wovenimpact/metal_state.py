@@ -1,8 +1,8 @@
 """Per-element quantities of metal (J2) sections, read from their points' states.
 
 A J2 section keeps one state row per material point (kernels/j2_layout.py): element e
-owns ``Model.point_width``-wide blocks in ``State.mat[e]``, in-plane point g (one, or
-four for a 2×2 membrane) and through-thickness level k at block ``g · n_pts + k``
+owns rows ``Model.mat_row[e]`` … of ``State.mat``, in-plane point g (one, or four for a
+2×2 membrane) and through-thickness level k at row ``mat_row[e] + g · n_pts + k``
 (kernels/shell.py, ``full_membrane`` / ``section_response``). Weighting a per-point
 quantity per unit reference area by the Simpson weight w_k (Σ w_k = 1) and the in-plane
 weight (A0 for one point, det J_g for the 2×2 points, Σ_g = A0) gives the element's
@@ -53,7 +53,8 @@ def _j2_point_values(model, state, column: int):
         if elems.size == 0:
             continue
         n_pts, n_in = int(row[SL.C_POINTS]), int(row[SL.C_INPLANE])
-        blocks = state.mat[elems, : n_in * n_pts * width].reshape(len(elems), n_in, n_pts, width)
+        rows = model.mat_row[elems][:, None] + np.arange(n_in * n_pts)
+        blocks = state.mat[rows, :width].reshape(len(elems), n_in, n_pts, width)
         if n_in == 4:
             w_in = model.gauss_weight[elems]
         else:

@@ -47,7 +47,8 @@ class State:
         v: (n_nodes, 3) velocities v^{n−1/2}.
         omega: (n_nodes, 3) angular velocities ω^{n−1/2} (global axes).
         elem: (n_elems, N_ELEM_STATE) element state (shell_layout).
-        mat: (n_elems, n_mat_state) material state of each element's point.
+        mat: (n_rows, max(1, Model.point_width)) material state, one row per point:
+            element e's points in rows Model.mat_row[e] … mat_row[e + 1] − 1.
         f_int: (n_nodes, 6) internal forces and moments at x^n.
         f_ext: (n_nodes, 6) external forces, body forces and reactions at x^n.
         node_active: (n_nodes,) 1 while a node belongs to at least one live element.
@@ -109,6 +110,18 @@ class State:
         return True
 
 
+def initial_material_rows(model) -> np.ndarray:
+    """``State.mat`` at the start: each element's rows (``Model.mat_row``) from its
+    section's initial point blocks (``Model.section_state0``)."""
+    width = max(1, model.point_width)
+    counts = np.diff(model.mat_row)
+    section = np.repeat(model.elem_section, counts)  # of each row
+    point = np.arange(model.mat_row[-1]) - np.repeat(model.mat_row[:-1], counts)
+    blocks = model.section_state0.shape[1] // width
+    per_point = model.section_state0[:, :blocks * width].reshape(-1, blocks, width)
+    return np.ascontiguousarray(per_point[section, point])
+
+
 def initial_state(model, velocity=None, angular_velocity=None) -> State:
     """State at t = 0: reference positions, the given velocity field, materials at rest.
 
@@ -127,7 +140,7 @@ def initial_state(model, velocity=None, angular_velocity=None) -> State:
         elem[:, col] = 1.0
         elem[:, col + 3] = 1.0
     elem[:, SL.E_ALIVE] = 1.0
-    mat = model.section_state0[model.elem_section].copy()
+    mat = initial_material_rows(model)
     energy = np.zeros(N_ENERGY)
     ke = 0.5 * (np.sum(model.node_mass[:, None] * v * v) + np.sum(model.node_inertia[:, None] * w * w))
     bodies = model.body_state0.copy()

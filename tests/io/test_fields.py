@@ -124,8 +124,10 @@ def test_fabric_columns_come_from_the_material_state(tmp_path, model, kevlar):
     which = np.array(["steel", "fabric", "fabric", "steel"])
     fm = build_model(mesh.nodes, mesh.quads, sections, which)
     s = initial_state(fm)
-    s.mat[:, FL.S_TENSION:FL.S_TENSION + 2] = [[1.0, 2.0], [3.0, 4.0], [5.0, 6.0], [7.0, 8.0]]
-    s.mat[:, FL.S_DAMAGE:FL.S_DAMAGE + 2] = 0.5
+    first = fm.mat_row[:-1]  # each element's first point's material row
+    s.mat[first, FL.S_TENSION:FL.S_TENSION + 2] = [[1.0, 2.0], [3.0, 4.0], [5.0, 6.0],
+                                                   [7.0, 8.0]]
+    s.mat[first, FL.S_DAMAGE:FL.S_DAMAGE + 2] = 0.5
     cd = {k: v[0] for k, v in meshio.read(FieldWriter(tmp_path, fm).write(s)).cell_data.items()}
     assert cd["tension_warp"].tolist() == [0.0, 3.0, 5.0, 0.0]
     assert cd["tension_fill"].tolist() == [0.0, 4.0, 6.0, 0.0]
@@ -139,8 +141,8 @@ ALUMINIUM = MetalParameters(name="al", kind="j2_plastic", density=2780.0, modulu
 
 def test_metal_and_integrated_fabric_columns_in_one_model(tmp_path, kevlar):
     """Fabric integrated through the thickness (3 points) beside a J2 metal (5 points):
-    a point's block is then Model.point_width (16) wide, and the fabric columns come from
-    the mid-level point's block; a metal element's plastic_strain is the largest ε̄p of
+    a point's row of State.mat is then Model.point_width (16) wide, and the fabric columns
+    come from the mid-level point's row; a metal element's plastic_strain is the largest ε̄p of
     its points and its thickness_ratio the Simpson-weighted λ3 (1/12, 4/12, 2/12, 4/12,
     1/12); a fabric element has 0 and 1, a metal one at rest 0 and 1."""
     mesh = plate_mesh(0.02, 0.01)
@@ -150,9 +152,10 @@ def test_metal_and_integrated_fabric_columns_in_one_model(tmp_path, kevlar):
     w = fm.point_width
     assert w == J.N_STATE > FL.N_STATE
     s = initial_state(fm)
-    s.mat[1:3, w + FL.S_TENSION] = [3.0, 5.0]  # level 1 of 3: the mid-surface
-    s.mat[0, np.arange(5) * w + J.S_EPS_P] = [0.01, 0.02, 0.05, 0.02, 0.01]
-    s.mat[0, np.arange(5) * w + J.S_THICK] = [0.9, 0.96, 1.0, 0.96, 0.9]
+    assert s.mat.shape[1] == w
+    s.mat[fm.mat_row[1:3] + 1, FL.S_TENSION] = [3.0, 5.0]  # level 1 of 3: the mid-surface
+    s.mat[fm.mat_row[0] + np.arange(5), J.S_EPS_P] = [0.01, 0.02, 0.05, 0.02, 0.01]
+    s.mat[fm.mat_row[0] + np.arange(5), J.S_THICK] = [0.9, 0.96, 1.0, 0.96, 0.9]
     cd = {k: v[0] for k, v in meshio.read(FieldWriter(tmp_path, fm).write(s)).cell_data.items()}
     assert cd["tension_warp"].tolist() == [0.0, 3.0, 5.0, 0.0]
     assert cd["plastic_strain"].tolist() == [0.05, 0.0, 0.0, 0.0]

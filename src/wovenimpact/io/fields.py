@@ -88,16 +88,16 @@ def element_fields(model, state: State, fabric: np.ndarray) -> dict[str, np.ndar
         "ply": np.asarray(model.ply, dtype=np.int64),
         "element": np.arange(model.n_elems, dtype=np.int64),
     }
-    # integrated sections: the mid-surface point (block points // 2 of the state row)
-    # (a point's block is model.point_width wide: 16 beside a metal section, not FL.N_STATE)
+    # integrated sections: the mid-surface point of the first in-plane point (row
+    # points // 2 of the element's material rows, Model.mat_row)
     n_points = model.sections[model.elem_section, SL.C_POINTS].astype(np.int64)
-    mid = (n_points // 2) * model.point_width
-    rows = np.flatnonzero(fabric)
+    elems = np.flatnonzero(fabric)
+    rows = model.mat_row[elems] + n_points[elems] // 2
     for name, col in (("tension_warp", FL.S_TENSION), ("tension_fill", FL.S_TENSION + 1),
                       ("damage_warp", FL.S_DAMAGE), ("damage_fill", FL.S_DAMAGE + 1)):
         values = np.zeros(model.n_elems)
-        if rows.size:
-            values[rows] = state.mat[rows, mid[rows] + col]
+        if elems.size:
+            values[elems] = state.mat[rows, col]
         out[name] = values
     out["thickness_ratio"] = thickness_ratio(model, state)
     out["plastic_strain"] = max_plastic_strain(model, state)

@@ -36,6 +36,7 @@ class ShellMesh(NamedTuple):
     gauss_weight: np.ndarray  # (n_elems, 4) their weights (det J)
     rot_inertia: np.ndarray  # (n_elems,) rotary inertia lumped on each corner (kg m²)
     point_width: int  # values per material point state block
+    mat_row: np.ndarray  # (n_elems + 1,) element e's material rows mat_row[e] … [e + 1] − 1
     step_mode: int  # shell_layout STEP_*: the fabric elements' stable step
 
 
@@ -53,7 +54,7 @@ class ElementTables(NamedTuple):
 
     el_in: np.ndarray  # (n_elems, N_ELEM_STATE)
     el_out: np.ndarray
-    mat_in: np.ndarray  # (n_elems, width): an element's point blocks side by side
+    mat_in: np.ndarray  # (n_rows, width): one row per material point (ShellMesh.mat_row)
     mat_out: np.ndarray
 
 

@@ -730,7 +730,7 @@ def carry_state(e, el_in, el_out, rows_in, rows_out, row0, n_rows):
 
 
 @kernel
-def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
+def shell_force(e, mesh, motion, dt, tables, blocks):
     """Internal forces of shell element e at x^n (see the module docstring).
 
     Args:
@@ -738,12 +738,12 @@ def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
         mesh: :class:`~wovenimpact.kernels.bundles.ShellMesh` (Model tables).
         motion: :class:`~wovenimpact.kernels.bundles.Motion`: x^n, v^{n−1/2}, ω^{n−1/2}.
         dt: Δt^{n−1/2}, the step the rates act over (0 at the start).
-        tables: :class:`~wovenimpact.kernels.bundles.ElementTables` whose material
-            tables are one row per point (rows_in, rows_out below).
+        tables: :class:`~wovenimpact.kernels.bundles.ElementTables` (el_in, el_out,
+            rows_in, rows_out below).
         el_in, el_out: element state tables (shell_layout), start / end of step.
         rows_in, rows_out: material point states, start / end of step, one row per
-            point: element e owns rows e·point_blocks … + point_blocks − 1, of which
-            its section uses the first C_POINTS·C_INPLANE (only those are carried).
+            point: element e owns rows mesh.mat_row[e] … mat_row[e + 1] − 1
+            (``Model.mat_row``).
             An eroded element's rows are carried only while the out tables still
             hold it alive (the first step after its erosion): both tables then hold
             the same rows for good, provided they did when the run started.
@@ -763,11 +763,8 @@ def shell_force(e, mesh, motion, dt, tables, point_blocks, blocks):
     sections, mat_kind, mat_params = mesh.sections, mesh.mat_kind, mesh.mat_params
     el_in, el_out, rows_in, rows_out = tables.el_in, tables.el_out, tables.mat_in, tables.mat_out
     sec = np.uint64(mesh.elem_section[e])
-    # the rows the element's section uses (a fabric section of a model that also holds
-    # 2×2×5-point metal uses 4 of the 20 point rows each element owns)
-    n_rows = min(np.uint64(sections[sec, C_POINTS] * sections[sec, C_INPLANE]),
-                 np.uint64(point_blocks))
-    row0 = e * np.uint64(point_blocks)
+    row0 = np.uint64(mesh.mat_row[e])
+    n_rows = np.uint64(mesh.mat_row[e + np.uint64(1)]) - row0
     if el_in[e, E_ALIVE] == 0.0:
         # eroded: its state no longer changes; the other buffer needs it once more
         if el_out[e, E_ALIVE] != 0.0:
@@ -947,11 +944,11 @@ def finish_element(e, st, er, dt_check, el_out, blocks, status, eroded_now, aliv
 
 
 @kernel
-def scalar_element(e, mesh, motion, dt, tables, point_blocks, blocks, status, eroded_now,
-                   alive, dt_erode, erode_inverted):
+def scalar_element(e, mesh, motion, dt, tables, blocks, status, eroded_now, alive, dt_erode,
+                   erode_inverted):
     """``shell_force`` of element e, then :func:`finish_element`; returns the latter's
     (failed, eroded, own step)."""
-    st, er, dt_check = shell_force(e, mesh, motion, dt, tables, point_blocks, blocks)
+    st, er, dt_check = shell_force(e, mesh, motion, dt, tables, blocks)
     return finish_element(e, st, er, dt_check, tables.el_out, blocks, status, eroded_now,
                           alive, dt_erode, erode_inverted)
 
@@ -961,8 +958,8 @@ def internal_force_for_shells(mesh, motion, dt, tables, results, dt_erode, erode
     """``shell_force`` for every element (prange; each element writes its own rows).
 
     Args: mesh (``bundles.ShellMesh``); motion (``bundles.Motion``); dt; tables
-    (``bundles.ElementTables``: mat_in, mat_out (n_elems, width), an element's points'
-    state blocks of ``mesh.point_width`` values side by side); results
+    (``bundles.ElementTables``: mat_in, mat_out one row per material point, element e's
+    from ``mesh.mat_row[e]``); results
     (``bundles.ElementResults``, written: blocks (n_elems, 4, 6); status, eroded_now
     (n_elems,); alive (n_elems,) uint8: 1 for an element alive at the end of the step, a
     compact copy of ``el_out[:, E_ALIVE]`` for the node kernels); dt_erode: an element
@@ -992,24 +989,10 @@ def internal_force_for_shells(mesh, motion, dt, tables, results, dt_erode, erode
     n_failed = 0
     n_eroded = 0
     dt_min = math.inf
-    # the material state as one row per point: an element's row of mat_in holds its
-    # points' state blocks side by side; elastic-only models have none (point_width 0)
-    m_in = tables.mat_in
-    m_out = tables.mat_out
-    point_width = mesh.point_width
-    width = m_in.shape[1]
-    point_blocks = width // point_width if point_width > 0 else 0
-    if point_blocks > 0 and point_blocks * point_width == width:
-        rows_in = m_in.reshape((ne * point_blocks, point_width))
-        rows_out = m_out.reshape((ne * point_blocks, point_width))
-    else:
-        rows_in = m_in
-        rows_out = m_out
-        point_blocks = 1
-    rows = ElementTables(tables.el_in, el_out, rows_in, rows_out)
+    rows = ElementTables(tables.el_in, el_out, tables.mat_in, tables.mat_out)
     for e in prange(ne):
-        failed, er, dt_own = scalar_element(np.uint64(e), mesh, motion, dt, rows, point_blocks,
-                                            blocks, status, eroded_now, alive, dt_erode,
+        failed, er, dt_own = scalar_element(np.uint64(e), mesh, motion, dt, rows, blocks,
+                                            status, eroded_now, alive, dt_erode,
                                             erode_inverted)
         dt_min = min(dt_min, dt_own)
         n_failed += failed

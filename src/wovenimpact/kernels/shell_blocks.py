@@ -392,8 +392,7 @@ def crossover_points(tid, kin, coef, geo, res, mc):
 
 
 @block_kernel
-def exact_points(p, m, tid, b, elems, point_blocks, el_in, rows_in, rows_out, kin, exact, flag,
-                 res):
+def exact_points(p, m, tid, b, elems, mat_row, el_in, rows_in, rows_out, kin, exact, flag, res):
     """Stage 4′ (scalar): the points marked in exact (a yarn damaged, outside the table or
     in an exactly-solved cell) by ``fabric.fabric_point`` itself, as ``section_response``
     calls it — its row of rows_out written, its results into res in place of the
@@ -411,7 +410,7 @@ def exact_points(p, m, tid, b, elems, point_blocks, el_in, rows_in, rows_out, ki
         o11, o12, o21, o22 = through_thickness_f(
             0.0, el_in[e, E_KAPPA], el_in[e, E_KAPPA + 1], el_in[e, E_KAPPA + 2],
             el_in[e, col], el_in[e, col + 1], el_in[e, col + 2], el_in[e, col + 3])
-        row = e * _U(point_blocks) + _U(g)
+        row = _U(mat_row[e]) + _U(g)
         st, stiff, n_xx, n_yy, n_xy, k_shear, k_w, k_f = fabric_point(
             p, m, o11, o12, o21, o22, kin[tid, atq(0, q)], kin[tid, atq(1, q)],
             kin[tid, atq(2, q)], kin[tid, atq(3, q)], rows_in, rows_out, row)
@@ -742,16 +741,9 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
     pending = scratch.pending
     m_in = tables.mat_in
     m_out = tables.mat_out
-    point_width = mesh.point_width
-    width = m_in.shape[1]
-    point_blocks = width // point_width if point_width > 0 else 0
-    if point_blocks > 0 and point_blocks * point_width == width:
-        rows_in = m_in.reshape((ne * point_blocks, point_width))
-        rows_out = m_out.reshape((ne * point_blocks, point_width))
-    else:
-        rows_in = m_in
-        rows_out = m_out
-        point_blocks = 1
+    mat_row = mesh.mat_row
+    rows_in = m_in
+    rows_out = m_out
     pw = rows_in.shape[1]
     rows = ElementTables(el_in, el_out, rows_in, rows_out)
     n_failed = 0
@@ -798,7 +790,7 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
                 for k in range(16):
                     out_el[tid, at(E_FG + k, lu)] = el_in[e, E_FG + k]
             else:
-                row0 = e * _U(point_blocks)
+                row0 = _U(mat_row[e])
                 for g in range(4):
                     r = row0 + _U(g)
                     worn += 0.0 if rows_in[r, FL.S_ALIVE] != 0.0 else 1.0
@@ -822,7 +814,7 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
             kinematics_lanes(tid, b, cn, old, gg, rg, dt, kin, flag)
             table_lookup(mat_params, m, tid, kin, coef, geo, exact)
             crossover_points(tid, kin, coef, geo, res, material_lanes(mat_params, m))
-            exact_points(mat_params, m, tid, b, elems, point_blocks, el_in, rows_in, rows_out,
+            exact_points(mat_params, m, tid, b, elems, mat_row, el_in, rows_in, rows_out,
                          kin, exact, flag, res)
             element_lanes(tid, b, cn, old, res, flag, gg, gw, rg, a0s, inert, out_el, out_blk,
                           dt, thick, mu, e_b, nu_b, kgt, r_hg, step_yarn)
@@ -841,7 +833,7 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
             for i in range(4):
                 for k in range(6):
                     blocks[e, i, k] = out_blk[tid, at(6 * i + k, lu)]
-            row0 = e * _U(point_blocks)
+            row0 = _U(mat_row[e])
             if kind == MAT_ELASTIC:  # shell.carry_state's one row (an elastic point has none)
                 for j in range(pw):
                     rows_out[row0, j] = rows_in[row0, j]
@@ -889,14 +881,14 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
             if pending[k] == 0:
                 continue
             failed, er, dt_own = scalar_element(_U(elems[k]), mesh, motion, dt, rows,
-                                                point_blocks, blocks, status, eroded_now,
+                                                blocks, status, eroded_now,
                                                 alive, dt_erode, erode_inverted)
             dt_min = min(dt_min, dt_own)
             n_failed += failed
             n_eroded += er
     for k in prange(others.shape[0]):
         failed, er, dt_own = scalar_element(_U(others[k]), mesh, motion, dt, rows,
-                                            point_blocks, blocks, status, eroded_now, alive,
+                                            blocks, status, eroded_now, alive,
                                             dt_erode, erode_inverted)
         dt_min = min(dt_min, dt_own)
         n_failed += failed

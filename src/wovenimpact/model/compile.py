@@ -396,11 +396,11 @@ def spin_blade(model: Model, state: State, mesh: Mesh, section: Section, omega, 
     state.omega[nodes] = spun.omega
     state.elem[elems] = spun.elem
     width = min(free.point_width, model.point_width)
-    if width:
-        blocks = spun.mat.shape[1] // free.point_width
-        dst = state.mat[elems].reshape(len(elems), -1, model.point_width)
-        dst[:, :blocks, :width] = spun.mat.reshape(len(elems), blocks, free.point_width)[..., :width]
-        state.mat[elems] = dst.reshape(len(elems), -1)
+    if width:  # the blade's points' rows (the same section, so as many rows per element)
+        n_rows = np.diff(free.mat_row)
+        src = np.arange(free.mat_row[-1])  # the blade model's rows, element by element
+        dst = src + np.repeat(model.mat_row[elems] - free.mat_row[:-1], n_rows)
+        state.mat[dst, :width] = spun.mat[src, :width]
     ke = 0.5 * float(np.sum(model.node_mass[:, None] * state.v**2)
                      + np.sum(model.node_inertia[:, None] * state.omega**2))
     state.energy[KINETIC] = ke

@@ -34,12 +34,9 @@ def blocks_enabled() -> bool:
     return os.environ.get("WOVENIMPACT_BLOCKS", "1").strip() != "0"
 
 
-def block_sections(model, width: int) -> list[int]:
-    """The sections whose elements the block stage can take (the module docstring), for
-    material rows ``width`` wide: a fabric section only when those rows are whole blocks
-    of at least four points."""
-    pw = model.point_width
-    fabric_rows = pw > 0 and width % pw == 0 and width // pw >= 4
+def block_sections(model) -> list[int]:
+    """The sections whose elements the block stage can take (the module docstring)."""
+    fabric_rows = model.point_width > 0  # (a 2×2 fabric section's element owns 4 rows)
     out = []
     for s, row in enumerate(model.sections):
         m = int(row[SL.C_MAT])
@@ -69,7 +66,7 @@ def block_plan(model, state) -> BlockPlan | None:
     """The plan for ``model`` (None when no element qualifies or blocks are disabled)."""
     if not blocks_enabled():
         return None
-    secs = block_sections(model, state.mat.shape[1])
+    secs = block_sections(model)
     if not secs:
         return None
     elems, lanes, section = [], [], []

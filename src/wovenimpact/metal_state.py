@@ -44,7 +44,6 @@ def simpson_weights(n_pts: int) -> np.ndarray:
 def _j2_point_values(model, state, column: int):
     """For each J2 section: (elements, in-plane weights (m²), Simpson weights, values
     (elements, in-plane points, levels)) of state column ``column``."""
-    width = model.point_width
     for sec in range(model.sections.shape[0]):
         row = model.sections[sec]
         if model.mat_kind[int(row[SL.C_MAT])] != SL.MAT_J2:
@@ -54,12 +53,12 @@ def _j2_point_values(model, state, column: int):
             continue
         n_pts, n_in = int(row[SL.C_POINTS]), int(row[SL.C_INPLANE])
         rows = model.mat_row[elems][:, None] + np.arange(n_in * n_pts)
-        blocks = state.mat[rows, :width].reshape(len(elems), n_in, n_pts, width)
+        values = state.mat[rows, column].reshape(len(elems), n_in, n_pts)  # that column only
         if n_in == 4:
             w_in = model.gauss_weight[elems]
         else:
             w_in = model.area0[elems][:, None]
-        yield elems, w_in, simpson_weights(n_pts), blocks[..., column]
+        yield elems, w_in, simpson_weights(n_pts), values
 
 
 def plastic_work(model, state) -> float:

@@ -704,7 +704,6 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
     :class:`~wovenimpact.kernels.bundles.BlockScratch` (one row per thread).
     """
     # one bundle member per statement, read before the parallel loops (shell.py explains)
-    ne = mesh.quads.shape[0]
     quads = mesh.quads
     sections = mesh.sections
     mat_kind = mesh.mat_kind

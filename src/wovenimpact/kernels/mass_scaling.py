@@ -13,7 +13,8 @@ of each of its elements, its rotary inertia scaled by the same factor as its mas
 
 Mass added to a moving node, at its velocity, adds ½ Δm v·v + ½ ΔI ω·ω of kinetic
 energy, which the energy balance books as an input (``MASS_SCALING`` of the State).
-Both kernels are deterministic: serial minimum, per-node sums in CSR order.
+Both kernels are deterministic: a minimum and a count (exact in any order), per-node sums
+in CSR order.
 """
 
 from __future__ import annotations
@@ -23,10 +24,10 @@ import math
 import numpy as np
 from numba import prange
 
-from wovenimpact.jit import kernel, loop_kernel
+from wovenimpact.jit import loop_kernel
 
 
-@kernel
+@loop_kernel
 def scale_element_masses(elem, col_dt, col_kin, alive, ratio, dt_target):
     """Raise r_e of the live elements whose scaled step Δt_e √(1 + r_e) is below
     ``dt_target`` (same units as ``elem[:, col_dt]``: L_e/c_e, before the factor α).
@@ -40,13 +41,12 @@ def scale_element_masses(elem, col_dt, col_kin, alive, ratio, dt_target):
     """
     raised = 0
     dt_min = math.inf
-    for e in range(elem.shape[0]):
+    for e in prange(elem.shape[0]):  # (a count and a minimum: exact in any order)
         if alive[e] == 0:
             continue
-        dt_min = min(dt_min, elem[e, col_kin])
         d = elem[e, col_dt]
         if not (d > 0.0) or not math.isfinite(d):
-            dt_min = min(dt_min, d)
+            dt_min = min(dt_min, min(elem[e, col_kin], d))
             continue
         scaled = d * math.sqrt(1.0 + ratio[e])
         if scaled < dt_target:
@@ -54,7 +54,7 @@ def scale_element_masses(elem, col_dt, col_kin, alive, ratio, dt_target):
             ratio[e] = q * q - 1.0
             scaled = dt_target
             raised += 1
-        dt_min = min(dt_min, scaled)
+        dt_min = min(dt_min, min(elem[e, col_kin], scaled))
     return raised, dt_min
 
 

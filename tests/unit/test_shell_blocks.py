@@ -116,13 +116,13 @@ def test_mixed_sections_and_exact_crossover():
     """Metal elements and a fabric section solved exactly stay with shell_force; the
     tabulated fabric beside them in blocks; the whole state bitwise the scalar one."""
     model, st = fabric_plate(10, metal_rows=3)
-    plan = block_plan(model, st)
+    plan = block_plan(model)
     metal = np.flatnonzero(model.elem_section == 1)
     assert set(metal) <= set(plan.others) and not set(metal) & set(plan.elems)
     a, b, wa, wb, _ = run_both(model, st, 10)
     assert_same(a, b, wa, wb)
-    model, st = fabric_plate(6, crossover="exact")
-    assert block_plan(model, st) is None
+    model, _ = fabric_plate(6, crossover="exact")
+    assert block_plan(model) is None
 
 
 @pytest.mark.parametrize("stable_step", ["isotropic", "yarn"])
@@ -144,7 +144,7 @@ def test_fabric_elastic_and_j2_sections_together():
     """Fabric and elastic blocks and J2 elements (shell_force) in one model: the plan
     takes the fabric and the elastic sections, and the state is bitwise the scalar one."""
     model, st = fabric_plate(10, metal_rows=2, elastic_rows=3, stable_step="yarn")
-    plan = block_plan(model, st)
+    plan = block_plan(model)
     for s in (0, 2):  # fabric, steel
         ids = np.flatnonzero(model.elem_section == s)
         assert set(ids) <= set(plan.elems) and not set(ids) & set(plan.others)
@@ -158,9 +158,9 @@ def test_fabric_elastic_and_j2_sections_together():
 
 
 def test_blocks_can_be_switched_off(monkeypatch):
-    model, st = fabric_plate(4)
+    model, _ = fabric_plate(4)
     monkeypatch.setenv("WOVENIMPACT_BLOCKS", "0")
-    assert block_plan(model, st) is None
+    assert block_plan(model) is None
 
 
 def test_atan2_upper_within_one_ulp():

@@ -35,7 +35,6 @@ class ShellMesh(NamedTuple):
     gauss_grad: np.ndarray  # (n_elems, 4, 2, 4) the same at the 2×2 Gauss points
     gauss_weight: np.ndarray  # (n_elems, 4) their weights (det J)
     rot_inertia: np.ndarray  # (n_elems,) rotary inertia lumped on each corner (kg m²)
-    point_width: int  # values per material point state block
     mat_row: np.ndarray  # (n_elems + 1,) element e's material rows mat_row[e] … [e + 1] − 1
     step_mode: int  # shell_layout STEP_*: the fabric elements' stable step
 

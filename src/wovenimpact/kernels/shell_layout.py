@@ -46,10 +46,12 @@ Per-element state (``State.elem``, one row per element):
 - ``E_FG``: the in-plane F at the four Gauss points of a fully integrated membrane
   (4 × 4 values, point g at ``E_FG + 4 g``).
 
-The material state of an element is ``n_inplane × n_points`` consecutive blocks of
-``Model.point_width`` values (the longest state vector of the model's material kinds;
-a shorter one uses the first columns), block ``g · n_points + k`` for in-plane point g
-and through-thickness point k (one block for a one-point resultant section).
+The material state of an element is ``n_inplane × n_points`` consecutive rows of
+``State.mat`` from ``Model.mat_row[e]``, each ``Model.point_width`` values wide (the
+longest state vector of the model's material kinds; a shorter one uses the first
+columns): row ``mat_row[e] + g · n_points + k`` for in-plane point g and
+through-thickness point k (one row for a one-point resultant section, and one unused row
+for an elastic material).
 """
 
 from __future__ import annotations

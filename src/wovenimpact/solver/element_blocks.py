@@ -62,7 +62,7 @@ def _to_blocks(values: np.ndarray, elems: np.ndarray) -> np.ndarray:
     return np.ascontiguousarray(v.reshape(nb, LANES, width).transpose(0, 2, 1)).ravel()
 
 
-def block_plan(model, state) -> BlockPlan | None:
+def block_plan(model) -> BlockPlan | None:
     """The plan for ``model`` (None when no element qualifies or blocks are disabled)."""
     if not blocks_enabled():
         return None

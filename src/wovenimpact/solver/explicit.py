@@ -143,9 +143,9 @@ class Workspace:
             mat_kind=model.mat_kind, mat_params=model.mat_params, area0=model.area0,
             ref_grad=model.ref_grad, gauss_grad=model.gauss_grad,
             gauss_weight=model.gauss_weight, rot_inertia=model.elem_rot_inertia,
-            point_width=int(model.point_width), mat_row=model.mat_row,
+            mat_row=model.mat_row,
             step_mode=SL.STABLE_STEPS[model.stable_step])
-        ws.plan = block_plan(model, state)
+        ws.plan = block_plan(model)
         ws.scratch = block_scratch(ws.plan) if ws.plan is not None else None
         ws.results = ElementResults(blocks=ws.blocks, status=ws.status,
                                     eroded_now=ws.eroded_now, alive=ws.alive)

@@ -225,8 +225,8 @@ def layer_absorbed_energies(model, state) -> list[float]:
 
 def layer_materials(model) -> list[str]:
     """The material of each casing layer, innermost first (that of the section most of
-    its elements have): the material's own name, or, for a material file without one
-    (the fabric files), the name of the case's section."""
+    its elements have): the material's own name (the ``name`` of its file), or, for a
+    material built without one in code, the name of the case's section."""
     out = []
     for elems in layer_elements(model):
         sec = int(np.bincount(model.elem_section[elems]).argmax()) if elems.size else 0
@@ -266,12 +266,16 @@ def containment_outcome(h: dict, inner_radius: float, outer_radius: float = math
       (``fragment_beyond_casing``: past a sector's cut edge, where the rest of the ring
       is not modelled): model more of the ring. A heavy fragment still pushing intact
       layers is never ``escaped``.
-    Returns the outcome, ``contained`` (bool) and the exit speed (its speed at the end
-    if escaped, else 0)."""
+    Returns the outcome, ``contained`` (bool), the exit speed — its speed at the end if
+    escaped, 0 if contained, None if undecided (no exit speed is known: a fit or a
+    verdict must not read the speed of a fragment still in the casing as one) — and
+    ``fragment_speed_at_end_m_per_s`` whatever the outcome."""
     speed = np.asarray(h["fragment_speed_m_per_s"], dtype=float)
     outcome = str(row_outcomes(h, inner_radius, outer_radius)[-1])
+    exit_speed = {"escaped": float(speed[-1]), "contained": 0.0}.get(outcome)
     return {"outcome": outcome, "contained": outcome == "contained",
-            "fragment_exit_speed_m_per_s": 0.0 if outcome == "contained" else float(speed[-1])}
+            "fragment_exit_speed_m_per_s": exit_speed,
+            "fragment_speed_at_end_m_per_s": float(speed[-1])}
 
 
 def row_outcomes(h: dict, inner_radius: float, outer_radius: float = math.inf) -> np.ndarray:

@@ -531,7 +531,7 @@ IMPACT_SUMMARY_KEYS = ("outcome", "perforated", "residual_velocity_m_per_s",
                        "absorbed_energy_J", "absorbed_energy_per_ply_J", "max_deflection_m",
                        "max_deflection_per_ply_m", "peak_contact_force_N")
 CONTAINMENT_SUMMARY_KEYS = ("outcome", "contained", "fragment_exit_speed_m_per_s",
-                            "fragment_exit_speed_settled", "fragment_mass_kg", "fragment_initial_speed_m_per_s", "max_bulge_m",
+                            "fragment_speed_at_end_m_per_s", "fragment_exit_speed_settled", "fragment_mass_kg", "fragment_initial_speed_m_per_s", "max_bulge_m",
                             "casing_mass_kg", "casing_mass_per_area_kg_per_m2", "casing_layers",
                             "absorbed_energy_per_layer_J", "held_energy_per_layer_J",
                             "absorbed_energy_per_material_J", "stopped_when_decided")

@@ -197,9 +197,24 @@ def _magnitude(value, dimension: str, dim: Dimension, field: str, valid: str) ->
         ) from None
     if not math.isfinite(si):
         raise QuantityError(field, value, "is not a finite number", valid, expected=True)
+    if dimension in ANGULAR and _radian_power(unit) != 1:
+        # pint counts the radian as dimensionless: "166.6 Hz" would pass as 166.6 rad/s,
+        # a 2π error if cycles per second were meant
+        raise QuantityError(field, value, f"has no angle in its unit ({unit_text!r}: cycles "
+                            "or radians?)", f"{valid} (rad, deg, turn or rpm)",
+                            expected=True)
     # pint's factors carry ~1 ulp of rounding (1 g/cm^3 → 999.9999999999999 kg/m^3);
     # 15 significant digits give back the decimal the user wrote.
     return float(f"{si:.15g}")
+
+
+ANGULAR = ("angle", "angular_velocity")  # quantities whose unit must name an angle
+
+
+def _radian_power(unit: pint.Unit) -> float:
+    """The power of the radian in ``unit``'s root units: 1 for 'rad/s', 'rpm', 'deg'; 0
+    for 'Hz' and '1/s', which pint also converts to rad/s."""
+    return ureg.Quantity(1.0, unit).to_root_units().units._units.get("radian", 0)
 
 
 def _dimensionality_text(unit: pint.Unit) -> str:

@@ -268,7 +268,7 @@ name = "abaqus strip"
 steel = "{(ROOT / 'examples' / 'materials' / 'steel.toml').as_posix()}"
 [sections.plate]
 material = "steel"
-thickness = "0.01 mm"
+thickness = "10 mm"
 [mesh]
 kind = "abaqus"
 file = "strip.inp"

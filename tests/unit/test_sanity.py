@@ -183,3 +183,16 @@ def test_the_case_writer_round_trips():  # the corpus and these tests write TOML
     import tomllib
 
     assert tomllib.loads(dumps(IMPACT)) == IMPACT
+
+
+def test_a_mesh_in_millimetres_read_as_metres_is_refused(tmp_path):
+    """A 1 mm plate drawn in mm and read as m has 1 m elements, 2000 thicknesses of its
+    0.5 mm fabric: refused with the length_unit hint; read with length_unit = '1 mm' it
+    is the plate it was drawn as."""
+    (tmp_path / "plate.inp").write_text(plate_inp(h=1.0))
+    doc = _set(INP_CASE, "mesh.file", "plate.inp")
+    doc = _set(doc, "materials", {"kevlar": BASE["kevlar"]})
+    with pytest.raises(InputError, match=r"more than 1000.*length_unit = '1 mm'"):
+        compile_case(case_from_dict(doc, source="case.toml"), tmp_path)
+    spec = case_from_dict(_set(doc, "mesh.length_unit", "1 mm"), source="case.toml")
+    assert compile_case(spec, tmp_path).model.n_elems == 9

@@ -9,7 +9,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from wovenimpact.errors import InputError
-from wovenimpact.units import DIMENSIONS, to_si
+from wovenimpact.units import DIMENSIONS, QuantityError, to_si
 
 REL = 1e-14  # pint factors and the 15-digit rounding are exact to a few ulp
 
@@ -150,3 +150,19 @@ def test_lengths_in_mm_and_m_agree(x):
     assert to_si(f"{x!r} mm", "length", "f") == pytest.approx(
         to_si(f"{x!r} m", "length", "f") * 1e-3, rel=REL, abs=1e-300
     )
+
+
+@pytest.mark.parametrize("text", ["166.6 Hz", "1047 1/s", "5 kHz", "3 percent"])
+def test_an_angular_rate_or_angle_without_an_angle_unit_is_refused(text):
+    """pint counts the radian as dimensionless, so '166.6 Hz' converts to 166.6 rad/s: a
+    2π error when revolutions per second were meant. An angle or angular velocity must
+    name its angle (rad, deg, turn, rpm…)."""
+    dimension = "angle" if text.endswith("percent") else "angular_velocity"
+    with pytest.raises(QuantityError, match="has no angle in its unit"):
+        to_si(text, dimension, "spin.rate")
+
+
+@pytest.mark.parametrize("text, si", [("1047 rad/s", 1047.0), ("10000 rpm", 10000 * math.pi / 30),
+                                      ("360 deg/s", 2 * math.pi), ("1 turn/s", 2 * math.pi)])
+def test_angular_rates_with_an_angle_unit_convert(text, si):
+    assert to_si(text, "angular_velocity", "spin.rate") == pytest.approx(si, rel=1e-14)

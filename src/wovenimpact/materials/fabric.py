@@ -88,6 +88,7 @@ class FabricParameters:
         areal_density: measured areal mass (kg/m²); None = from yarn volume (§1.8).
         thickness: shell thickness (m); None = 2 (h_w0 + h_f0) (= 4 h0, Table 5-1).
         options: model variants.
+        name: the material file's name (a label for reports; no part of the model).
     """
 
     warp: YarnFamily
@@ -101,6 +102,7 @@ class FabricParameters:
     areal_density: float | None = None
     thickness: float | None = None
     options: FabricOptions = field(default_factory=FabricOptions)
+    name: str = field(default="", compare=False)
 
     # --- derived quantities ---------------------------------------------------
     @property

@@ -19,9 +19,9 @@ from wovenimpact.model.mesh import Mesh
 
 def _divisions(extent: float, size: float, label: str) -> int:
     if not (math.isfinite(extent) and extent > 0.0):
-        raise InputError(f"{label} = {extent!r} m must be > 0")
+        raise InputError(f"{label} = {extent:.6g} m must be > 0")
     if not (math.isfinite(size) and size > 0.0):
-        raise InputError(f"element_size = {size!r} m must be > 0")
+        raise InputError(f"element_size = {size:.6g} m must be > 0")
     n = int(math.ceil(extent / size - 1e-9))
     if n > 20000:
         raise InputError(f"{label} / element_size = {extent / size:.3g} elements along one "
@@ -73,7 +73,7 @@ def casing_mesh(
         raise InputError(f"casing layer radii {radii.tolist()} must increase outwards")
     # "360 deg" read through radians comes back as 360.0000000000002
     if not (0.0 < sector <= 360.0 + 1e-9):
-        raise InputError(f"casing sector = {sector!r}°; valid: 0 < sector ≤ 360")
+        raise InputError(f"casing sector = {sector:.6g}°; valid: 0 < sector ≤ 360")
     full = sector >= 360.0 - 1e-9
     sector = 360.0 if full else sector
     span = math.radians(sector)
@@ -235,18 +235,18 @@ def blade_mesh(
     (``release`` included in neither), ``blade``.
     """
     if not (0.0 < root_radius < crack_radius < tip_radius):
-        raise InputError(f"blade radii: need 0 < root_radius ({root_radius!r}) < crack_radius "
-                         f"({crack_radius!r}) < tip_radius ({tip_radius!r}) (m)")
+        raise InputError(f"blade radii: need 0 < root_radius ({root_radius:.6g}) < crack_radius "
+                         f"({crack_radius:.6g}) < tip_radius ({tip_radius:.6g}) (m)")
     for label, c in (("root_chord", root_chord), ("tip_chord", tip_chord)):
         if not (math.isfinite(c) and c > 0.0):
-            raise InputError(f"blade {label} = {c!r} m must be > 0")
+            raise InputError(f"blade {label} = {c:.6g} m must be > 0")
     if not (math.isfinite(tip_curve) and 0.0 <= tip_curve <= 0.5 * (tip_radius - crack_radius)):
-        raise InputError(f"blade tip_curve = {tip_curve!r} m: need 0 ≤ tip_curve ≤ half the "
+        raise InputError(f"blade tip_curve = {tip_curve:.6g} m: need 0 ≤ tip_curve ≤ half the "
                          f"fragment's span, (tip_radius − crack_radius)/2 = "
                          f"{0.5 * (tip_radius - crack_radius):g} m")
     for label, a in (("stagger", stagger), ("stagger + twist", stagger + twist)):
         if not (math.isfinite(a) and abs(a) <= 90.0 + 1e-9):  # "90 deg" read through radians
-            raise InputError(f"blade {label} = {a!r} deg must lie within [−90, 90] deg (the "
+            raise InputError(f"blade {label} = {a:.6g} deg must lie within [−90, 90] deg (the "
                              "chord turned from the axial direction towards the tangential)")
     n_in = _divisions(crack_radius - root_radius, element_size, "blade hub length")
     n_out = _divisions(tip_radius - crack_radius, element_size, "blade fragment length")

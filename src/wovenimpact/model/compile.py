@@ -20,6 +20,7 @@ from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.model.abaqus import read_inp
 from wovenimpact.model.gmsh import read_msh
 from wovenimpact.model.mesh import Mesh, plate_mesh
+from wovenimpact.model.containment_checks import check_containment, check_spin_speed
 from wovenimpact.model.sanity import check_case
 from wovenimpact.impactor import Impactor
 from wovenimpact.kernels import rigid_body as RB
@@ -421,7 +422,8 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         )
         for name, s in spec.sections.items()
     }
-    warp = getattr(spec.mesh, "warp_direction", None)
+    warp = (spec.mesh.warp if isinstance(spec.mesh, ImportedMeshSpec)
+            else getattr(spec.mesh, "warp_direction", None))
     if isinstance(spec.mesh, ContainmentMeshSpec):
         mesh, elem_sections, warp = containment_mesh(spec.mesh, sections)
     else:
@@ -514,14 +516,16 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     w[model.bc_code[:, 3:] == 1] = 0.0
     check_impactor_clearance(model)
     state = initial_state(model, velocity=v, angular_velocity=w)
-    check_case(spec, model, state, mesh, sections)  # model.sanity: before the expensive parts
+    dt = check_case(spec, model, state, mesh, sections)  # model.sanity: before the spin-up
     if spin is not None:
+        check_spin_speed(spec, model, mesh, dt)
         blade = {elem_sections[e] for e in mesh.elem_sets["blade.blade"]}
         if len(blade) != 1:
             raise InputError(f"mesh.containment.blade: the blade's elements have sections "
                              f"{sorted(blade)}; its spin state needs one section")
         spin_blade(model, state, mesh, sections[blade.pop()], spin,
                    spec.spin.relaxation_tolerance, warp)
+        check_containment(spec, model, state, mesh)  # on the spun blade
     for i, er in enumerate(spec.initial_erosion):
         erode_at_start(model, state, er, f"initial_erosion[{i}]")
     return CompiledCase(model=model, state=state, mesh=mesh, materials=materials)

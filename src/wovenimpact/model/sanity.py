@@ -14,7 +14,8 @@ error, is in docs/inputs.md):
   cross more than half the smallest element in one step (penalty contact and the
   element kinematics both assume small increments);
 - geometry: plies whose mid-planes are closer than a shell thickness overlap; a section
-  thicker than the whole mesh is not a shell;
+  thicker than the whole mesh is not a shell, and elements more than 1000 thicknesses
+  across are a unit slip (a mesh in mm read as m);
 - constraints: one degree of freedom both held and driven, or driven at two speeds;
 - the impactor: its path must cross the structure ahead of its nose; a contact later
   than ``run.end_time`` is a warning with the gap and the arrival time; an impactor
@@ -43,6 +44,9 @@ MAX_RADIUS_EXTENTS = 10.0  # impactor radius / largest extent of the mesh
 MIN_RADIUS_ELEMENTS = 0.1  # impactor radius / largest element edge (thesis study: 2.78/6 mm)
 MAX_QUIET_OUTPUTS = 1000  # outputs at every step beyond this many are warned of
 AREAL_MASS_FACTOR = 10.0  # a section's areal mass this far from its material's is warned of
+# element edge / thickness: casing rings at 21 mm over 0.25 mm plies are ~100; a mesh in mm
+# read as m gives thousands
+MAX_SIZE_TO_THICKNESS = 1000.0
 
 
 def _text(seconds: float) -> str:
@@ -187,12 +191,29 @@ def check_thickness(model, spec) -> None:
                 f"sections: thickness {t:.3g} m is below {MIN_THICKNESS:g} m in "
                 f"{_section_text(model, e, spec)} (valid: a structural shell, foil and "
                 "fabric are 10 µm and thicker)")
+        edge = _median_edge(model, sec)
+        if edge > MAX_SIZE_TO_THICKNESS * t:
+            e = int(np.flatnonzero(model.elem_section == sec)[0])
+            unit = ("; a mesh drawn in millimetres read as metres? give mesh.length_unit = "
+                    "'1 mm'" if hasattr(spec.mesh, "length_unit") else "")
+            raise InputError(
+                f"sections: elements {edge:.3g} m across (median edge) are "
+                f"{edge / t:.3g} times their thickness {t:.3g} m in "
+                f"{_section_text(model, e, spec)}, more than {MAX_SIZE_TO_THICKNESS:g} (valid: "
+                f"an impact model's elements, a few to a few hundred thicknesses{unit})")
         if extent > 0.0 and t > extent:
             e = int(np.flatnonzero(model.elem_section == sec)[0])
             raise InputError(
                 f"sections: thickness {t:.3g} m is larger than the whole mesh ({extent:.3g} m "
                 f"across) in {_section_text(model, e, spec)} (valid: a shell thinner than the "
                 "structure it models)")
+
+
+def _median_edge(model, sec: int) -> float:
+    """The median edge length (m) of the elements of section ``sec``."""
+    p = model.x0[model.quads[model.elem_section == sec]]
+    edges = np.linalg.norm(np.roll(p, -1, axis=1) - p, axis=2)
+    return float(np.median(edges[edges > 0])) if np.any(edges > 0) else 0.0
 
 
 def check_constraints(spec, mesh) -> None:
@@ -302,8 +323,9 @@ def warn_areal_mass(spec, sections) -> None:
                 f"times its material's {own:.3g} kg/m^2", InputWarning, stacklevel=3)
 
 
-def check_case(spec, model, state, mesh, sections) -> None:
-    """Every check of this module, cheapest first (see the module docstring)."""
+def check_case(spec, model, state, mesh, sections) -> float:
+    """Every check of this module, cheapest first (see the module docstring); returns
+    the first stable step Δt₁ (inf when none is known)."""
     check_constraints(spec, mesh)
     check_plies(spec, model)
     check_thickness(model, spec)
@@ -312,3 +334,4 @@ def check_case(spec, model, state, mesh, sections) -> None:
     dt = check_step_count(model, state, spec)
     warn_output_intervals(spec, dt)
     check_motion_per_step(model, state, dt, spec)
+    return dt

@@ -172,17 +172,35 @@ class ImportedMeshSpec(BaseModel):
     of one coordinate unit of the file ("1 mm" for a mesh drawn in millimetres; default
     1 m). ``warp_direction`` is a vector projected on each element, or
     ``"circumferential"``: the hoop direction about ``axis`` (through the origin), the
-    warp of a fabric wrapped on a cylinder (a casing). ``[mesh.containment]`` names the
-    sets of a containment model (:class:`ContainmentSetsSpec`)."""
+    warp of a fabric wrapped on a cylinder (a casing). Not given, it is
+    ``"circumferential"`` for a containment model and x = (1, 0, 0) otherwise.
+    ``[mesh.containment]`` names the sets of a containment model
+    (:class:`ContainmentSetsSpec`), whose blade spins about the z axis: its ``axis`` is
+    z."""
 
     model_config = STRICT
     kind: Literal["abaqus", "gmsh"]
     file: str = Field(min_length=1)
     sections: dict[str, str] = Field(min_length=1)  # element set → section name
     length_unit: quantity("length", gt=0, example="1 mm") = 1.0
-    warp_direction: Direction | Literal["circumferential"] = (1.0, 0.0, 0.0)
+    warp_direction: Direction | Literal["circumferential"] | None = None
     axis: Direction = (0.0, 0.0, 1.0)
     containment: ContainmentSetsSpec | None = None
+
+    @model_validator(mode="after")
+    def _containment_spins_about_z(self):
+        a = self.axis
+        if self.containment is not None and (a[0] != 0.0 or a[1] != 0.0 or a[2] <= 0.0):
+            raise ValueError(f"axis = {list(a)}: a containment model's blade spins about the "
+                             "z axis, so its casing's axis is z = [0, 0, 1]; turn the mesh")
+        return self
+
+    @property
+    def warp(self):
+        """``warp_direction``, or its default (see the class docstring)."""
+        if self.warp_direction is not None:
+            return self.warp_direction
+        return "circumferential" if self.containment is not None else (1.0, 0.0, 0.0)
 
 
 AbaqusMeshSpec = ImportedMeshSpec  # the name of the table before gmsh files were read
@@ -280,7 +298,10 @@ class SpinSpec(BaseModel):
     keeps turning; the fragment is released at ``release_time`` (theory §8.2)."""
 
     model_config = STRICT
-    rate: Spin = 1047.0
+    # counter-clockwise about +z (the generated blade's stagger and twist, and the fine
+    # zone placed downstream of it, assume this sense): > 0; a clockwise rotor is the
+    # mirror image of a counter-clockwise one
+    rate: quantity("angular_velocity", gt=0, example="1047 rad/s") = 1047.0
     release_time: quantity("time", ge=0, example="0 us") = 0.0
     relaxation_tolerance: quantity("dimensionless", gt=0, lt=0.1, example="1e-5") = 1e-5
 

@@ -20,7 +20,9 @@ from typing import Annotated, Any
 from pydantic import BaseModel, BeforeValidator, ConfigDict, ValidationError
 from pydantic_core import PydanticCustomError
 
-from wovenimpact.errors import InputError
+# InputWarning is re-exported here: one class for every input warning, which the CLI
+# prints as a `warning:` line
+from wovenimpact.errors import InputError, InputWarning  # noqa: F401
 from wovenimpact.units import QuantityError, bounds_text, describe, to_si
 
 STRICT = ConfigDict(extra="forbid", frozen=True)
@@ -29,8 +31,6 @@ STRICT = ConfigDict(extra="forbid", frozen=True)
 _MISSING = object()
 
 
-class InputWarning(UserWarning):
-    """An input is valid but suspicious (inconsistent parameters, ignored settings)."""
 
 
 @dataclass(frozen=True)

@@ -340,6 +340,7 @@ def _fabric_parameters(
         areal_density=spec.areal_density,
         thickness=spec.thickness,
         options=options,
+        name=spec.name,
     )
 
 

@@ -8,7 +8,7 @@ import meshio
 import numpy as np
 import pytest
 
-from wovenimpact.errors import InputError
+from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.model.abaqus import read_inp
 from wovenimpact.model.mesh import plate_mesh
 
@@ -62,7 +62,7 @@ def test_strip_with_a_triangle(tmp_path):
 
 def test_line_elements_are_skipped_with_a_warning(tmp_path):
     text = STRIP.replace("*NSET, NSET=left", "*ELEMENT, TYPE=B31\n30, 1, 2\n*NSET, NSET=left")
-    with pytest.warns(UserWarning, match="skipping 1 'line' elements"):
+    with pytest.warns(InputWarning, match="skipping 1 'line' elements"):
         m = read_inp(write(tmp_path, text))
     assert len(m.quads) == 3
     assert m.elem_sets["mixed"].tolist() == [1, 2]

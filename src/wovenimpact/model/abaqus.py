@@ -23,7 +23,7 @@ from pathlib import Path
 import meshio
 import numpy as np
 
-from wovenimpact.errors import InputError
+from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.model.mesh import Mesh
 from wovenimpact.spec.fields import read_text
 
@@ -97,7 +97,8 @@ def _block_offsets(path: Path, cells) -> list[int | None]:
             n += len(block.data)
         elif block.type in SKIPPED_TYPES:
             warnings.warn(f"{path}: skipping {len(block.data)} {block.type!r} elements "
-                          "(only shell quads and triangles are read)", stacklevel=3)
+                          "(only shell quads and triangles are read)", InputWarning,
+                          stacklevel=3)
             offsets.append(None)
         else:
             raise InputError(

@@ -90,6 +90,11 @@ def test_unknown_element_type_is_named(tmp_path):
         ("*ELEMENT, TYPE=S4R", "*NODE\n8, 5.0, 5.0, 0.0\n*ELEMENT, TYPE=S4R", "second *NODE"),
         ("*ELEMENT, TYPE=S3", "*ELSET, ELSET=early\n10\n*ELEMENT, TYPE=S3", "above the *ELEMENT"),
         ("11, 2, 3, 6, 5", "11, 2, 3, 6, 99", "cannot read"),
+        ("*NODE\n", "*Part, name=P\n*NODE\n", "*PART is not supported"),
+        ("*NSET, NSET=left", "*Assembly, name=A\n*Instance, name=I, part=P\n5.0, 0.0, 0.0\n"
+                             "*End Instance\n*NSET, NSET=left", "*ASSEMBLY is not supported"),
+        ("*NSET, NSET=left", "*Instance, name=I, part=P\n*End Instance\n*NSET, NSET=left",
+         "*INSTANCE is not supported"),
     ],
 )
 def test_constructs_meshio_would_misread_are_refused(tmp_path, old, new, words):

@@ -8,10 +8,10 @@ quad with its last node repeated. Line and vertex elements (beams, trusses) are
 skipped with a warning; any other element type is an :class:`InputError`.
 
 meshio reads a flat file only; the constructs it would misread silently are
-refused with a message instead (checked by :func:`_scan_keywords`): several
-``*NODE`` blocks (parts and instances), ``*INCLUDE``, a set defined twice, an
-``*ELSET`` that lists other sets by name, and an ``*ELSET`` placed above an
-``*ELEMENT`` block.
+refused with a message instead (checked by :func:`_scan_keywords`): ``*PART``,
+``*ASSEMBLY`` and ``*INSTANCE`` (an instance's translation and rotation would be
+lost), several ``*NODE`` blocks, ``*INCLUDE``, a set defined twice, an ``*ELSET``
+that lists other sets by name, and an ``*ELSET`` placed above an ``*ELEMENT`` block.
 """
 
 from __future__ import annotations
@@ -181,6 +181,11 @@ def _scan_keywords(path: Path) -> _Keywords:
             if n_node_blocks > 1:
                 raise InputError(f"{path}:{lineno}: a second *NODE block (parts or "
                                  "instances?); write the file without parts and assemblies")
+        elif keyword in ("PART", "ASSEMBLY", "INSTANCE"):
+            raise InputError(f"{path}:{lineno}: *{keyword} is not supported (parts and "
+                             "instances would be read without their placement); write the "
+                             "file flat (Abaqus/CAE: Model > Edit Attributes > Do not use "
+                             "parts and assemblies in input files)")
         elif keyword == "INCLUDE":
             raise InputError(f"{path}:{lineno}: *INCLUDE is not supported; inline the file")
         elif keyword == "ELEMENT":

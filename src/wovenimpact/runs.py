@@ -70,6 +70,7 @@ from wovenimpact.containment import (
 )
 from wovenimpact.provenance import changed_parts, digest_of, provenance, restart_parts
 from wovenimpact.solver import Workspace, energy_balance, step
+from wovenimpact.solver.explicit import error_fraction
 from wovenimpact.spec.case import load_case
 from wovenimpact.state import KINETIC0, MASS_SCALING, State
 
@@ -102,9 +103,10 @@ def history_columns(model) -> tuple[str, ...]:
     ``energy_drift_part_J`` is the balance's drift (solver.explicit.energy_balance),
     ``energy_normaliser_part_J`` the largest energy put into the model so far (the running
     maximum of its ``scale_J`` over the rows up to this one) and ``energy_error_fraction``
-    = |drift| / normaliser; summary.json's figure is the largest |drift| over the last
-    (largest) normaliser. ``body_force_work_part_J`` and ``reaction_work_part_J`` (supports
-    and prescribed motions) are the two parts of ``external_work_part_J``.
+    = |drift| / normaliser (0 while the normaliser is 0: no energy put in); summary.json's
+    figure is the largest |drift| over the last (largest) normaliser.
+    ``body_force_work_part_J`` and ``reaction_work_part_J`` (supports and prescribed
+    motions) are the two parts of ``external_work_part_J``.
     ``contact_energy_part_J`` is −(work of the contact forces): the penalty springs' energy
     plus ``contact_dissipated_part_J``, what contact dashpots and friction dissipated.
     ``plastic_work_part_J`` (models with a metal section): the plastic work of the J2
@@ -150,7 +152,7 @@ def history_row(model, state: State, normaliser: float = 0.0,
         "contact_dissipated_part_J": eb["contact_dissipated_J"],
         "body_force_work_part_J": eb["body_force_work_J"],
         "reaction_work_part_J": eb["reaction_work_J"], "energy_drift_part_J": eb["drift_J"],
-        "energy_error_fraction": abs(eb["drift_J"]) / scale,
+        "energy_error_fraction": error_fraction(eb["drift_J"], scale),
         "energy_normaliser_part_J": scale, "max_displacement_m": float(disp),
         "eroded_elements": int(np.sum(state.elem[:, SL.E_ALIVE] == 0.0)),
     }
@@ -450,7 +452,8 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
     model = compiled.model
     eb = energy_balance(model, state)
     cycles = state.step * model.n_elems
-    error = float(np.max(np.abs(h["energy_drift_part_J"])) / h["energy_normaliser_part_J"][-1])
+    error = error_fraction(np.max(np.abs(h["energy_drift_part_J"])),
+                           h["energy_normaliser_part_J"][-1])
     factor = symmetry_factor(model)
     impact = {}
     if is_containment(model):

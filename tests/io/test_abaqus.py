@@ -8,7 +8,7 @@ import meshio
 import numpy as np
 import pytest
 
-from wovenimpact.errors import InputError
+from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.model.abaqus import read_inp
 from wovenimpact.model.mesh import plate_mesh
 
@@ -62,7 +62,7 @@ def test_strip_with_a_triangle(tmp_path):
 
 def test_line_elements_are_skipped_with_a_warning(tmp_path):
     text = STRIP.replace("*NSET, NSET=left", "*ELEMENT, TYPE=B31\n30, 1, 2\n*NSET, NSET=left")
-    with pytest.warns(UserWarning, match="skipping 1 'line' elements"):
+    with pytest.warns(InputWarning, match="skipping 1 'line' elements"):
         m = read_inp(write(tmp_path, text))
     assert len(m.quads) == 3
     assert m.elem_sets["mixed"].tolist() == [1, 2]
@@ -90,6 +90,11 @@ def test_unknown_element_type_is_named(tmp_path):
         ("*ELEMENT, TYPE=S4R", "*NODE\n8, 5.0, 5.0, 0.0\n*ELEMENT, TYPE=S4R", "second *NODE"),
         ("*ELEMENT, TYPE=S3", "*ELSET, ELSET=early\n10\n*ELEMENT, TYPE=S3", "above the *ELEMENT"),
         ("11, 2, 3, 6, 5", "11, 2, 3, 6, 99", "cannot read"),
+        ("*NODE\n", "*Part, name=P\n*NODE\n", "*PART is not supported"),
+        ("*NSET, NSET=left", "*Assembly, name=A\n*Instance, name=I, part=P\n5.0, 0.0, 0.0\n"
+                             "*End Instance\n*NSET, NSET=left", "*ASSEMBLY is not supported"),
+        ("*NSET, NSET=left", "*Instance, name=I, part=P\n*End Instance\n*NSET, NSET=left",
+         "*INSTANCE is not supported"),
     ],
 )
 def test_constructs_meshio_would_misread_are_refused(tmp_path, old, new, words):

@@ -179,6 +179,29 @@ def test_triangles_go_to_their_own_block(tmp_path):
     assert m.cell_data["membrane_resultant"][1][0, 0] == 9.0
 
 
+@pytest.mark.parametrize("quads, types", [
+    ([[0, 1, 2, 3], [3, 2, 4, 4]], ["quad", "triangle"]),
+    ([[0, 1, 2, 2], [0, 2, 3, 3], [3, 2, 4, 4]], ["triangle"]),
+    ([[0, 1, 2, 3]], ["quad"]),
+])
+def test_triangle_only_quad_only_and_mixed_meshes_write_readable_files(tmp_path, quads, types):
+    """No empty cell block is written (meshio's VTU writer fails on one), whole model or
+    one part at a time: a part of triangles only has just its triangle block."""
+    nodes = np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], [0, 1, 0], [0.5, 2, 0]], dtype=float)
+    quads = np.array(quads)
+    tm = build_model(nodes, quads, {"p": Section(material=STEEL, thickness=1e-3)},
+                     np.zeros(len(quads), dtype=np.int64))
+    m = meshio.read(FieldWriter(tmp_path / "all", tm).write(initial_state(tm)))
+    assert [b.type for b in m.cells] == types
+    assert sum(len(b.data) for b in m.cells) == len(quads)
+    assert np.sort(np.concatenate(m.cell_data["element"])).tolist() == list(range(len(quads)))
+    last = [("rest", np.arange(len(quads) - 1)), ("last", [len(quads) - 1])]
+    w = FieldWriter(tmp_path / "parts", tm, parts=last[1:] if len(quads) == 1 else last)
+    w.write(initial_state(tm))
+    m = meshio.read(tmp_path / "parts" / "step_000000_last.vtu")
+    assert [(b.type, len(b.data)) for b in m.cells] == [(types[-1], 1)]
+
+
 def test_parts_are_blocks_of_each_frame_and_resume_by_frame(tmp_path, model):
     """A series in two parts (the plies here): each frame is a file per part with that
     part's nodes and elements only, listed in fields.pvd with its part index; a restart

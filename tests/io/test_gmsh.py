@@ -118,3 +118,44 @@ end_time = "1 us"
     assert not np.allclose(model.ref_grad, axial, atol=1e-3 * np.abs(ref).max())
     clamped = compiled.mesh.node_sets["end_low"]
     assert np.all(model.bc_code[clamped] != 0)
+
+
+def test_an_element_in_two_physical_groups_is_one_element_in_both_sets(tmp_path):
+    """gmsh 2.2 writes an element once per physical group it is in: BLADE (tag 1) holds
+    two quads and a triangle, RELEASE (tag 2) one quad and the triangle again. They are
+    read as three elements (not five: double mass), the sets overlapping."""
+    pts = np.array([[0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0], [1, 1, 0], [2, 1, 0],
+                    [1, 2, 0.0]])
+    q = np.array([[0, 1, 4, 3], [1, 2, 5, 4]])
+    t = np.array([[3, 4, 6]])
+    cells = [("quad", q), ("triangle", t), ("quad", q[1:]), ("triangle", t)]
+    phys = [np.array([1, 1]), np.array([1]), np.array([2]), np.array([2])]
+    meshio.write(tmp_path / "d.msh",
+                 meshio.Mesh(pts, cells, cell_data={"gmsh:physical": phys,
+                                                    "gmsh:geometrical": phys},
+                             field_data={"BLADE": np.array([1, 2]),
+                                         "RELEASE": np.array([2, 2])}),
+                 file_format="gmsh22", binary=False)
+    mesh = read_msh(tmp_path / "d.msh")
+    assert mesh.quads.tolist() == [[0, 1, 4, 3], [1, 2, 5, 4], [3, 4, 6, 6]]
+    assert mesh.elem_sets["BLADE"].tolist() == [0, 1, 2]
+    assert mesh.elem_sets["RELEASE"].tolist() == [1, 2]
+    assert mesh.node_sets["RELEASE"].tolist() == [1, 2, 3, 4, 5, 6]
+
+
+def test_a_missing_set_of_a_gmsh_file_suggests_format_2_2(tmp_path):
+    """meshio reads only the first physical group of each entity of a gmsh 4.1 file: the
+    error for a set a .msh file lacks says so (and an Abaqus file's does not)."""
+    from types import SimpleNamespace
+
+    from wovenimpact.model.compile import containment_sets
+
+    write_cylinder_sector(tmp_path / "c.msh")
+    sets = SimpleNamespace(blade="casing", release="RELEASE", root="end_low",
+                           fragment="casing", casing_layers=["casing"])
+    with pytest.raises(InputError, match=r"'RELEASE' is not an element set of c\.msh.*"
+                                         r"first physical group.*4\.1.*-format msh22"):
+        containment_sets(read_msh(tmp_path / "c.msh"), sets, "c.msh")
+    with pytest.raises(InputError) as err:
+        containment_sets(read_msh(tmp_path / "c.msh"), sets, "c.inp")
+    assert "msh22" not in str(err.value)

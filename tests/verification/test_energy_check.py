@@ -135,3 +135,32 @@ def test_the_tolerance_is_a_case_key(tmp_path):
     case.write_text(PLATE.replace("[run]", "[run]\nenergy_tolerance = 2") + CLAMPED, "utf-8")
     result = CliRunner().invoke(app, ["run", str(case), "--out", str(tmp_path / "bad")])
     assert result.exit_code == 2 and "run.energy_tolerance" in result.output
+
+
+def test_a_curved_mesh_at_rest_without_loads_has_error_0(tmp_path):
+    """Nothing moves and nothing loads a cylindrical sector (an imported gmsh casing): no
+    energy is put in (normaliser 0), and the round-off drift of its curved elements
+    (~1e-46 J) is not divided by a floor (was 1.75e254, a failed check). A tiny but
+    non-zero input is still judged relative to itself."""
+    from tests.io.test_gmsh import write_cylinder_sector
+    from wovenimpact.solver.explicit import error_fraction
+
+    write_cylinder_sector(tmp_path / "casing.msh")
+    s, h = run(tmp_path, PLATE.split("[mesh]")[0] + """
+[mesh]
+kind = "gmsh"
+file = "casing.msh"
+sections = { casing = "fabric" }
+length_unit = "1 mm"
+warp_direction = "circumferential"
+[[boundary]]
+nodes = "end_low"
+type = "clamped"
+[run]
+end_time = "30 us"
+""", "rest")
+    assert s["steps"] >= 4 and np.any(h["energy_drift_part_J"] != 0.0)
+    assert np.all(h["energy_normaliser_part_J"] == 0.0)
+    assert s["energy_error_fraction"] == 0.0 and s["energy_check"] == "pass"
+    assert np.all(h["energy_error_fraction"] == 0.0)
+    assert error_fraction(-1e-41, 1e-40) == pytest.approx(0.1)

@@ -13,7 +13,8 @@ configuration ``State.x`` with
 
 Quads are written as VTK quads; an element whose quad repeats a node (a triangle)
 is written as a VTK triangle in a second cell block, so VTK filters never see a
-degenerate quad. The ``element`` cell array maps cells back to Model elements.
+degenerate quad; a model of triangles only (or a part with no quads) has just the
+triangle block. The ``element`` cell array maps cells back to Model elements.
 After every file ``fields.pvd`` is rewritten atomically to list all files with
 their times; ParaView opens it as one time series.
 
@@ -68,16 +69,14 @@ def fabric_elements(model) -> np.ndarray:
 
 
 def cell_blocks(quads: np.ndarray) -> list[tuple[str, np.ndarray, np.ndarray]]:
-    """(VTK cell type, element indices, connectivity) of the quad and triangle blocks."""
+    """(VTK cell type, element indices, connectivity) of the quad and triangle blocks;
+    a block with no cells is left out (meshio's VTU writer fails on an empty block)."""
     q = np.asarray(quads, dtype=np.int64)
     distinct = q != np.roll(q, -1, axis=1)  # corner c differs from corner c + 1
     tri = distinct.sum(axis=1) == 3
-    blocks = [("quad", np.flatnonzero(~tri), q[~tri])]
-    if tri.any():
-        idx = np.flatnonzero(tri)
-        conn = q[tri][distinct[tri]].reshape(-1, 3)  # drop the repeated corner, keep order
-        blocks.append(("triangle", idx, conn))
-    return blocks
+    conn = q[tri][distinct[tri]].reshape(-1, 3)  # drop the repeated corner, keep order
+    blocks = [("quad", np.flatnonzero(~tri), q[~tri]), ("triangle", np.flatnonzero(tri), conn)]
+    return [b for b in blocks if len(b[1])]
 
 
 def element_fields(model, state: State, fabric: np.ndarray) -> dict[str, np.ndarray]:

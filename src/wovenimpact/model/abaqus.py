@@ -8,10 +8,10 @@ quad with its last node repeated. Line and vertex elements (beams, trusses) are
 skipped with a warning; any other element type is an :class:`InputError`.
 
 meshio reads a flat file only; the constructs it would misread silently are
-refused with a message instead (checked by :func:`_scan_keywords`): several
-``*NODE`` blocks (parts and instances), ``*INCLUDE``, a set defined twice, an
-``*ELSET`` that lists other sets by name, and an ``*ELSET`` placed above an
-``*ELEMENT`` block.
+refused with a message instead (checked by :func:`_scan_keywords`): ``*PART``,
+``*ASSEMBLY`` and ``*INSTANCE`` (an instance's translation and rotation would be
+lost), several ``*NODE`` blocks, ``*INCLUDE``, a set defined twice, an ``*ELSET``
+that lists other sets by name, and an ``*ELSET`` placed above an ``*ELEMENT`` block.
 """
 
 from __future__ import annotations
@@ -23,7 +23,7 @@ from pathlib import Path
 import meshio
 import numpy as np
 
-from wovenimpact.errors import InputError
+from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.model.mesh import Mesh
 from wovenimpact.spec.fields import read_text
 
@@ -97,7 +97,8 @@ def _block_offsets(path: Path, cells) -> list[int | None]:
             n += len(block.data)
         elif block.type in SKIPPED_TYPES:
             warnings.warn(f"{path}: skipping {len(block.data)} {block.type!r} elements "
-                          "(only shell quads and triangles are read)", stacklevel=3)
+                          "(only shell quads and triangles are read)", InputWarning,
+                          stacklevel=3)
             offsets.append(None)
         else:
             raise InputError(
@@ -180,6 +181,11 @@ def _scan_keywords(path: Path) -> _Keywords:
             if n_node_blocks > 1:
                 raise InputError(f"{path}:{lineno}: a second *NODE block (parts or "
                                  "instances?); write the file without parts and assemblies")
+        elif keyword in ("PART", "ASSEMBLY", "INSTANCE"):
+            raise InputError(f"{path}:{lineno}: *{keyword} is not supported (parts and "
+                             "instances would be read without their placement); write the "
+                             "file flat (Abaqus/CAE: Model > Edit Attributes > Do not use "
+                             "parts and assemblies in input files)")
         elif keyword == "INCLUDE":
             raise InputError(f"{path}:{lineno}: *INCLUDE is not supported; inline the file")
         elif keyword == "ELEMENT":

@@ -18,7 +18,7 @@ import numpy as np
 
 from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.model.abaqus import read_inp
-from wovenimpact.model.gmsh import read_msh
+from wovenimpact.model.gmsh import gmsh_hint, read_msh
 from wovenimpact.model.mesh import Mesh, plate_mesh
 from wovenimpact.model.containment_checks import check_containment, check_spin_speed
 from wovenimpact.model.sanity import check_case
@@ -126,7 +126,7 @@ def make_mesh(spec: CaseSpec, base: Path, sections: dict | None = None
     for elset, section in m.sections.items():
         if elset not in mesh.elem_sets:
             raise InputError(f"mesh.sections: element set {elset!r} is not in {m.file}; "
-                             f"sets there: {sorted(mesh.elem_sets)}")
+                             f"sets there: {sorted(mesh.elem_sets)}{gmsh_hint(m.file)}")
         for e in mesh.elem_sets[elset]:
             if names[e] is not None and names[e] != section:
                 raise InputError(f"mesh.sections: element {e} is in two sets with different "
@@ -319,7 +319,7 @@ def containment_sets(mesh: Mesh, sets, file: str) -> None:
     def elems(name: str, field: str) -> np.ndarray:
         if name not in mesh.elem_sets:
             raise InputError(f"{key}.{field}: {name!r} is not an element set of {file}; "
-                             f"element sets there: {sorted(mesh.elem_sets)}")
+                             f"element sets there: {sorted(mesh.elem_sets)}{gmsh_hint(file)}")
         idx = np.unique(np.asarray(mesh.elem_sets[name], dtype=np.int64))
         if idx.size == 0:
             raise InputError(f"{key}.{field}: element set {name!r} of {file} is empty")
@@ -332,7 +332,7 @@ def containment_sets(mesh: Mesh, sets, file: str) -> None:
             idx = np.unique(mesh.quads[np.asarray(mesh.elem_sets[name], dtype=np.int64)])
         else:
             raise InputError(f"{key}.{field}: {name!r} is neither a node set nor an element "
-                             f"set of {file}; node sets there: {sorted(mesh.node_sets)}")
+                             f"set of {file}; node sets: {sorted(mesh.node_sets)}{gmsh_hint(file)}")
         if idx.size == 0:
             raise InputError(f"{key}.{field}: set {name!r} of {file} holds no node")
         return idx

@@ -8,6 +8,12 @@ curve group names the edge to clamp. Names are the groups' names (``$PhysicalNam
 an unnamed group is ``"<dim>:<tag>"``; elements in no group (physical tag 0) are in
 no set. Line and point elements are not shells: they
 only feed the node sets. Any other element type (volumes) is an :class:`InputError`.
+
+Groups may overlap (a strip of the blade in both BLADE and RELEASE). Format 2.2 writes
+such an element once per group: shell elements with identical node lists are merged
+into one element that is in every group it was listed in. In format 4.1 meshio keeps
+only the first physical group of each gmsh entity, so the other groups lose those
+elements (:func:`gmsh_hint` says so where a set is missing).
 """
 
 from __future__ import annotations
@@ -58,9 +64,13 @@ def read_msh(path: str | Path) -> Mesh:
             groups.append(np.asarray(tags, dtype=np.int64))
     if not quads:
         raise InputError(f"{path}: no shell elements (quads or triangles) found")
-    quads = np.concatenate(quads)
-    groups = np.concatenate(groups)
-    elem_sets = {names.get((2, int(t)), f"2:{int(t)}"): np.flatnonzero(groups == t)
+    quads, groups = np.concatenate(quads), np.concatenate(groups)
+    # one element per distinct node list, in the file's order; element[i]: row i's element
+    _, first, row_of = np.unique(quads, axis=0, return_index=True, return_inverse=True)
+    order = np.argsort(first)
+    element = np.argsort(order)[row_of.ravel()]
+    quads = quads[first[order]]
+    elem_sets = {names.get((2, int(t)), f"2:{int(t)}"): np.unique(element[groups == t])
                  for t in np.unique(groups[groups != 0])}
     pts = np.asarray(raw.points, dtype=float)
     nodes = pts if pts.shape[1] == 3 else np.column_stack([pts, np.zeros(len(pts))])
@@ -74,3 +84,14 @@ def read_msh(path: str | Path) -> Mesh:
     return Mesh(nodes=nodes, quads=quads, ply=np.zeros(len(quads), dtype=np.int64),
                 node_sets={k: np.sort(v) for k, v in node_groups.items()},
                 elem_sets=elem_sets)
+
+
+def gmsh_hint(file: str) -> str:
+    """Text to append to a "set not found" error about mesh ``file``: for a gmsh file,
+    that meshio reads only the first physical group of each entity in format 4.1 and
+    that format 2.2 keeps them all; "" for any other file."""
+    if not str(file).lower().endswith(".msh"):
+        return ""
+    return ("; if it is a gmsh 4.1 file: meshio reads only the first physical group of each "
+            "gmsh entity in format 4.1 (a surface in two groups is in the first only), so "
+            "save the mesh in format 2.2 (gmsh -format msh22) to keep overlapping groups")

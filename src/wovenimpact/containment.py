@@ -376,9 +376,13 @@ def casing_summary(model, state, h: dict) -> dict:
     outcome = containment_outcome(h, casing_inner_radius(model), casing_outer_radius(model))
     casing_elems = np.flatnonzero(np.isin(model.quads, np.concatenate(
         [model.node_sets[s] for s in layers])).all(axis=1))
-    mass = float(np.sum(model.sections[model.elem_section[casing_elems], SL.C_AREAL_MASS]
-                        * model.area0[casing_elems]))
-    area = float(model.area0[casing_elems].sum())
+    areal = model.sections[model.elem_section, SL.C_AREAL_MASS]
+    mass = float(np.sum(areal[casing_elems] * model.area0[casing_elems]))
+    # the wall's mass per unit area: each layer's own (its mass over its area) summed
+    # through the wall — the mass over the mean layer area would weigh the heavy inner
+    # shell, at the smallest radius, by less than its areal mass (−0.4 % at 16 plies)
+    per_area = sum(float(np.sum(areal[e] * model.area0[e]) / np.sum(model.area0[e]))
+                   for e in layer_elements(model) if e.size)
     bulge = np.asarray(h.get("outer_layer_bulge_m", ()), dtype=float)
     return {
         **outcome,
@@ -392,6 +396,6 @@ def casing_summary(model, state, h: dict) -> dict:
         "held_energy_per_layer_J": layer_energies(model, state),
         "absorbed_energy_per_material_J": energy_per_material(model, state),
         "casing_mass_kg": mass,
-        "casing_mass_per_area_kg_per_m2": mass / area * len(layers) if area else None,
+        "casing_mass_per_area_kg_per_m2": per_area if per_area else None,
         "casing_layers": len(layers),
     }

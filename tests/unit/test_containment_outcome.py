@@ -521,3 +521,21 @@ def test_summary_json_takes_numpy_scalars_and_refuses_anything_else():
     assert json.loads(text) == {"a": True, "b": 1.5, "c": 3}
     with pytest.raises(TypeError, match="object"):
         json.dumps({"d": object()}, default=_json_scalar)
+
+
+def test_the_casing_mass_per_area_sums_the_layers_areal_masses():
+    """The wall's mass per unit area is each layer's areal mass summed through it: the
+    1 mm aluminium shell (2.78 kg/m²) and two Kevlar plies (the sections' own areal
+    masses) — not the mass over the mean layer area, which weighs the inner shell, at
+    the smallest radius, low."""
+    from wovenimpact.containment import casing_summary, fragment_row
+    from wovenimpact.kernels import shell_layout as SL
+
+    model, state = coarse_two_ply_casing()
+    h = {k: np.array([v]) for k, v in fragment_row(model, state).items()}
+    h["time_s"] = np.array([0.0])
+    summary = casing_summary(model, state, h)
+    sections = [model.section_names.index(s) for s in ("shell", "fabric", "fabric")]
+    expected = sum(float(model.sections[s, SL.C_AREAL_MASS]) for s in sections)
+    assert expected == pytest.approx(2.78 + 2 * 0.4775, rel=1e-3)
+    assert summary["casing_mass_per_area_kg_per_m2"] == pytest.approx(expected, rel=1e-12)

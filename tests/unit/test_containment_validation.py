@@ -208,3 +208,23 @@ def test_validate_containment_from_runs_names_its_command_and_set_needs_containm
                                    "--work", str(tmp_path / "w")])
     assert bad.exit_code != 0 and "--set goes with --containment" in bad.output
     assert not (tmp_path / "w").exists()
+
+
+def test_runs_that_contradict_the_regression_or_each_other_are_named(tmp_path):
+    """The metal ladder's case: the regression answered 14 layers although the 14-layer
+    run let the fragment out; and an escape above the fewest layers that contained is
+    a non-monotonic outcome. Both are said beside the answers."""
+    rows = [_row(n, "escaped", 130.0 + 4.0 * n - n * n, 2.8 * n) for n in (4, 8, 10, 12)]
+    rows += [_row(14, "escaped", 4.4, 39.0), _row(15, "contained", 0.0, 41.7),
+             _row(16, "escaped", 1.0, 44.5), _row(18, "contained", 0.0, 50.0)]
+    reg = cv.ladder_result(rows)["regression"]
+    assert reg.plies_to_stop <= 16
+    lines, _ = cv.ladder_lines("containment_metal", "Metal", "layers", {}, "note", rows,
+                               tmp_path)
+    text = "\n".join(lines)
+    assert "The runs contradict the regression" in text and "the runs' answer stands" in text
+    assert "Not monotonic: 16 layers let the fragment out although 15 contained it" in text
+    clean = [r for r in rows if r[cv.KEY] not in (14, 16)]
+    text = "\n".join(cv.ladder_lines("containment_metal", "Metal", "layers", {}, "note", clean,
+                                     tmp_path)[0])
+    assert "contradict" not in text and "Not monotonic" not in text

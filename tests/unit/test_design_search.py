@@ -171,3 +171,16 @@ def test_a_pack_that_failed_its_energy_check_is_named_with_its_summary(tmp_path)
     with pytest.raises(InputError, match=r"8 plies: the run failed: energy balance failed "
                        r"\(see .*plies_8/summary.json\)"):
         refuse_failed({4: "perforated", 8: "failed: energy balance failed"}, tmp_path)
+
+
+@pytest.mark.parametrize("override, field", [("mesh.casing.layers=abc", "mesh.casing.layers"),
+                                             ("mesh.casing.layers=0", "mesh.casing.layers")])
+def test_a_bad_containment_case_is_refused_before_any_run(tmp_path, override, field):
+    """The case is validated before the search starts: a clear error naming the key
+    (a ValueError or KeyError traceback before), and nothing is run."""
+    from wovenimpact.studies.design import design_plies
+
+    case = ROOT / "examples" / "containment" / "metal_24.toml"
+    with pytest.raises(InputError, match=field):
+        design_plies(case, tmp_path / "out", overrides=[override])
+    assert not list((tmp_path / "out").glob("plies_*"))

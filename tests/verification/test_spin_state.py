@@ -186,7 +186,8 @@ def test_the_default_blade_relaxes_with_coarse_elements(size, blade):
     set_dotted(doc, "mesh.element_size", size)
     for key, value in blade.items():
         set_dotted(doc, f"mesh.blade.{key}", value)
-    set_dotted(doc, "mesh.casing.sector", "30 deg")  # the casing does not take part
+    set_dotted(doc, "mesh.casing.sector", "30 deg")  # the casing does not take part,
+    set_dotted(doc, "mesh.casing.centre_angle", "105 deg")  # but lies where the tip meets it
     for key in ("fine_sector", "coarse_element_size"):  # nor its grading
         doc["mesh"]["casing"].pop(key, None)
     compiled = compile_case(case_from_dict(doc, source=str(path)), path.parent)

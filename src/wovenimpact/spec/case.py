@@ -176,7 +176,7 @@ class ImportedMeshSpec(BaseModel):
     ``"circumferential"`` for a containment model and x = (1, 0, 0) otherwise.
     ``[mesh.containment]`` names the sets of a containment model
     (:class:`ContainmentSetsSpec`), whose blade spins about the z axis: its ``axis`` is
-    z."""
+    z (``check_references``)."""
 
     model_config = STRICT
     kind: Literal["abaqus", "gmsh"]
@@ -186,14 +186,6 @@ class ImportedMeshSpec(BaseModel):
     warp_direction: Direction | Literal["circumferential"] | None = None
     axis: Direction = (0.0, 0.0, 1.0)
     containment: ContainmentSetsSpec | None = None
-
-    @model_validator(mode="after")
-    def _containment_spins_about_z(self):
-        a = self.axis
-        if self.containment is not None and (a[0] != 0.0 or a[1] != 0.0 or a[2] <= 0.0):
-            raise ValueError(f"axis = {list(a)}: a containment model's blade spins about the "
-                             "z axis, so its casing's axis is z = [0, 0, 1]; turn the mesh")
-        return self
 
     @property
     def warp(self):

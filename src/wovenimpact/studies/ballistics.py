@@ -119,7 +119,8 @@ def quadratic_ply_regression(plies, residual) -> PlyRegression:
     if n.shape != v.shape or n.ndim != 1:
         raise InputError("plies and residual velocities must be 1-D sequences of equal length")
     if np.unique(n).size < 3:
-        raise InputError(f"a quadratic needs at least three distinct ply counts, got {sorted(set(n))}")
+        counts = ", ".join(f"{k:g}" for k in np.unique(n))
+        raise InputError(f"a quadratic needs at least three distinct ply counts, got {counts}")
     c2, c1, c0 = np.polyfit(n, v, 2)
     pred = c2 * n * n + c1 * n + c0
     ss_res = float(np.sum((v - pred) ** 2))

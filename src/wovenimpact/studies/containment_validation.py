@@ -152,6 +152,20 @@ def ladder_lines(name: str, title: str, unit: str, thesis: dict, note: str, rows
             if below == fewest - 2 else
             f"; {below} let it through and {below + 1}–{fewest - 1} are not decided by a "
             f"run: by runs the answer lies between {below + 1} and {fewest} {unit}."))
+    escaped_at = {int(float(r[KEY])) for r in rows
+                  if r.get("status") == "done" and r.get("outcome") == "escaped"}
+    if reg is not None and reg.plies_to_stop:
+        beaten = sorted(n for n in escaped_at if n >= reg.plies_to_stop)
+        if beaten:
+            lines.append(f"The runs contradict the regression: {', '.join(map(str, beaten))} "
+                         f"{unit} let the fragment out, at or above its {reg.plies_to_stop}; "
+                         "the runs' answer stands.")
+    if result["fewest_contained"] is not None:
+        above = sorted(n for n in escaped_at if n > result["fewest_contained"])
+        if above:
+            lines.append(f"Not monotonic: {', '.join(map(str, above))} {unit} let the fragment "
+                         f"out although {result['fewest_contained']} contained it (near the "
+                         "limit an outcome can turn on round-off, theory §8.8).")
     falling = [int(float(r[KEY])) for r in rows if r.get("status") == "done" and unsettled(r)]
     if falling:
         lines.append(f"Escaped with the speed still falling at the end (not in the "

@@ -40,11 +40,13 @@ def is_containment(doc: dict) -> bool:
 
 
 def search_plies(stops: Callable[[list[int]], dict[int, bool]], start: int = 1,
-                 max_plies: int = MAX_PLIES) -> tuple[int, dict[int, bool]]:
+                 max_plies: int = MAX_PLIES, unit: str = "plies",
+                 goal: str = "stops the impactor") -> tuple[int, dict[int, bool]]:
     """Smallest N ≥ 1 with stops(N), assuming more plies never do worse.
 
     ``stops`` evaluates a batch of ply counts (in parallel) and returns N → stopped.
-    Returns (N, every evaluation made).
+    Returns (N, every evaluation made). ``unit`` and ``goal`` word the error when no N
+    up to ``max_plies`` holds ("layers", "contains the fragment" for a casing).
     """
     seen: dict[int, bool] = {}
     lo, hi = 0, None  # lo: largest known perforated (0: none), hi: smallest known stopped
@@ -52,7 +54,8 @@ def search_plies(stops: Callable[[list[int]], dict[int, bool]], start: int = 1,
     while hi is None:
         batch = [k for k in (n, 2 * n) if k <= max_plies and k not in seen]
         if not batch:
-            raise InputError(f"no pack of up to {max_plies} plies stops the impactor")
+            raise InputError(f"no pack of up to {max_plies} {unit} {goal} (searched from "
+                             f"{max(1, start)}: {sorted(seen) or 'none run'})")
         seen.update(stops(batch))
         for k in sorted(seen):
             if seen[k] and (hi is None or k < hi):
@@ -196,13 +199,18 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
                     "in the case and search again")
         return {n: results[n] in HELD for n in batch}
 
+    from wovenimpact.spec.case import case_from_dict
+
+    # the case as given, validated before any run: a clear error for a bad case, and its
+    # N with the defaults filled in
+    given = case_from_dict(doc, source=str(path))
     if is_containment(doc):
-        unit = "layers"
-        n0 = int(doc["mesh"]["casing"]["layers"])
+        unit, goal = "layers", "contains the fragment"
+        n0 = given.mesh.casing.layers
     else:
-        unit = "plies"
-        n0 = int(doc.get("mesh", {}).get("plies", 1))
-    plies, seen = search_plies(stops, start=start or n0)
+        unit, goal = "plies", "stops the impactor"
+        n0 = getattr(given.mesh, "plies", 1)
+    plies, seen = search_plies(stops, start=start or n0, unit=unit, goal=goal)
     extra = [k for k in range(plies + 1, plies + 1 + check) if k not in seen]
     if extra:
         seen.update(stops(extra))
@@ -219,7 +227,6 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
             "warning": monotonic_warning(plies, seen, "layers", "contain the fragment"),
         }
     from wovenimpact.model.compile import compile_case
-    from wovenimpact.spec.case import case_from_dict
 
     spec = case_from_dict(_case_with_plies(doc, plies), source=str(path))
     model = compile_case(spec, Path(base)).model

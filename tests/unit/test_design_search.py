@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import math
 from pathlib import Path
 
@@ -184,3 +185,26 @@ def test_a_bad_containment_case_is_refused_before_any_run(tmp_path, override, fi
     with pytest.raises(InputError, match=field):
         design_plies(case, tmp_path / "out", overrides=[override])
     assert not list((tmp_path / "out").glob("plies_*"))
+
+
+def test_an_undecided_pack_is_continued_from_its_checkpoint(tmp_path):
+    """A pack still undecided at its end time is continued to twice the end time from
+    the checkpoint it ended with (continue_from), not run again from t = 0; the
+    continued run ends where a fresh run to that time ends, to the bit."""
+    from tests.corpus.generate import IMPACT, _set
+    from wovenimpact.studies.design import _longer, _run_one, continue_from
+
+    doc = _set(IMPACT, "materials", {"kevlar": str(ROOT / "examples" / "materials"
+                                                 / "kevlar_thesis.toml")})
+    doc = _set(doc, "run", {"end_time": "3 us", "history_interval": "0.5 us"})
+    base = str(tmp_path)
+    assert _run_one(doc, base, str(tmp_path / "plies_2")) == "undecided"  # still in contact
+    longer = _longer(doc)
+    continue_from(tmp_path / "plies_2", tmp_path / "plies_2_end2x", longer)
+    _run_one(longer, base, str(tmp_path / "plies_2_end2x"))
+    _run_one(longer, base, str(tmp_path / "fresh"))
+    continued, fresh = (json.loads((tmp_path / d / "summary.json").read_text())
+                        for d in ("plies_2_end2x", "fresh"))
+    assert continued["restarted_from_step"] > 0 and fresh["restarted_from_step"] is None
+    for key in ("steps", "end_time_s", "internal_work_J", "total_kinetic_energy_J"):
+        assert continued[key] == fresh[key], key

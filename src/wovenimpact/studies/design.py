@@ -9,9 +9,9 @@ plies of a hybrid casing, aluminium layers of an all-metal one) and the answer i
 fewest layers that contain the fragment, with the casing's mass (inner shell counted).
 Each round runs its candidates in parallel (local processes). Only decided runs count:
 a pack whose run ends ``undecided`` (still in contact, or intact plies ahead of the
-impactor, at the end time) or ``no contact`` is run once more with twice the end time
-(in ``plies_N_end2x``, saying so through ``log``); if it is still not decided the
-search stops with advice to run longer.
+impactor, at the end time) or ``no contact`` is continued from its last checkpoint to
+twice the end time (in ``plies_N_end2x``, saying so through ``log``; :func:`continue_from`);
+if it is still not decided the search stops with advice to run longer.
 """
 
 from __future__ import annotations
@@ -143,6 +143,38 @@ def _quiet(message: str) -> None:
     """The default ``log`` of :func:`design_plies`: says nothing."""
 
 
+def continue_from(src: Path, dst: Path, doc: dict) -> None:
+    """Seed ``dst`` with the run in ``src`` so that running ``doc`` there (its case with a
+    later ``run.end_time``) resumes from the checkpoint ``src`` ended with instead of
+    starting again: its newest checkpoint, history.csv and fields/ are copied and
+    ``doc`` is written as the run's parameters (:func:`sweep.start_or_resume` then
+    resumes; a restart may change ``run.end_time``, theory §9). A ``dst`` already
+    holding a run of ``doc`` (a search resumed after a crash) is left as it is; a
+    ``src`` without a checkpoint seeds nothing, and the run starts from t = 0."""
+    import shutil
+
+    from wovenimpact.io.atomic import atomic_write_text
+    from wovenimpact.io.checkpoint import latest_checkpoint
+
+    params = json.dumps(doc, indent=2, default=str) + "\n"  # as sweep.start_or_resume
+    try:
+        if json.loads((dst / "parameters.json").read_text(encoding="utf-8")) == json.loads(params):
+            return
+    except (OSError, ValueError):
+        pass
+    last = latest_checkpoint(src / "checkpoints")
+    if last is None or not (src / "history.csv").exists():
+        return
+    if dst.exists():
+        shutil.rmtree(dst)
+    (dst / "checkpoints").mkdir(parents=True)
+    shutil.copy2(last, dst / "checkpoints" / last.name)
+    shutil.copy2(src / "history.csv", dst / "history.csv")
+    if (src / "fields").is_dir():
+        shutil.copytree(src / "fields", dst / "fields")
+    atomic_write_text(dst / "parameters.json", params)
+
+
 def _longer(doc: dict) -> dict:
     """The case document with twice its ``run.end_time``."""
     d = copy.deepcopy(doc)
@@ -184,7 +216,8 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
             longer = [_longer(d) for n, d in zip(batch, docs) if n in again]
             for n, d in zip(again, longer):
                 log(f"{n} {unit}: {results[n]} at run.end_time = {docs[batch.index(n)]['run']['end_time']}"
-                    f"; running it again to {d['run']['end_time']} (plies_{n}_end2x)")
+                    f"; continuing it to {d['run']['end_time']} (plies_{n}_end2x)")
+                continue_from(out / f"plies_{n}", out / f"plies_{n}_end2x", d)
             for n, r in zip(again, run_batch(longer, [str(out / f"plies_{n}_end2x")
                                                       for n in again])):
                 reruns[str(n)] = f"{results[n]} → {r} with twice the end time"

@@ -228,3 +228,24 @@ def test_runs_that_contradict_the_regression_or_each_other_are_named(tmp_path):
     text = "\n".join(cv.ladder_lines("containment_metal", "Metal", "layers", {}, "note", clean,
                                      tmp_path)[0])
     assert "contradict" not in text and "Not monotonic" not in text
+
+
+def test_runs_striking_with_another_fragment_are_not_one_ladder(tmp_path):
+    """A run on another mesh strikes with another fragment (the released row is one
+    element wide): given beside the ladder's runs it is refused, naming both; runs with
+    one fragment pass."""
+    import json
+    import shutil
+
+    from wovenimpact.errors import InputError
+
+    runs = tmp_path / "runs"
+    for name, layers, mass in (("m4", 4, 0.2289), ("m8", 8, 0.2289), ("m12", 12, 0.2243)):
+        d = _run_dir(runs, name, layers, ("aluminium",), "escaped", 100.0 - 5 * layers, 2.8)
+        summary = json.loads((d / "summary.json").read_text())
+        summary.update(fragment_mass_kg=mass, fragment_initial_speed_m_per_s=150.4)
+        (d / "summary.json").write_text(json.dumps(summary))
+    with pytest.raises(InputError, match=r"mixes fragments: .*m12.* 0.2243 kg"):
+        cv.rows_from_runs([runs])
+    shutil.rmtree(runs / "m12")
+    assert [r[cv.KEY] for r in cv.rows_from_runs([runs])[0]["containment_metal"]] == [4, 8]

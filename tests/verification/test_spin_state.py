@@ -404,3 +404,26 @@ def test_a_blade_whose_staggered_corners_reach_the_casing_is_refused():
         doc["mesh"]["casing"].pop(key, None)
     with pytest.raises(InputError, match=r"farthest node lies at r = 0\.264"):
         compile_case(case_from_dict(doc, source=str(path)), path.parent)
+
+
+def test_a_blade_that_yields_at_its_spin_rate_is_named_as_the_cause():
+    """The titanium strip at 5000 rad/s: the root's centrifugal stress ρω²(R² − r0²)/2 =
+    3.3 GPa passes the 827 MPa yield stress, the blade creeps and the relaxation cannot
+    settle. The error says so (it used to suggest a tolerance or an unheld root)."""
+    from pathlib import Path
+
+    from wovenimpact.errors import SimulationError
+    from wovenimpact.spec.material import load_material
+
+    ti = load_material(Path(__file__).resolve().parents[2] / "examples" / "materials"
+                       / "titanium.toml")
+    omega = np.array([0.0, 0.0, 5000.0])
+    mesh = blade_mesh(0.05, 0.25, 0.15, 0.02, 0.02, 10e-3)
+    sec = {"ti": Section(ti, thickness=4.98e-3)}
+    es = np.zeros(mesh.n_elems, int)
+    bc = BoundaryConditions(mesh.n_nodes).fix(mesh.node_sets["root"])
+    spin = build_model(mesh.nodes, mesh.quads, sec, es, bcs=bc,
+                       body_accel=centrifugal_acceleration(mesh.nodes, omega))
+    model = build_model(mesh.nodes, mesh.quads, sec, es, bcs=bc)
+    with pytest.raises(SimulationError, match=r"did not converge.*yields at this rate"):
+        spin_state(spin, model, omega, tol=1e-6, max_steps=3000)

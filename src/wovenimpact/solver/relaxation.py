@@ -113,10 +113,17 @@ def spin_state(spin_model, model, omega, centre=(0.0, 0.0, 0.0), nodes=None,
     relaxing = initial_state(spin_model)
     info = relax(spin_model, relaxing, tol=tol, max_steps=max_steps)
     if not info.converged:
+        from wovenimpact.metal_state import max_plastic_strain
+
+        eps_p = float(np.max(max_plastic_strain(spin_model, relaxing), initial=0.0))
+        why = (f"the spinning part yields at this rate (plastic strain up to {eps_p:.3g}): "
+               "its centrifugal stress passes the material's yield stress, and a plastic "
+               "part creeps instead of settling; lower the spin rate" if eps_p > 0.0 else
+               "refine the tolerance or check that the spinning part is held (a clamped "
+               "root)")
         raise SimulationError(
             f"spin state: dynamic relaxation did not converge in {info.steps} steps "
-            f"(residual {info.residual:.2e} > {tol:g}); refine the tolerance or check that "
-            "the spinning part is held (a clamped root)")
+            f"(residual {info.residual:.2e} > {tol:g}); {why}")
     if nodes is None:
         nodes = np.flatnonzero(np.any(spin_model.body_accel != 0.0, axis=1))
     v = np.zeros((model.n_nodes, 3))

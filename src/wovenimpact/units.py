@@ -214,7 +214,7 @@ ANGULAR = ("angle", "angular_velocity")  # quantities whose unit must name an an
 def _radian_power(unit: pint.Unit) -> float:
     """The power of the radian in ``unit``'s root units: 1 for 'rad/s', 'rpm', 'deg'; 0
     for 'Hz' and '1/s', which pint also converts to rad/s."""
-    return ureg.Quantity(1.0, unit).to_root_units().units._units.get("radian", 0)
+    return dict(ureg.Quantity(1.0, unit).to_root_units().unit_items()).get("radian", 0)
 
 
 def _dimensionality_text(unit: pint.Unit) -> str:

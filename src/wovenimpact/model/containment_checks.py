@@ -25,19 +25,17 @@ import warnings
 
 import numpy as np
 
+from wovenimpact.containment import layer_sets
 from wovenimpact.errors import InputError, InputWarning
+from wovenimpact.model.sanity import MAX_CROSSING, smallest_edge
 
 MAX_RADIAL_SPREAD = 0.25  # a layer's (r_max − r_min) / r_mean about the z axis
 MIN_GAP_FRACTION = 0.1  # layers closer than this fraction of their thickness coincide
-MAX_CROSSING = 0.5  # of the smallest element, in one step (as model.sanity)
 
 
 def _layers(mesh) -> list[np.ndarray]:
-    out, k = [], 0
-    while f"casing.layer{k}" in mesh.node_sets:
-        out.append(np.asarray(mesh.node_sets[f"casing.layer{k}"], dtype=np.int64))
-        k += 1
-    return out
+    """The casing layers' node sets, innermost first (``containment.layer_sets``)."""
+    return [np.asarray(mesh.node_sets[name], dtype=np.int64) for name in layer_sets(mesh)]
 
 
 def _key(spec, k: int | None = None) -> str:
@@ -59,16 +57,15 @@ def check_spin_speed(spec, model, mesh, dt: float) -> None:
     if spec.spin is None or not (math.isfinite(dt) and dt > 0.0):
         return
     blade = np.unique(mesh.quads[mesh.elem_sets["blade.blade"]])
-    tip = spec.spin.rate * float(_radius(mesh.nodes[blade]).max())
-    p = model.x0[model.quads]
-    edges = np.linalg.norm(np.roll(p, -1, axis=1) - p, axis=2)
-    h = float(edges[edges > 0].min())
+    r_tip = float(_radius(mesh.nodes[blade]).max())
+    tip = spec.spin.rate * r_tip
+    h = smallest_edge(model)
     if tip * dt > MAX_CROSSING * h:
         raise InputError(
             f"spin.rate = {spec.spin.rate:.4g} rad/s moves the blade's tip at {tip:.3g} m/s "
             f"{tip * dt:.3g} m in one step (Δt = {dt:.3g} s), more than half the smallest "
-            f"element ({h:.3g} m) (valid: below {MAX_CROSSING * h / dt / (tip / spec.spin.rate):.4g} "
-            "rad/s; a fan's tip moves at a few hundred m/s)")
+            f"element ({h:.3g} m) (valid: below {MAX_CROSSING * h / (dt * r_tip):.4g} rad/s; "
+            "a fan's tip moves at a few hundred m/s)")
 
 
 def check_containment(spec, model, state, mesh) -> None:

@@ -116,9 +116,7 @@ def check_motion_per_step(model, state, dt: float, spec) -> None:
     """Nothing may cross more than MAX_CROSSING of the smallest element in one step."""
     if not (math.isfinite(dt) and dt > 0.0):
         return
-    p = model.x0[model.quads]
-    edges = np.linalg.norm(np.roll(p, -1, axis=1) - p, axis=2)
-    h = float(edges[edges > 0].min()) if np.any(edges > 0) else 0.0
+    h = smallest_edge(model)
     if h <= 0.0:
         return
     limit = MAX_CROSSING * h
@@ -209,11 +207,24 @@ def check_thickness(model, spec) -> None:
                 "structure it models)")
 
 
+def _edges(model, elems=slice(None)) -> np.ndarray:
+    """The non-zero reference edge lengths (m) of ``elems`` (a triangle's repeated
+    corner gives a zero edge, left out)."""
+    p = model.x0[model.quads[elems]]
+    edges = np.linalg.norm(np.roll(p, -1, axis=1) - p, axis=2)
+    return edges[edges > 0]
+
+
+def smallest_edge(model) -> float:
+    """The smallest reference edge length of the model (m; 0 without elements)."""
+    edges = _edges(model)
+    return float(edges.min()) if edges.size else 0.0
+
+
 def _median_edge(model, sec: int) -> float:
     """The median edge length (m) of the elements of section ``sec``."""
-    p = model.x0[model.quads[model.elem_section == sec]]
-    edges = np.linalg.norm(np.roll(p, -1, axis=1) - p, axis=2)
-    return float(np.median(edges[edges > 0])) if np.any(edges > 0) else 0.0
+    edges = _edges(model, model.elem_section == sec)
+    return float(np.median(edges)) if edges.size else 0.0
 
 
 def check_constraints(spec, mesh) -> None:

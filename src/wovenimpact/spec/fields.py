@@ -31,8 +31,6 @@ STRICT = ConfigDict(extra="forbid", frozen=True)
 _MISSING = object()
 
 
-
-
 @dataclass(frozen=True)
 class Valid:
     """Annotation metadata: what a valid value of the field looks like (for messages)."""

@@ -372,8 +372,8 @@ def check_one_fragment(name: str, rows: list[dict]) -> None:
     without these keys (older summaries) are not compared."""
     keys = ("fragment_mass_kg", "fragment_initial_speed_m_per_s")
     known = [r for r in rows if all(r.get(k) is not None for k in keys)]
+    ref = known[0] if known else None
     for r in known[1:]:
-        ref = known[0]
         if any(abs(float(r[k]) - float(ref[k])) > 1e-9 * abs(float(ref[k])) for k in keys):
             raise InputError(
                 f"--runs: the {name} ladder mixes fragments: {ref['path']} strikes with "

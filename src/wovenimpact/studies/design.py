@@ -155,8 +155,9 @@ def continue_from(src: Path, dst: Path, doc: dict) -> None:
 
     from wovenimpact.io.atomic import atomic_write_text
     from wovenimpact.io.checkpoint import latest_checkpoint
+    from wovenimpact.studies.sweep import parameters_text
 
-    params = json.dumps(doc, indent=2, default=str) + "\n"  # as sweep.start_or_resume
+    params = parameters_text(doc)
     try:
         if json.loads((dst / "parameters.json").read_text(encoding="utf-8")) == json.loads(params):
             return

@@ -170,6 +170,11 @@ def quiet_spec(document: dict, source: str):
             return None
 
 
+def parameters_text(values: dict) -> str:
+    """A run's ``parameters.json``: the values (or case document) it was run with."""
+    return json.dumps(values, indent=2, default=str) + "\n"
+
+
 def start_or_resume(out: Path, values: dict) -> bool:
     """Prepare ``out`` for a run of ``values`` (written to its ``parameters.json``); True
     if the run may resume: an earlier run of the same values left a checkpoint there (it
@@ -178,7 +183,7 @@ def start_or_resume(out: Path, values: dict) -> bool:
     from wovenimpact.io.checkpoint import latest_checkpoint
 
     params = out / "parameters.json"
-    text = json.dumps(values, indent=2, default=str) + "\n"
+    text = parameters_text(values)
     try:
         same = json.loads(params.read_text(encoding="utf-8")) == json.loads(text)
     except (OSError, ValueError):

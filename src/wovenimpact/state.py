@@ -13,6 +13,8 @@ from dataclasses import MISSING, dataclass, field, fields
 
 import numpy as np
 
+from wovenimpact.kernels import fabric_layout as FL
+from wovenimpact.kernels import j2_layout as JL
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as SL
 
@@ -20,7 +22,8 @@ from wovenimpact.kernels import shell_layout as SL
 W_INT = 0  # work of the internal forces (membrane, bending, shear, hourglass)
 W_EXT = 1  # work of external forces, body forces, support reactions and contact on nodes
 KINETIC = 2  # kinetic energy at the last whole step (translational + rotational)
-ERODED_KINETIC = 3  # kinetic energy of nodes left without any element
+ERODED_KINETIC = 3  # kinetic energy of nodes that left the model (lost their last element;
+#                     with run.eroded_nodes = "keep" such nodes stay, and this stays 0)
 ERODED_INTERNAL = 4  # stored energy of elements at their erosion
 KINETIC0 = 5  # kinetic energy at t = 0 (nodes and rigid bodies)
 BODY_KINETIC = 6  # kinetic energy of the rigid bodies at the last whole step
@@ -51,7 +54,9 @@ class State:
             element e's points in rows Model.mat_row[e] … mat_row[e + 1] − 1.
         f_int: (n_nodes, 6) internal forces and moments at x^n.
         f_ext: (n_nodes, 6) external forces, body forces and reactions at x^n.
-        node_active: (n_nodes,) 1 while a node belongs to at least one live element.
+        node_active: (n_nodes,) 1 while a node is in the model: it belongs to at least
+            one live element, or (``run.eroded_nodes = "keep"``) it lost its last one
+            and flies on as a free node.
         energy: (N_ENERGY,) accumulators (indices in this module).
         dt_first: the first stable step (s), reference of the Δt-collapse check.
         bodies: (n_bodies, N_BODY_STATE) rigid impactors (kernels.rigid_body layout).
@@ -61,6 +66,13 @@ class State:
         contact_work: (n_nodes,) work the contact forces did on each node so far (J,
             the trapezoid rule of ``force_pair_power``): the energy a node's part took
             from contact, which it holds, dissipated or carried away when it eroded.
+        contact_books: (2, 3, P, P) the work of the contact forces split by interface
+            and by part of the pair force (J; wovenimpact.interfaces, theory §6,
+            "Contact energy per interface"): [0][kind, a, b] the energy the springs
+            (kind 0), dashpots (1) and friction (2) of the pairs of a node of part a and
+            a segment or body of part b took out of the structure up to the last whole
+            step, [1] the same of the last step's forces against the velocities after it,
+            moved into [0] at the next step.
     """
 
     t: float
@@ -81,6 +93,7 @@ class State:
     mass_ratio: np.ndarray = field(default_factory=lambda: np.zeros(0))
     added_mass: np.ndarray = field(default_factory=lambda: np.zeros(0))
     contact_work: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    contact_books: np.ndarray = field(default_factory=lambda: np.zeros((2, 3, 0, 0)))
 
     def copy(self) -> State:
         return State(**{f.name: (getattr(self, f.name).copy() if isinstance(
@@ -119,7 +132,18 @@ def initial_material_rows(model) -> np.ndarray:
     point = np.arange(model.mat_row[-1]) - np.repeat(model.mat_row[:-1], counts)
     blocks = model.section_state0.shape[1] // width
     per_point = model.section_state0[:, :blocks * width].reshape(-1, blocks, width)
-    return np.ascontiguousarray(per_point[section, point])
+    rows = np.ascontiguousarray(per_point[section, point])
+    if model.elem_failure.shape[0] == model.n_elems:
+        # each point's failure columns from its element's lengths (theory §1.4, §7.3)
+        elem = np.repeat(np.arange(model.n_elems), counts)
+        kind = model.mat_kind[model.sections[section, SL.C_MAT].astype(np.int64)]
+        fab = np.flatnonzero(kind == SL.MAT_FABRIC)
+        if fab.size:
+            rows[fab, FL.S_TU_SCALE:FL.S_TU_SCALE + 6] = model.elem_failure[elem[fab]]
+        j2 = np.flatnonzero(kind == SL.MAT_J2)
+        if j2.size:
+            rows[j2, JL.S_FRAC_SCALE:JL.S_FRAC_SCALE + 2] = model.elem_failure[elem[j2], :2]
+    return rows
 
 
 def initial_state(model, velocity=None, angular_velocity=None) -> State:
@@ -130,6 +154,8 @@ def initial_state(model, velocity=None, angular_velocity=None) -> State:
         velocity: (3,) or (n_nodes, 3) initial velocities (m/s).
         angular_velocity: (3,) or (n_nodes, 3) initial nodal spins (rad/s).
     """
+    from wovenimpact.interfaces import empty_books
+
     n, ne = model.n_nodes, model.n_elems
     v = np.zeros((n, 3)) if velocity is None else np.broadcast_to(
         np.asarray(velocity, dtype=float), (n, 3)).copy()
@@ -157,7 +183,7 @@ def initial_state(model, velocity=None, angular_velocity=None) -> State:
                  f_int=np.zeros((n, 6)), f_ext=np.zeros((n, 6)),
                  node_active=np.ones(n, dtype=np.int8), energy=energy, bodies=bodies,
                  f_contact=np.zeros((n, 3)), mass_ratio=np.zeros(ne), added_mass=np.zeros(n),
-                 contact_work=np.zeros(n))
+                 contact_work=np.zeros(n), contact_books=empty_books(model))
 
 
 def rigid_rotation_velocity(x: np.ndarray, omega, centre=(0.0, 0.0, 0.0)) -> np.ndarray:

@@ -114,15 +114,19 @@ def test_a_yarn_past_its_ultimate_tension_breaks_and_its_partner_decrimps(rows):
 
 def test_the_sliver_rule_needs_a_broken_family():
     p = np.zeros((1, L.N_PARAM))
-    p[0, L.P_ERODE_STRETCH] = 1.5
+    s = np.zeros((1, L.N_STATE))
+    s[0, L.S_ERODE_LIMIT:L.S_ERODE_LIMIT + 2] = 1.5  # the point's stretch limits
     p[0, L.P_ERODE_CRUSH] = 0.5
-    assert not sliver_erodes(p, U0, 0.0, 0.0, 1.8, 0.4)  # intact: never
-    assert sliver_erodes(p, U0, 1.0, 0.0, 1.6, 1.0)  # broken warp stretched past 1.5
-    assert not sliver_erodes(p, U0, 1.0, 0.0, 1.4, 1.0)
-    assert sliver_erodes(p, U0, 0.0, 1.0, 1.0, 0.45)  # crushed below 0.5
-    p[0, L.P_ERODE_STRETCH] = 0.0
+    assert not sliver_erodes(p, U0, s, U0, 0.0, 0.0, 1.8, 0.4)  # intact: never
+    assert sliver_erodes(p, U0, s, U0, 1.0, 0.0, 1.6, 1.0)  # broken warp stretched past 1.5
+    assert not sliver_erodes(p, U0, s, U0, 1.0, 0.0, 1.4, 1.0)
+    assert sliver_erodes(p, U0, s, U0, 0.0, 1.0, 1.0, 0.45)  # crushed below 0.5
+    s[0, L.S_ERODE_LIMIT + 1] = 1.2  # a limit of its own per family (an element's lengths)
+    assert sliver_erodes(p, U0, s, U0, 0.0, 1.0, 1.0, 1.3)
+    assert not sliver_erodes(p, U0, s, U0, 1.0, 0.0, 1.3, 1.0)
+    s[0, L.S_ERODE_LIMIT:L.S_ERODE_LIMIT + 2] = 0.0
     p[0, L.P_ERODE_CRUSH] = 0.0
-    assert not sliver_erodes(p, U0, 1.0, 0.0, 5.0, 0.01)  # both tests disabled
+    assert not sliver_erodes(p, U0, s, U0, 1.0, 0.0, 5.0, 0.01)  # both tests disabled
 
 
 def test_the_intact_crush_rule_erodes_a_cell_crushed_both_ways_only_when_asked():
@@ -130,11 +134,12 @@ def test_the_intact_crush_rule_erodes_a_cell_crushed_both_ways_only_when_asked()
     a cell crushed both ways — but not one crushed across one family only, nor any
     point with the option off (the default, and the shipped Kevlar)."""
     p = np.zeros((1, L.N_PARAM))
-    assert not sliver_erodes(p, U0, 0.0, 0.0, 0.2, 0.2)  # off: never
+    s = np.zeros((1, L.N_STATE))
+    assert not sliver_erodes(p, U0, s, U0, 0.0, 0.0, 0.2, 0.2)  # off: never
     p[0, L.P_ERODE_INTACT] = 0.1
-    assert sliver_erodes(p, U0, 0.0, 0.0, 0.3, 0.3)  # 0.09 < 0.1
-    assert not sliver_erodes(p, U0, 0.0, 0.0, 0.35, 0.35)  # 0.1225
-    assert not sliver_erodes(p, U0, 0.0, 0.0, 1.04, 0.12)  # one way (a casing fold): 0.125
+    assert sliver_erodes(p, U0, s, U0, 0.0, 0.0, 0.3, 0.3)  # 0.09 < 0.1
+    assert not sliver_erodes(p, U0, s, U0, 0.0, 0.0, 0.35, 0.35)  # 0.1225
+    assert not sliver_erodes(p, U0, s, U0, 0.0, 0.0, 1.04, 0.12)  # one way (a casing fold): 0.125
     assert reference_fabric().to_array()[L.P_ERODE_INTACT] == 0.0
 
 

@@ -62,6 +62,7 @@ COLUMNS = {
     "thickness_stretch": "λ3 = t / t0",
     "triaxiality": "η = σ_m / σ_eq",
     "damage": "Johnson–Cook damage D",
+    "softening_damage": "damage D_e after the onset of failure (stress × (1 − D_e))",
     "alive": "1 until the point fails",
     "stored_energy_J_per_m2": "elastic stored energy per unit reference area",
     "plastic_work_J_per_m2": "plastic work per unit reference area",
@@ -166,14 +167,15 @@ def _gradient(test: str, strain: float, lateral: float) -> np.ndarray:
 class MetalPointDriver:
     """State of one test run: the point, its F, and the accepted history."""
 
-    def __init__(self, params, test, strain_max, rate, thickness):
+    def __init__(self, params, test, strain_max, rate, thickness, element_length=None):
         self.params, self.test, self.strain_max = params, test, strain_max
         self.rate, self.t0 = rate, thickness
         self.p = j2_parameter_row(params)
         self.p_intact = self.p.copy()  # the same material without its failure criteria
         self.p_intact[L.P_FRACTURE] = 0.0
         self.p_intact[L.P_DAMAGE] = 0.0
-        self.state = initial_state(params)[0]
+        self.state = initial_state(
+            params, lengths=None if element_length is None else [element_length])[0]
         self.f = np.eye(2)
         self.piola = np.zeros((2, 2))
         self.work = 0.0
@@ -219,7 +221,7 @@ class MetalPointDriver:
             s, strain, f[0, 0], f[1, 1], f[0, 1], sxx, syy, sxy, seq, teq,
             st[L.S_EPS_P], st[L.S_YIELD], float(self.params.flow_stress(st[L.S_EPS_P])),
             st[L.S_RATE], st[L.S_THICK], (sxx + syy) / (3.0 * seq) if seq > 0.0 else 0.0,
-            st[L.S_JC_DAMAGE], st[L.S_ALIVE], st[L.S_ENERGY], st[L.S_PLASTIC_WORK],
+            st[L.S_JC_DAMAGE], st[L.S_SOFT_DAMAGE], st[L.S_ALIVE], st[L.S_ENERGY], st[L.S_PLASTIC_WORK],
             st[L.S_FAIL_ENERGY], self.work, st[L.S_RETURN_ITER],
         ])
 
@@ -237,6 +239,7 @@ def run_metal_element_test(
     n_steps: int = 400,
     strain_rate: float = DEFAULT_STRAIN_RATE,
     thickness: float = DEFAULT_THICKNESS_M,
+    element_length: float | None = None,
 ) -> MetalElementTestResult:
     """Drive one J2 point through a test history to failure (or the end); record everything.
 
@@ -247,6 +250,8 @@ def run_metal_element_test(
         n_steps: number of equal load steps.
         strain_rate: rate of the applied strain (1/s); sets Δt of every step.
         thickness: reference thickness t0 (m).
+        element_length: l_e = √A0 of the element the point stands for (m), for a
+            material with a [material.regularisation]; None: its reference length.
     """
     if test not in METAL_TESTS:
         raise ValueError(f"test = {test!r} is not valid for a metal: choose one of "
@@ -262,7 +267,7 @@ def run_metal_element_test(
         raise ValueError(f"strain = {strain_max} is not valid: it must be > 0")
     if not strain_rate > 0.0:
         raise ValueError(f"strain rate = {strain_rate} 1/s is not valid: it must be > 0")
-    drv = MetalPointDriver(params, test, strain_max, strain_rate, thickness)
+    drv = MetalPointDriver(params, test, strain_max, strain_rate, thickness, element_length)
     drv.record(0.0, drv.f, update_points(drv.p, drv.f, drv.f, drv.state, 0.0, thickness))
     fail_s = fail_eps = None
     for k in range(1, n_steps + 1):

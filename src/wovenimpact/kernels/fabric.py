@@ -55,7 +55,6 @@ from wovenimpact.kernels.fabric_layout import (
     P_ELL0,
     P_ERODE_CRUSH,
     P_ERODE_INTACT,
-    P_ERODE_STRETCH,
     P_FAILURE,
     P_FRAME,
     P_G1,
@@ -66,19 +65,21 @@ from wovenimpact.kernels.fabric_layout import (
     P_HOMOG,
     P_LT0,
     P_SHEAR,
-    P_SOFT,
     P_THICK,
     P_TU,
     S_ALIVE,
     S_DAMAGE,
     S_ENERGY,
+    S_ERODE_LIMIT,
     S_GAMMA,
     S_H,
     S_ITER,
     S_LAMBDA,
     S_SHEAR_ENERGY,
+    S_SOFT,
     S_TAU,
     S_TENSION,
+    S_TU_SCALE,
     SHEAR_THESIS,
     STATUS_BAD_KINEMATICS,
     STATUS_NOT_CONVERGED,
@@ -439,22 +440,26 @@ def green_naghdi_stretches(fo11, fo12, fo21, fo22, f11, f12, f21, f22, lam_w_old
 
 
 @inline_kernel
-def yarn_damage(p, m, strain_w, strain_f, t_w, t_f, d_w, d_f, ea_w, ea_f):
-    """Step 3, the failure check, for yarn strains ε and tensions T at a point: the
-    damages after it. Progressive softening (theory §1.7) of each family not yet
+def yarn_damage(p, m, s_in, i, strain_w, strain_f, t_w, t_f, d_w, d_f, ea_w, ea_f):
+    """Step 3, the failure check, for yarn strains ε and tensions T at point i: the
+    damages after it. Progressive softening (theory §1.4) of each family not yet
     broken, or eq. (6.29): a yarn breaks for good when T ≥ T_u. A broken family
-    (d = 1) stays broken. Returns (d_w, d_f)."""
+    (d = 1) stays broken. T_u is the point's regularised strength s_i T_u and Δε_s its
+    own softening strain (columns S_TU_SCALE, S_SOFT, set from its element's lengths;
+    s = 1 and Δε_s = the material's for an unregularised point). Returns (d_w, d_f)."""
     d_w_new = d_w
     d_f_new = d_f
+    tu_w = s_in[i, S_TU_SCALE] * p[m, P_TU]
+    tu_f = s_in[i, S_TU_SCALE + 1] * p[m, P_TU + 1]
     if p[m, P_FAILURE] == FAILURE_PROGRESSIVE:
         if d_w < 1.0:
-            d_w_new = softening_damage(strain_w, d_w, ea_w, p[m, P_TU], p[m, P_SOFT])
+            d_w_new = softening_damage(strain_w, d_w, ea_w, tu_w, s_in[i, S_SOFT])
         if d_f < 1.0:
-            d_f_new = softening_damage(strain_f, d_f, ea_f, p[m, P_TU + 1], p[m, P_SOFT])
+            d_f_new = softening_damage(strain_f, d_f, ea_f, tu_f, s_in[i, S_SOFT + 1])
     else:
-        if d_w < 1.0 and t_w >= p[m, P_TU]:
+        if d_w < 1.0 and t_w >= tu_w:
             d_w_new = 1.0
-        if d_f < 1.0 and t_f >= p[m, P_TU + 1]:
+        if d_f < 1.0 and t_f >= tu_f:
             d_f_new = 1.0
     return d_w_new, d_f_new
 
@@ -572,8 +577,8 @@ def crossover_equilibrium(p, m, s_in, i, lam_w, lam_f):
         inside, hw_t, hf_t, tw_t, tf_t, lw_t, lf_t, w_t, gw_t, gf_t = tabulated_crossover(
             p, m, lam_w, lam_f, yc)
         if inside:
-            d_w_new, d_f_new = yarn_damage(p, m, tw_t / ea_w, tf_t / ea_f, tw_t, tf_t, d_w,
-                                           d_f, ea_w, ea_f)
+            d_w_new, d_f_new = yarn_damage(p, m, s_in, i, tw_t / ea_w, tf_t / ea_f, tw_t, tf_t,
+                                           d_w, d_f, ea_w, ea_f)
             if d_w_new == d_w and d_f_new == d_f:
                 return (True, 0, hw_t, hf_t, d_w, d_f, tw_t, tf_t, 0.0, 0.0, lw_t, lf_t, 0.0,
                         True, w_t, gw_t, gf_t)
@@ -611,8 +616,8 @@ def crossover_equilibrium(p, m, s_in, i, lam_w, lam_f):
         t_f = k_f * max(ext_f, 0.0)
         if attempt == 1:
             break
-        d_w_new, d_f_new = yarn_damage(p, m, ext_w / lt0_w, ext_f / lt0_f, t_w, t_f, d_w, d_f,
-                                       ea_w, ea_f)
+        d_w_new, d_f_new = yarn_damage(p, m, s_in, i, ext_w / lt0_w, ext_f / lt0_f, t_w, t_f,
+                                       d_w, d_f, ea_w, ea_f)
         if d_w_new == d_w and d_f_new == d_f:
             break
         d_w = d_w_new
@@ -623,16 +628,19 @@ def crossover_equilibrium(p, m, s_in, i, lam_w, lam_f):
 
 
 @inline_kernel
-def sliver_erodes(p, m, d_w, d_f, lam_w, lam_f):
-    """Theory §1.4: a point with a family broken erodes once it is a sliver — the broken
-    family stretched beyond P_ERODE_STRETCH (held by nothing across the break), or either
-    family crushed below P_ERODE_CRUSH (slack intact yarns, or intact yarns bunched with
-    nothing holding them apart); any point, intact or not, once crushed both ways to
-    λ_w λ_f below P_ERODE_INTACT (off by default); 0 disables each test."""
-    lim = p[m, P_ERODE_STRETCH]
+def sliver_erodes(p, m, s_in, i, d_w, d_f, lam_w, lam_f):
+    """Theory §1.4: point i with a family broken erodes once it is a sliver — the broken
+    family stretched beyond its limit S_ERODE_LIMIT (held by nothing across the break: the
+    material's P_ERODE_STRETCH, or 1 + δ_e/h_i, an opening δ_e across an element h_i long),
+    or either family crushed below P_ERODE_CRUSH (slack intact yarns, or intact yarns
+    bunched with nothing holding them apart); any point, intact or not, once crushed both
+    ways to λ_w λ_f below P_ERODE_INTACT (off by default); 0 disables each test."""
+    lim_w = s_in[i, S_ERODE_LIMIT]
+    lim_f = s_in[i, S_ERODE_LIMIT + 1]
     crush = p[m, P_ERODE_CRUSH]
     intact = p[m, P_ERODE_INTACT]
-    return (lim > 0.0 and ((d_w >= 1.0 and lam_w > lim) or (d_f >= 1.0 and lam_f > lim))) or (
+    return ((lim_w > 0.0 and d_w >= 1.0 and lam_w > lim_w)
+            or (lim_f > 0.0 and d_f >= 1.0 and lam_f > lim_f)) or (
         crush > 0.0 and (d_w >= 1.0 or d_f >= 1.0) and min(lam_w, lam_f) < crush
     ) or (intact > 0.0 and lam_w * lam_f < intact)
 
@@ -830,7 +838,7 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
     s_out[i, S_TENSION] = t_w
     s_out[i, S_TENSION + 1] = t_f
     # eroded (theory §1.4): both families broken, or one broken and the point a sliver
-    if sliver_erodes(p, m, d_w, d_f, lam_w, lam_f):
+    if sliver_erodes(p, m, s_in, i, d_w, d_f, lam_w, lam_f):
         d_w = 1.0
         d_f = 1.0
         s_out[i, S_DAMAGE] = 1.0

@@ -47,7 +47,18 @@ P_TAB_IBF = 37  # 1 / bucket width along λ_f
 P_TAB_DATA = 38  # index in the row of the first knot's data (= s + n_w + n_f + m_w + m_f)
 P_ERODE_CRUSH = 39  # with a family broken, erode once either is crushed below this (—), 0: never
 P_ERODE_INTACT = 40  # intact too: erode once λ_w λ_f falls below this (—), 0: never (default)
-N_PARAM = 41
+# --- element-size regularisation of failure (theory §1.4, "Failure that does not move with
+# the mesh"). The kernels never read these: they set each point's S_TU_SCALE, S_SOFT and
+# S_ERODE_LIMIT at the start of a run (materials.fabric.regularised_columns), from the
+# point's element lengths h_w, h_f along the two families.
+P_REG_LENGTH = 41  # h_ref,i, reference length of family i (m): the crossover cell 2ℓ_i0 unless given
+P_SOFT_OPENING = 43  # δ_s, post-peak opening of a yarn (m): Δε_s,i = δ_s / (s_i h_i); 0: none
+P_ERODE_OPENING = 44  # δ_e, a broken family erodes once opened by this (m): λ_lim = 1 + δ_e/h_i;
+#                       0: the fixed stretch P_ERODE_STRETCH
+P_REG_ROWS = 45  # rows of the strength-scale table (0: no scaling, s = 1)
+P_REG_TABLE = 46  # row k: h_i/h_ref,i at P_REG_TABLE + 2k, scale s of T_u at + 2k + 1
+REG_ROWS_MAX = 16
+N_PARAM = P_REG_TABLE + 2 * REG_ROWS_MAX
 
 CROSSOVER_EXACT = 0
 CROSSOVER_TABLE = 1
@@ -91,7 +102,11 @@ S_ALIVE = 10  # 1.0 while at least one family is intact, 0.0 once eroded
 S_ENERGY = 11  # stored energy per unit reference area (J/m²): yarns + compaction + shear
 S_SHEAR_ENERGY = 12  # shear part of S_ENERGY (J/m²)
 S_ITER = 13  # iterations of the last height solve
-N_STATE = 14
+# per point, set at the start of a run from its element's lengths and never changed (theory §1.4):
+S_TU_SCALE = 14  # s_i, the scale of family i's T_u (1: unregularised); S_TU_SCALE + 1 for fill
+S_SOFT = 16  # Δε_s,i, family i's softening strain of progressive failure (—)
+S_ERODE_LIMIT = 18  # λ_lim,i: a broken family i stretched past it erodes the point (0: never)
+N_STATE = 20
 
 # --- status codes returned per point -----------------------------------------
 STATUS_OK = 0

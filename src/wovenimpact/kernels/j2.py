@@ -87,13 +87,16 @@ from wovenimpact.kernels.j2_layout import (
     S_ALIVE,
     S_ENERGY,
     S_EPS_P,
+    S_EVOLUTION,
     S_FAIL_ENERGY,
+    S_FRAC_SCALE,
     S_JC_DAMAGE,
     S_KIRCHHOFF,
     S_PLASTIC_WORK,
     S_RATE,
     S_RETURN_ITER,
     S_SIG,
+    S_SOFT_DAMAGE,
     S_THICK,
     S_YIELD,
     STATUS_BAD_KINEMATICS,
@@ -406,20 +409,58 @@ def j2_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, dt, thick, s_in, 
     s_out[i, S_SIG + 1] = t22 / jac
     s_out[i, S_SIG + 2] = t12 / jac
 
-    # 5. damage and failure (J12–J13)
-    failed = False
+    # 5. damage and failure (J12–J13) at the point's regularised fracture strain s ε_f,
+    # then the softening after onset (J15–J16)
+    onset = False
+    after = 0.0  # the part of Δε̄p past the onset of failure
     if deps > 0.0:
+        s_frac = s_in[i, S_FRAC_SCALE]
         if p[m, P_DAMAGE] != 0.0:
             seq = math.sqrt(t11 * t11 - t11 * t22 + t22 * t22 + 3.0 * t12 * t12)
             eta = (t11 + t22) / (3.0 * seq) if seq > 0.0 else 0.0
-            ef = fracture_strain_jc(p, m, eta, rate)
-            dmg = s_in[i, S_JC_DAMAGE] + deps / ef if ef > 0.0 else 1.0
+            ef = s_frac * fracture_strain_jc(p, m, eta, rate)
+            d_old = s_in[i, S_JC_DAMAGE]
+            dmg = d_old + deps / ef if ef > 0.0 else 1.0
             s_out[i, S_JC_DAMAGE] = dmg
-            failed = dmg >= 1.0
-        ef_const = p[m, P_FRACTURE]
+            if dmg >= 1.0:
+                onset = True
+                after = deps if d_old >= 1.0 else deps * (dmg - 1.0) / (dmg - d_old)
+        ef_const = s_frac * p[m, P_FRACTURE]
         if ef_const > 0.0 and eps_p_new >= ef_const:
-            failed = True
+            onset = True
+            after = max(after, eps_p_new - max(eps_p, ef_const))
+    d_e_old = s_in[i, S_SOFT_DAMAGE]
+    d_e = d_e_old
+    failed = onset
+    if onset and s_in[i, S_EVOLUTION] > 0.0:
+        d_e = min(1.0, d_e_old + s_in[i, S_EVOLUTION] * after)  # (J15)
+        failed = d_e >= 1.0
+    if d_e > 0.0 and not failed:
+        # (J16): the stress is (1 − D_e) τ̃; what the step's work does not store is
+        # dissipated — plastic work and the work of softening together
+        a_o = 1.0 - d_e_old
+        a_n = 1.0 - d_e
+        work = 0.5 * thick * ((a_o * to11 + a_n * t11) * dd11 + (a_o * to22 + a_n * t22) * dd22
+                              + (a_o * to12 + a_n * t12) * dg12)
+        stored_old = s_in[i, S_ENERGY]
+        w_e = a_n * w_e
+        s_out[i, S_ENERGY] = w_e
+        s_out[i, S_PLASTIC_WORK] = s_in[i, S_PLASTIC_WORK] + work - (w_e - stored_old)
+        s_out[i, S_SOFT_DAMAGE] = d_e
+        s_out[i, S_SIG] = a_n * t11 / jac
+        s_out[i, S_SIG + 1] = a_n * t22 / jac
+        s_out[i, S_SIG + 2] = a_n * t12 / jac
+        t11 = a_n * t11
+        t22 = a_n * t22
+        t12 = a_n * t12
     if failed:
+        if d_e > d_e_old:  # softened to the end: the rest of its work was dissipated
+            a_o = 1.0 - d_e_old
+            work = 0.5 * thick * a_o * (to11 * dd11 + to22 * dd22 + to12 * dg12)
+            s_out[i, S_PLASTIC_WORK] = (s_in[i, S_PLASTIC_WORK] + work
+                                        + s_in[i, S_ENERGY])
+            s_out[i, S_SOFT_DAMAGE] = 1.0
+            w_e = 0.0
         s_out[i, S_FAIL_ENERGY] = s_in[i, S_FAIL_ENERGY] + w_e
         clear_failed_point(s_out, i)
         return STATUS_OK, 0.0, 0.0, 0.0, 0.0

@@ -31,7 +31,15 @@ P_DAMAGE_REF = 12  # ε̇0 of the damage rate term (1/s)
 P_N_HARD = 13  # number of rows of the hardening table (1 … N_HARD_MAX)
 P_HARD = 14  # row k: ε_p at P_HARD + 2k, σ_y (Pa) at P_HARD + 2k + 1
 N_HARD_MAX = 64
-N_PARAM = P_HARD + 2 * N_HARD_MAX
+# element-size regularisation of fracture (theory §7.3). The kernel reads none of these:
+# each point's S_FRAC_SCALE and S_EVOLUTION are set at the start of a run from its
+# element's length l_e = √A0 (materials.metal.regularised_columns).
+P_FRAC_LENGTH = P_HARD + 2 * N_HARD_MAX  # l_ref, the length at which ε_f holds as given (m)
+P_FAIL_DISP = P_FRAC_LENGTH + 1  # ū_f, plastic displacement from onset to failure (m); 0: none
+P_FRAC_ROWS = P_FRAC_LENGTH + 2  # rows of the fracture-strain scale table (0: s = 1)
+P_FRAC_TABLE = P_FRAC_LENGTH + 3  # row k: l_e/l_ref at P_FRAC_TABLE + 2k, scale s at + 2k + 1
+FRAC_ROWS_MAX = 16
+N_PARAM = P_FRAC_TABLE + 2 * FRAC_ROWS_MAX
 
 # --- state (history variables and outputs of one material point) -------------
 # S_ALIVE and S_ENERGY sit at the same columns as in fabric_layout, so a section
@@ -49,7 +57,11 @@ S_RATE = 12  # ε̇p, equivalent plastic strain rate of the last step (1/s)
 S_YIELD = 13  # σ_y, current flow stress (Pa), rate factor included
 S_FAIL_ENERGY = 14  # elastic energy per reference area released when the point failed (J/m²)
 S_RETURN_ITER = 15  # iterations of the last return
-N_STATE = 16
+# per point, set at the start of a run from its element's length and never changed (theory §7.3):
+S_FRAC_SCALE = 16  # s, the scale of the fracture strain (constant and Johnson–Cook) (—)
+S_EVOLUTION = 17  # l_e/ū_f: damage D_e grows by l_e Δε̄p/ū_f after onset (1/—); 0: fail at onset
+S_SOFT_DAMAGE = 18  # D_e ∈ [0, 1], damage after the onset of failure; the stress is (1 − D_e) τ̃
+N_STATE = 19
 
 # --- status codes returned per point -----------------------------------------
 STATUS_OK = 0

@@ -75,6 +75,32 @@ class FabricOptions:
 
 
 @dataclass(frozen=True)
+class FailureRegularisation:
+    """Element-size regularisation of yarn failure (theory §1.4, "Failure that does not
+    move with the mesh"). Each point knows its element's lengths h_w, h_f along the two
+    yarn families (the element's reference area over its width across the family).
+
+    Attributes:
+        reference_length: h_ref (m), the element length at which the material's own T_u
+            holds; None = the crossover cell along each family, 2ℓ_i0 (0.94 mm at 27 tpi).
+        strength_scale: rows (h_i/h_ref, s): family i fails at s T_u, s piecewise linear in
+            h_i/h_ref, flat beyond the first and last rows, s = 1 at h_ref; empty: s = 1.
+        softening_opening: δ_s (m) of progressive failure: past s T_u a yarn's tension falls
+            linearly to zero while the element opens by δ_s / s along the yarn — over the
+            yarn strain Δε_s,i = δ_s ℓ_i0 / (s h_i L_i0) — so that the work of the
+            softening, ½ s T_u · δ_s / s = ½ T_u δ_s per yarn crossing the crack, does not
+            depend on h_i; 0: the material's fixed ``softening_strain``.
+        erosion_opening: δ_e (m): a point whose family i is broken erodes once λ_i exceeds
+            1 + δ_e/h_i (the crack opened by δ_e); 0: the fixed ``erode_broken_stretch``.
+    """
+
+    reference_length: float | None = None
+    strength_scale: tuple[tuple[float, float], ...] = ()
+    softening_opening: float = 0.0
+    erosion_opening: float = 0.0
+
+
+@dataclass(frozen=True)
 class FabricParameters:
     """Complete, validated parameter set of the crossover model (SI).
 
@@ -88,6 +114,7 @@ class FabricParameters:
         areal_density: measured areal mass (kg/m²); None = from yarn volume (§1.8).
         thickness: shell thickness (m); None = 2 (h_w0 + h_f0) (= 4 h0, Table 5-1).
         options: model variants.
+        regularisation: element-size regularisation of failure (none by default).
         name: the material file's name (a label for reports; no part of the model).
     """
 
@@ -102,6 +129,7 @@ class FabricParameters:
     areal_density: float | None = None
     thickness: float | None = None
     options: FabricOptions = field(default_factory=FabricOptions)
+    regularisation: FailureRegularisation = field(default_factory=FailureRegularisation)
     name: str = field(default="", compare=False)
 
     # --- derived quantities ---------------------------------------------------
@@ -170,10 +198,11 @@ class FabricParameters:
                 )
         return out
 
-    def to_array(self) -> np.ndarray:
+    def to_array(self, table: bool = True) -> np.ndarray:
         """Pack into the flat parameter vector read by the kernels (with the crossover
         table appended when ``options.crossover == "table"`` and the frame is the fibre
-        frame; the Green–Naghdi option keeps the exact solve)."""
+        frame; the Green–Naghdi option keeps the exact solve). ``table=False``: the first
+        N_PARAM entries alone, without building the table."""
         p = np.zeros(L.N_PARAM)
         for i, y in enumerate((self.warp, self.fill)):
             p[L.P_E + i] = y.modulus
@@ -202,7 +231,22 @@ class FabricParameters:
         p[L.P_ERODE_STRETCH] = o.erode_broken_stretch
         p[L.P_ERODE_CRUSH] = o.erode_broken_crush
         p[L.P_ERODE_INTACT] = o.erode_intact_crush
+        r = self.regularisation
+        for i, y in enumerate((self.warp, self.fill)):
+            p[L.P_REG_LENGTH + i] = (r.reference_length if r.reference_length is not None
+                                     else 2.0 * y.half_length)
+        p[L.P_SOFT_OPENING] = r.softening_opening
+        p[L.P_ERODE_OPENING] = r.erosion_opening
+        if len(r.strength_scale) > L.REG_ROWS_MAX:
+            raise ValueError(f"strength_scale has {len(r.strength_scale)} rows; at most "
+                             f"{L.REG_ROWS_MAX}")
+        p[L.P_REG_ROWS] = len(r.strength_scale)
+        for k, (x, sc) in enumerate(r.strength_scale):
+            p[L.P_REG_TABLE + 2 * k] = x
+            p[L.P_REG_TABLE + 2 * k + 1] = sc
         p[L.P_TAB_START] = L.N_PARAM
+        if not table:
+            return p
         if o.crossover == "table" and o.frame == "fibre":
             from wovenimpact.materials.fabric_table import with_table
 
@@ -213,14 +257,58 @@ class FabricParameters:
 
 
 # --- running the kernel on points ------------------------------------------------
-def initial_state(params: FabricParameters, n_points: int = 1) -> np.ndarray:
-    """States of ``n_points`` undeformed points: H_i = h_i0, λ_i = 1, intact, alive."""
+def regularised_columns(p: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+    """Each point's failure columns S_TU_SCALE, S_SOFT, S_ERODE_LIMIT (warp, fill each)
+    from its element's lengths along the two families (theory §1.4).
+
+    Args:
+        p: the material's parameter row (:meth:`FabricParameters.to_array`).
+        lengths: (n, 2) h_w, h_f (m); a length ≤ 0 stands for the reference length
+            (a point without an element: the single-point drivers).
+
+    Returns:
+        (n, 6): s_w, s_f (T_u scales), Δε_s,w, Δε_s,f (softening strains), λ_lim,w,
+        λ_lim,f (stretch of a broken family at which the point erodes; 0: never).
+    """
+    lengths = np.atleast_2d(np.asarray(lengths, dtype=float))
+    h_ref = p[L.P_REG_LENGTH:L.P_REG_LENGTH + 2]
+    h = np.where(lengths > 0.0, lengths, h_ref)
+    n_rows = int(p[L.P_REG_ROWS])
+    table = p[L.P_REG_TABLE:L.P_REG_TABLE + 2 * n_rows].reshape(n_rows, 2)
+    scale = np.interp(h / h_ref, table[:, 0], table[:, 1]) if n_rows else np.ones_like(h)
+    out = np.empty((len(h), 6))
+    out[:, 0:2] = scale
+    opening = p[L.P_SOFT_OPENING]
+    # the yarn strain over which the element opens by δ_s / s in its plane: a straight
+    # yarn's strain grows by Δλ ℓ_i0 / L_i0 (eq. 6.19), and Δλ = δ_s / (s h_i)
+    crimp = p[L.P_ELL0:L.P_ELL0 + 2] / p[L.P_LT0:L.P_LT0 + 2]
+    out[:, 2:4] = crimp * opening / (scale * h) if opening > 0.0 else p[L.P_SOFT]
+    erode = p[L.P_ERODE_OPENING]
+    out[:, 4:6] = 1.0 + erode / h if erode > 0.0 else p[L.P_ERODE_STRETCH]
+    return out
+
+
+def set_regularised_columns(state: np.ndarray, p: np.ndarray, lengths: np.ndarray) -> None:
+    """Write :func:`regularised_columns` into the state rows (n, N_STATE), in place."""
+    cols = regularised_columns(p, lengths)
+    state[:, L.S_TU_SCALE:L.S_TU_SCALE + 2] = cols[:, 0:2]
+    state[:, L.S_SOFT:L.S_SOFT + 2] = cols[:, 2:4]
+    state[:, L.S_ERODE_LIMIT:L.S_ERODE_LIMIT + 2] = cols[:, 4:6]
+
+
+def initial_state(params: FabricParameters, n_points: int = 1,
+                  lengths: np.ndarray | None = None) -> np.ndarray:
+    """States of ``n_points`` undeformed points: H_i = h_i0, λ_i = 1, intact, alive;
+    their failure columns for elements of the given lengths (n_points, 2) along warp and
+    fill (None: the reference length, i.e. the material's own T_u; theory §1.4)."""
     s = np.zeros((n_points, L.N_STATE))
     s[:, L.S_H] = params.warp.h0
     s[:, L.S_H + 1] = params.fill.h0
     s[:, L.S_LAMBDA] = 1.0
     s[:, L.S_LAMBDA + 1] = 1.0
     s[:, L.S_ALIVE] = 1.0
+    set_regularised_columns(s, params.to_array(table=False),
+                            np.zeros((n_points, 2)) if lengths is None else lengths)
     return s
 
 

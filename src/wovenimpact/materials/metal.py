@@ -58,6 +58,28 @@ class DamageParameters:
 
 
 @dataclass(frozen=True)
+class FractureRegularisation:
+    """Element-size regularisation of fracture (theory §7.3; LS-DYNA *MAT_224 LCI, GISSMO
+    LCREGD, OpenRadioss /FAIL/INIEVO). Each point knows its element's length l_e = √A0.
+
+    Attributes:
+        reference_length: l_ref (m), the element length at which the fracture strain
+            (constant or Johnson–Cook) holds as given.
+        fracture_scale: rows (l_e/l_ref, s): the point's fracture strain is s ε_f, s
+            piecewise linear in l_e/l_ref, flat beyond the first and last rows, s = 1 at
+            l_ref; empty: s = 1.
+        failure_displacement: ū_f (m): after the onset of failure the damage D_e grows by
+            l_e Δε̄p/ū_f and the stress is (1 − D_e) times the undamaged one, so that the
+            work of the softening per unit crack area does not depend on l_e; the point
+            fails at D_e = 1. 0: it fails at onset.
+    """
+
+    reference_length: float = 0.0
+    fracture_scale: tuple[tuple[float, float], ...] = ()
+    failure_displacement: float = 0.0
+
+
+@dataclass(frozen=True)
 class MetalParameters:
     """Validated metal parameters (SI).
 
@@ -72,6 +94,7 @@ class MetalParameters:
         fracture_strain: equivalent plastic strain at failure (—), or None (no failure).
         rate: Johnson–Cook rate factor, or None (rate-independent).
         damage: Johnson–Cook damage, or None.
+        regularisation: element-size regularisation of fracture, or None.
     """
 
     name: str
@@ -83,6 +106,7 @@ class MetalParameters:
     fracture_strain: float | None = None
     rate: RateParameters | None = None
     damage: DamageParameters | None = None
+    regularisation: FractureRegularisation | None = None
 
     @property
     def shear_modulus(self) -> float:
@@ -135,16 +159,67 @@ def j2_parameter_row(params: MetalParameters) -> np.ndarray:
     for k, (e, s) in enumerate(params.hardening):
         p[L.P_HARD + 2 * k] = e
         p[L.P_HARD + 2 * k + 1] = s
+    r = params.regularisation
+    if r is not None:
+        if len(r.fracture_scale) > L.FRAC_ROWS_MAX:
+            raise ValueError(f"material {params.name!r}: fracture_scale has "
+                             f"{len(r.fracture_scale)} rows, at most {L.FRAC_ROWS_MAX}")
+        p[L.P_FRAC_LENGTH] = r.reference_length
+        p[L.P_FAIL_DISP] = r.failure_displacement
+        p[L.P_FRAC_ROWS] = len(r.fracture_scale)
+        for k, (x, sc) in enumerate(r.fracture_scale):
+            p[L.P_FRAC_TABLE + 2 * k] = x
+            p[L.P_FRAC_TABLE + 2 * k + 1] = sc
     return p
 
 
 # --- running the kernel on points ------------------------------------------------
-def initial_state(params: MetalParameters, n_points: int = 1) -> np.ndarray:
-    """States of ``n_points`` virgin points: no stress, λ3 = 1, alive, σ_y = σ_h(0)."""
+def regularised_columns(p: np.ndarray, lengths: np.ndarray) -> np.ndarray:
+    """Each point's S_FRAC_SCALE and S_EVOLUTION from its element's length l_e = √A0
+    (theory §7.3).
+
+    Args:
+        p: the material's J2 parameter row (:func:`j2_parameter_row`).
+        lengths: (n,) l_e (m); a length ≤ 0 stands for the reference length (a point
+            without an element: the single-point drivers).
+
+    Returns:
+        (n, 2): s (scale of the fracture strain) and l_e/ū_f (0: failure at onset).
+    """
+    lengths = np.asarray(lengths, dtype=float).reshape(-1)
+    l_ref = p[L.P_FRAC_LENGTH]
+    out = np.zeros((len(lengths), 2))
+    out[:, 0] = 1.0
+    if l_ref <= 0.0:
+        return out
+    le = np.where(lengths > 0.0, lengths, l_ref)
+    n_rows = int(p[L.P_FRAC_ROWS])
+    if n_rows:
+        table = p[L.P_FRAC_TABLE:L.P_FRAC_TABLE + 2 * n_rows].reshape(n_rows, 2)
+        out[:, 0] = np.interp(le / l_ref, table[:, 0], table[:, 1])
+    if p[L.P_FAIL_DISP] > 0.0:
+        out[:, 1] = le / p[L.P_FAIL_DISP]
+    return out
+
+
+def set_regularised_columns(state: np.ndarray, p: np.ndarray, lengths: np.ndarray) -> None:
+    """Write :func:`regularised_columns` into the state rows (n, N_STATE), in place."""
+    cols = regularised_columns(p, lengths)
+    state[:, L.S_FRAC_SCALE] = cols[:, 0]
+    state[:, L.S_EVOLUTION] = cols[:, 1]
+
+
+def initial_state(params: MetalParameters, n_points: int = 1,
+                  lengths: np.ndarray | None = None) -> np.ndarray:
+    """States of ``n_points`` virgin points: no stress, λ3 = 1, alive, σ_y = σ_h(0); their
+    fracture columns for elements of the given lengths l_e (None: the reference length,
+    i.e. the fracture strain as given; theory §7.3)."""
     s = np.zeros((n_points, L.N_STATE))
     s[:, L.S_THICK] = 1.0
     s[:, L.S_ALIVE] = 1.0
     s[:, L.S_YIELD] = params.hardening[0][1]
+    set_regularised_columns(s, j2_parameter_row(params),
+                            np.zeros(n_points) if lengths is None else lengths)
     return s
 
 

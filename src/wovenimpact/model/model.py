@@ -23,8 +23,10 @@ from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.materials.fabric import FabricParameters
 from wovenimpact.materials.fabric import initial_state as fabric_initial_state
+from wovenimpact.materials.fabric import regularised_columns as fabric_regularised_columns
 from wovenimpact.materials.metal import MetalParameters, j2_parameter_row
 from wovenimpact.materials.metal import initial_state as j2_initial_state
+from wovenimpact.materials.metal import regularised_columns as j2_regularised_columns
 
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 
@@ -33,6 +35,8 @@ def is_plastic(material) -> bool:
     """A J2 plastic metal (kernels.j2)."""
     return isinstance(material, MetalParameters) and material.kind == "j2_plastic"
 MEMBRANE_POINTS = {"full": SL.MEMBRANE_FULL, "reduced": SL.MEMBRANE_REDUCED}
+# what becomes of a node that loses its last live element (Model.eroded_nodes)
+ERODED_NODES = ("remove", "keep")
 GAUSS = 1.0 / np.sqrt(3.0)  # 2×2 Gauss points at (±1/√3, ±1/√3), weights 1
 GAUSS_XI = np.array([-GAUSS, GAUSS, GAUSS, -GAUSS])  # point g next to corner g
 GAUSS_ETA = np.array([-GAUSS, -GAUSS, GAUSS, GAUSS])
@@ -259,6 +263,9 @@ class ShellContactParams:
         friction: Coulomb coefficient μ ≥ 0.
         self_contact: a surface also meets its own non-adjacent segments (a folding
             ply or a single imported surface).
+        damping_mode: "always" (the dashpot acts while the pair overlaps) or "approach"
+            (only while it closes; theory §6). Not in the repr, which the digest hashes:
+            Model.digest adds it when it is not the default, so older digests hold.
     """
 
     enabled: bool = True
@@ -266,6 +273,7 @@ class ShellContactParams:
     damping: float = 0.3
     friction: float = 0.0
     self_contact: bool = False
+    damping_mode: str = field(default="always", repr=False)
 
 
 @dataclass(frozen=True, eq=False)
@@ -325,6 +333,16 @@ class Model:
         stable_step: "isotropic" or "yarn", the fabric elements' stable step (theory
             §4, "Stable step"; the shell kernel reads it as ``STEP_*``).
         elem_mass: (n_elems,) mass of each element, μ A0 (kg).
+        elem_length: (n_elems, 2) each element's lengths for the regularisation of
+            failure: along warp and fill for fabric, √A0 twice otherwise
+            (:func:`characteristic_lengths`).
+        elem_failure: (n_elems, 6) the failure columns of each element's points, from
+            its lengths (:func:`failure_columns`): fabric S_TU_SCALE … S_ERODE_LIMIT + 1,
+            J2 S_FRAC_SCALE, S_EVOLUTION in the first two.
+        eroded_nodes: "remove" (default): a node left without a live element leaves the
+            model with its kinetic energy; "keep" (LS-DYNA's ENMASS = 2): it flies on
+            as a free node with its mass and momentum, contact-active (theory §5,
+            "Eroded nodes").
     """
 
     x0: np.ndarray
@@ -371,6 +389,12 @@ class Model:
     # the rotary inertia each element lumps on each of its corners (kg m²; node_inertia
     # is their sum, so the digest covers it)
     elem_rot_inertia: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    # each element's lengths for the regularisation of failure (characteristic_lengths;
+    # derived from x0, quads and the warp direction): the initial material rows take
+    # their failure columns from them (state.initial_material_rows)
+    elem_length: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
+    elem_failure: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
+    eroded_nodes: str = "remove"
 
     @property
     def n_nodes(self) -> int:
@@ -397,6 +421,10 @@ class Model:
                        self.mass_scaling_fraction)).encode())
         if self.stable_step != "isotropic":  # (the default leaves older digests as they were)
             h.update(self.stable_step.encode())
+        if self.eroded_nodes != "remove":  # (likewise)
+            h.update(self.eroded_nodes.encode())
+        if self.shell_contact.damping_mode != "always":  # (likewise)
+            h.update(self.shell_contact.damping_mode.encode())
         h.update(np.ascontiguousarray(self.release_elems).tobytes())
         return h.hexdigest()
 
@@ -456,6 +484,52 @@ def material_frame_gradients(x0, quads, warp_direction):
     the 2×2 Gauss points with their weights det J(ξ_g, η_g) (Σ_g = area for a planar
     quad) — see :func:`gauss_gradients`.
     """
+    X, Y, area = material_frame_coordinates(x0, quads, warp_direction)
+    grad = np.empty((len(quads), 2, 4))
+    # one-point gradients of the bilinear quad (Belytschko–Lin–Tsay B matrix)
+    a2 = 2.0 * area
+    grad[:, 0] = np.stack([Y[:, 1] - Y[:, 3], Y[:, 2] - Y[:, 0], Y[:, 3] - Y[:, 1],
+                           Y[:, 0] - Y[:, 2]], axis=1) / a2[:, None]
+    grad[:, 1] = np.stack([X[:, 3] - X[:, 1], X[:, 0] - X[:, 2], X[:, 1] - X[:, 3],
+                           X[:, 2] - X[:, 0]], axis=1) / a2[:, None]
+    g_grad, g_weight = gauss_gradients(X, Y)
+    return grad, area, g_grad, g_weight
+
+
+def characteristic_lengths(x0, quads, warp_direction, kinds) -> np.ndarray:
+    """Each element's lengths for the regularisation of failure (theory §1.4, §7.3), (n, 2):
+    for a fabric element (kinds[e] == MAT_FABRIC) its length along each yarn family,
+    h_i = A0 / (its width across family i) — for a rectangle a × b with the warp along a,
+    h_w = a and h_f = b, the width of the band a crack across family i opens in; for any
+    other element l_e = √A0 in both columns (GISSMO's SIZFLG = 0 for shells)."""
+    X, Y, area = material_frame_coordinates(x0, quads, warp_direction)
+    out = np.empty((len(quads), 2))
+    out[:, 0] = area / (Y.max(axis=1) - Y.min(axis=1))
+    out[:, 1] = area / (X.max(axis=1) - X.min(axis=1))
+    other = np.asarray(kinds) != SL.MAT_FABRIC
+    out[other] = np.sqrt(area[other])[:, None]
+    return out
+
+
+def failure_columns(kinds, params, elem_mat, elem_length) -> np.ndarray:
+    """(n_elems, 6): the failure columns of each element's material points (theory §1.4,
+    §7.3) from its lengths — a fabric's :func:`materials.fabric.regularised_columns`, a
+    J2 metal's :func:`materials.metal.regularised_columns` in the first two, zeros for an
+    elastic element. kinds, params: per material; elem_mat: each element's material."""
+    out = np.zeros((len(elem_mat), 6))
+    for m, (kind, p) in enumerate(zip(kinds, params)):
+        sel = np.flatnonzero(elem_mat == m)
+        if kind == SL.MAT_FABRIC:
+            out[sel] = fabric_regularised_columns(p, elem_length[sel])
+        elif kind == SL.MAT_J2:
+            out[sel, :2] = j2_regularised_columns(p, elem_length[sel, 0])
+    return out
+
+
+def material_frame_coordinates(x0, quads, warp_direction):
+    """Corner coordinates (X, Y) (n, 4) of each element in its material frame (origin at
+    the corners' mean; see :func:`material_frame_gradients`) and the reference areas (n,).
+    """
     xe = x0[quads]  # (n, 4, 3)
     d13 = xe[:, 2] - xe[:, 0]
     d24 = xe[:, 3] - xe[:, 1]
@@ -484,15 +558,7 @@ def material_frame_gradients(x0, quads, warp_direction):
     rel = xe - xe.mean(axis=1, keepdims=True)
     X = np.einsum("nij,nj->ni", rel, e1)
     Y = np.einsum("nij,nj->ni", rel, e2)
-    grad = np.empty((len(quads), 2, 4))
-    # one-point gradients of the bilinear quad (Belytschko–Lin–Tsay B matrix)
-    a2 = 2.0 * area
-    grad[:, 0] = np.stack([Y[:, 1] - Y[:, 3], Y[:, 2] - Y[:, 0], Y[:, 3] - Y[:, 1],
-                           Y[:, 0] - Y[:, 2]], axis=1) / a2[:, None]
-    grad[:, 1] = np.stack([X[:, 3] - X[:, 1], X[:, 0] - X[:, 2], X[:, 1] - X[:, 3],
-                           X[:, 2] - X[:, 0]], axis=1) / a2[:, None]
-    g_grad, g_weight = gauss_gradients(X, Y)
-    return grad, area, g_grad, g_weight
+    return X, Y, area
 
 
 def release_array(elems, n_elems: int) -> np.ndarray:
@@ -567,6 +633,7 @@ def build_model(
     mass_scaling_fraction: float = 0.0,
     max_added_mass_fraction: float = 0.02,
     stable_step: str = "isotropic",
+    eroded_nodes: str = "remove",
 ) -> Model:
     """Assemble a :class:`Model` from a mesh, named sections and constraints.
 
@@ -591,6 +658,8 @@ def build_model(
         max_added_mass_fraction: stop once the added mass exceeds this fraction of the
             model's mass, 0 < f ≤ 1; default 0.02.
         stable_step: "isotropic" (default) or "yarn" (theory §4, "Stable step").
+        eroded_nodes: "remove" (default) or "keep": what becomes of a node that loses
+            its last live element (theory §5, "Eroded nodes").
     """
     x0 = np.ascontiguousarray(nodes, dtype=float)
     q = np.ascontiguousarray(quads, dtype=np.int64)
@@ -619,6 +688,9 @@ def build_model(
     if stable_step not in SL.STABLE_STEPS:
         raise InputError(
             f"stable_step = {stable_step!r}: valid {' or '.join(SL.STABLE_STEPS)}")
+    if eroded_nodes not in ERODED_NODES:
+        raise InputError(
+            f"eroded_nodes = {eroded_nodes!r}: valid {' or '.join(map(repr, ERODED_NODES))}")
     names = list(sections)
     # materials: one table row per distinct material object
     mats: list = []
@@ -672,6 +744,9 @@ def build_model(
     mat_row = np.zeros(len(q) + 1, dtype=np.int64)
     np.cumsum(sec_rows[es], out=mat_row[1:])
     ref_grad, area0, gauss_grad, gauss_weight = material_frame_gradients(x0, q, warp_direction)
+    elem_mat = sec_table[es, SL.C_MAT].astype(np.int64)
+    elem_length = characteristic_lengths(x0, q, warp_direction, np.array(kinds)[elem_mat])
+    elem_failure = failure_columns(kinds, params, elem_mat, elem_length)
     # lumped masses: a quarter of each element's mass to each corner, and the rotary
     # inertia the element lumps on each corner (rotary_inertia: rotations never govern
     # the stable step at the reference geometry; theory §4, "Stable step")
@@ -724,6 +799,6 @@ def build_model(
         section_names=tuple(names), material_names=tuple(getattr(m, "name", "") for m in mats),
         mass_scaling_fraction=float(mass_scaling_fraction),
         max_added_mass_fraction=float(max_added_mass_fraction), elem_mass=m_el,
-        elem_rot_inertia=elem_rot_inertia,
-        stable_step=str(stable_step),
+        elem_rot_inertia=elem_rot_inertia, elem_length=elem_length, elem_failure=elem_failure,
+        stable_step=str(stable_step), eroded_nodes=str(eroded_nodes),
     )

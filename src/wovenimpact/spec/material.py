@@ -25,12 +25,24 @@ import warnings
 from pathlib import Path
 from typing import Any, Literal
 
+import numpy as np
 from pydantic import BaseModel, Field, ValidationError
 
 from wovenimpact.calibration.crimp import crimp_amplitude, half_length_from_thread_count
-from wovenimpact.kernels.j2_layout import N_HARD_MAX
-from wovenimpact.materials.fabric import FabricOptions, FabricParameters, YarnFamily
-from wovenimpact.materials.metal import DamageParameters, MetalParameters, RateParameters
+from wovenimpact.kernels.fabric_layout import REG_ROWS_MAX
+from wovenimpact.kernels.j2_layout import FRAC_ROWS_MAX, N_HARD_MAX
+from wovenimpact.materials.fabric import (
+    FabricOptions,
+    FabricParameters,
+    FailureRegularisation,
+    YarnFamily,
+)
+from wovenimpact.materials.metal import (
+    DamageParameters,
+    FractureRegularisation,
+    MetalParameters,
+    RateParameters,
+)
 from wovenimpact.spec.fields import (
     STRICT,
     InputWarning,
@@ -113,6 +125,27 @@ class OptionsSpec(BaseModel):
     crossover: Literal["table", "exact"] = FabricOptions.crossover
 
 
+ScaleTable = list[
+    tuple[
+        quantity("dimensionless", gt=0, example="4"),
+        quantity("dimensionless", gt=0, le=100, example="0.8"),
+    ]
+]
+
+
+class FabricRegularisationSpec(BaseModel):
+    """``[material.regularisation]``: element-size regularisation of yarn failure
+    (docs/theory.md §1.4; :class:`~wovenimpact.materials.fabric.FailureRegularisation`)."""
+
+    model_config = STRICT
+    # h_ref; default: the crossover cell along each family, 2ℓ_i0
+    reference_length: quantity("length", gt=0, example="0.94 mm") | None = None
+    # [[h/h_ref, scale of T_u], ...], h/h_ref increasing, scale 1 at h/h_ref = 1
+    strength_scale: ScaleTable = Field(default_factory=list, max_length=REG_ROWS_MAX)
+    softening_opening: quantity("length", gt=0, example="0.3 mm") | None = None
+    erosion_opening: quantity("length", gt=0, example="0.94 mm") | None = None
+
+
 class FabricSpec(BaseModel):
     """``[material]`` with ``kind = "woven_fabric"``."""
 
@@ -127,6 +160,7 @@ class FabricSpec(BaseModel):
     compaction: CompactionSpec
     shear: ShearSpec
     options: OptionsSpec = OptionsSpec()
+    regularisation: FabricRegularisationSpec | None = None
 
 
 class FabricFile(BaseModel):
@@ -172,6 +206,17 @@ class DamageSpec(BaseModel):
     reference_rate: quantity("strain_rate", gt=0, example="1 1/s") | None = None
 
 
+class MetalRegularisationSpec(BaseModel):
+    """``[material.regularisation]``: element-size regularisation of fracture
+    (docs/theory.md §7.3; :class:`~wovenimpact.materials.metal.FractureRegularisation`)."""
+
+    model_config = STRICT
+    reference_length: quantity("length", gt=0, example="0.5 mm")
+    # [[l_e/l_ref, scale of the fracture strain], ...], l_e/l_ref increasing, 1 at 1
+    fracture_scale: ScaleTable = Field(default_factory=list, max_length=FRAC_ROWS_MAX)
+    failure_displacement: quantity("length", gt=0, example="0.05 mm") | None = None
+
+
 class J2Spec(BaseModel):
     """``[material]`` with ``kind = "j2_plastic"`` (aluminium casing, titanium blade)."""
 
@@ -184,6 +229,7 @@ class J2Spec(BaseModel):
     plasticity: PlasticitySpec
     rate: RateSpec | None = None
     damage: DamageSpec | None = None
+    regularisation: MetalRegularisationSpec | None = None
 
 
 class ElasticSpec(BaseModel):
@@ -328,6 +374,13 @@ def _fabric_parameters(
         erode_intact_crush=o.erode_intact_crush,
         crossover=o.crossover,
     )
+    r = spec.regularisation
+    regularisation = FailureRegularisation() if r is None else FailureRegularisation(
+        reference_length=r.reference_length,
+        strength_scale=tuple((float(x), float(v)) for x, v in r.strength_scale),
+        softening_opening=r.softening_opening or 0.0,
+        erosion_opening=r.erosion_opening or 0.0,
+    )
     return FabricParameters(
         warp=families["warp"],
         fill=families["fill"],
@@ -340,6 +393,7 @@ def _fabric_parameters(
         areal_density=spec.areal_density,
         thickness=spec.thickness,
         options=options,
+        regularisation=regularisation,
         name=spec.name,
     )
 
@@ -372,16 +426,54 @@ def _check_fabric(spec: FabricSpec, raw: dict) -> list[Problem]:
                 )
             )
     problems += _check_weave_geometry(spec, raw)
-    if spec.options.failure == "progressive" and spec.options.softening_strain is None:
+    r = spec.regularisation
+    opening = r is not None and r.softening_opening is not None
+    if spec.options.failure == "progressive" and spec.options.softening_strain is None \
+            and not opening:
         problems.append(
             Problem(
                 "material.options.softening_strain",
                 "is required when failure = 'progressive' (the strain over which the yarn "
-                "tension falls to zero, MODEL.md §1.4)",
+                "tension falls to zero, docs/theory.md §1.4), unless "
+                "material.regularisation.softening_opening gives the softening as an opening",
                 valid="a dimensionless number > 0 such as 0.01",
             )
         )
+    if opening and spec.options.failure != "progressive":
+        problems.append(Problem(
+            "material.regularisation.softening_opening",
+            "needs material.options.failure = 'progressive' (an instant failure has no "
+            "softening)", _raw(raw, "regularisation", "softening_opening"),
+            "failure = 'progressive', or no softening_opening"))
+    if opening and spec.options.softening_strain is not None:
+        problems.append(Problem(
+            "material.options.softening_strain",
+            "and material.regularisation.softening_opening both give the softening; the "
+            "opening takes the element's length into account, the strain does not",
+            _raw(raw, "options", "softening_strain"), "one of the two"))
+    if r is not None:
+        problems += _check_scale_table(r.strength_scale, raw, "strength_scale")
     return problems
+
+
+def _check_scale_table(table: list[tuple[float, float]], raw: dict, key: str) -> list[Problem]:
+    """A regularisation table: lengths strictly increasing, the scale 1 at the reference
+    length (where the material's own value holds, docs/theory.md §1.4, §7.3)."""
+    if not table:
+        return []
+    loc = f"material.regularisation.{key}"
+    xs = [float(x) for x, _ in table]
+    if any(b <= a for a, b in zip(xs, xs[1:])):
+        return [Problem(loc, "has lengths (first column, element length / reference length) "
+                        "that do not strictly increase", _raw(raw, "regularisation", key),
+                        "rows [[l/l_ref, scale], ...] with l/l_ref strictly increasing")]
+    at_one = float(np.interp(1.0, xs, [float(v) for _, v in table]))
+    if abs(at_one - 1.0) > 1e-12:
+        return [Problem(loc, f"gives the scale {at_one:.6g} at the reference length (l/l_ref "
+                        "= 1), where the material's own value must hold",
+                        _raw(raw, "regularisation", key),
+                        "a table whose scale is 1 at l/l_ref = 1 (e.g. a row [1, 1])")]
+    return []
 
 
 def _check_weave_geometry(spec: FabricSpec, raw: dict) -> list[Problem]:
@@ -438,8 +530,17 @@ def _metal_parameters(spec: J2Spec | ElasticSpec, raw: dict, source: str) -> Met
     rate = damage = None
     if isinstance(spec, J2Spec):
         table = spec.plasticity.hardening
+        reg_problems = []
+        if spec.regularisation is not None:
+            reg_problems = _check_scale_table(spec.regularisation.fracture_scale, raw,
+                                              "fracture_scale")
+            if spec.plasticity.fracture_strain is None and spec.damage is None:
+                reg_problems.append(Problem(
+                    "material.regularisation", "regularises a fracture strain the material "
+                    "does not have", valid="material.plasticity.fracture_strain or a "
+                    "[material.damage] table, or no [material.regularisation]"))
         raise_problems(_check_hardening(table, raw) + _check_damage(spec, raw)
-                       + _check_yield_strain(spec, raw), source)
+                       + _check_yield_strain(spec, raw) + reg_problems, source)
         hardening = tuple((float(e), float(s)) for e, s in table)
         fracture = spec.plasticity.fracture_strain
         if spec.rate is not None:
@@ -450,6 +551,14 @@ def _metal_parameters(spec: J2Spec | ElasticSpec, raw: dict, source: str) -> Met
             if ref is None:
                 ref = spec.rate.reference_rate if spec.rate is not None else 1.0
             damage = DamageParameters(d=(d.d1, d.d2, d.d3, d.d4, d.d5), reference_rate=ref)
+    regularisation = None
+    r = getattr(spec, "regularisation", None)
+    if r is not None:
+        regularisation = FractureRegularisation(
+            reference_length=r.reference_length,
+            fracture_scale=tuple((float(x), float(v)) for x, v in r.fracture_scale),
+            failure_displacement=r.failure_displacement or 0.0,
+        )
     return MetalParameters(
         name=spec.name,
         kind=spec.kind,
@@ -460,6 +569,7 @@ def _metal_parameters(spec: J2Spec | ElasticSpec, raw: dict, source: str) -> Met
         fracture_strain=fracture,
         rate=rate,
         damage=damage,
+        regularisation=regularisation,
     )
 
 

@@ -215,6 +215,7 @@ def test_restart_refuses_side_files_that_do_not_match_its_checkpoint(tmp_path):
     "edit, message",
     [
         (("[run]", "[run]\nbogus = 1"), "run.bogus"),
+        (("[run]", '[run]\neroded_nodes = "stay"'), "run.eroded_nodes"),
         (('end_time = "{end}"', 'end_time = "20"'), "run.end_time"),
         (('element_size = "0.94 mm"', 'element_size = "-0.94 mm"'), "mesh.element_size"),
         (('nodes = "edge_outer"', 'nodes = "rim"'), "boundary[0].nodes"),

@@ -75,13 +75,17 @@ class NodeMap(NamedTuple):
 
 
 class NodeModel(NamedTuple):
-    """Nodal masses (with any added by mass scaling), constraints and body loads."""
+    """Nodal masses (with any added by mass scaling), constraints and body loads, and
+    what becomes of a node that loses its last element."""
 
     mass: np.ndarray  # (n_nodes,) kg
     inertia: np.ndarray  # (n_nodes,) rotary inertia, kg m²
     bc_code: np.ndarray  # (n_nodes, 6) integrate FREE / FIXED / PRESCRIBED / ROTATING
     bc_velocity: np.ndarray  # (n_nodes, 6) prescribed velocities (or ω and the centre)
     body_accel: np.ndarray  # (n_nodes, 3) body-force acceleration, m/s²
+    # False: it leaves the model with its kinetic energy; True: it flies on as a free
+    # node with its mass and momentum (run.eroded_nodes = "keep"; integrate.update_node)
+    keep_free: bool = False
 
 
 class NodeForces(NamedTuple):

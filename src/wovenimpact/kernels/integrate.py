@@ -18,6 +18,14 @@ to (ωΔt/2)².
 gathers its internal force (``gather.node_force_sum``), then takes the update of
 ``update_node``; it also counts nodes left at a non-finite position, so the
 caller checks one integer instead of scanning x.
+
+A node that loses its last live element either leaves the model with its kinetic
+energy (``ke_eroded``; v = ω = 0, ``node_active`` 0: the default) or, with
+``NodeModel.keep_free`` (``run.eroded_nodes = "keep"``, LS-DYNA's ENMASS = 2), flies on
+as a free node: the same update with f_int = 0 (no element is left to gather), so it
+keeps its mass, momentum and spin (no moment acts on it: ω stays constant), takes its
+body load, constraints and contact forces, and its kinetic energy stays in ``ke``. A
+node without mass (in no element from the start) leaves the model either way.
 """
 
 from __future__ import annotations
@@ -91,14 +99,15 @@ def force_pair_power(f_old, f_new, v, dt, node_work):
 
 @inline_kernel
 def update_node(
-    n, mass, inertia, bc_code, bc_velocity, body_accel, f_con, amplitude, dt_old, dt_mid,
-    dt_new, f_int, f_int_old, f_ext_old, live, x, v, omega, node_active, f_ext, w_int, w_ext,
-    ke, ke_eroded,
+    n, mass, inertia, bc_code, bc_velocity, body_accel, keep_free, f_con, amplitude, dt_old,
+    dt_mid, dt_new, f_int, f_int_old, f_ext_old, live, x, v, omega, node_active, f_ext, w_int,
+    w_ext, ke, ke_eroded,
 ):
     """Central-difference update of node n (in place: x, v, omega, node_active; written:
     f_ext[n], w_int[n], w_ext[n], ke[n], ke_eroded[n]). ``live``: its live elements
-    (0 → the node is eroded now); dt_mid = ½(Δt^{n−1/2} + Δt^{n+1/2}). The arguments
-    are those of :func:`gather_and_update`.
+    (0 → the node has no element: it leaves the model now, or with ``keep_free`` and a
+    mass it flies on as a free node, f_int = 0); dt_mid = ½(Δt^{n−1/2} + Δt^{n+1/2}).
+    The arguments are those of :func:`gather_and_update`.
     """
     # the sums accumulate in locals (stored once: the arrays may alias as far as the
     # compiler knows, so += on them goes through memory); same order as ever
@@ -120,7 +129,7 @@ def update_node(
         wi += 0.5 * (f_int_old[n, d] + f_int[n, d]) * du
     w_int[n] = wi
     we = 0.0
-    if live == 0:
+    if live == 0 and not (keep_free and m > 0.0):
         # the loads of the last step still did work over [x^{n−1}, x^n]
         for d in range(6):
             vel = v[n, d] if d < 3 else omega[n, d - 3]
@@ -185,7 +194,8 @@ def gather_and_update(node_map, elements, nodes, f_con, amplitude, dt_old, dt_ne
         node_map: ``bundles.NodeMap`` (Model).
         elements: ``bundles.ElementResults`` of the element stage: its ``blocks``
             (n_elems, 4, 6) corner forces and moments at x^n and ``alive`` bytes are read.
-        nodes: ``bundles.NodeModel``: masses, rotary inertias, constraints, body loads.
+        nodes: ``bundles.NodeModel``: masses, rotary inertias, constraints, body loads,
+            and what becomes of a node that loses its last element (``keep_free``).
         f_con: (n, 3) contact forces at x^n (external loads of the shells).
         amplitude: prescribed-velocity amplitude at t^{n+1/2}.
         dt_old, dt_new: Δt^{n−1/2}, Δt^{n+1/2}.
@@ -193,11 +203,12 @@ def gather_and_update(node_map, elements, nodes, f_con, amplitude, dt_old, dt_ne
             f_int_old and f_ext_old at x^{n−1} read, f_ext written (body forces plus
             reactions at x^n).
         motion: ``bundles.Motion``: x, v, omega advanced in place.
-        node_active: (n,) advanced in place (0 once a node has lost its last element).
+        node_active: (n,) advanced in place (0 once a node has left the model: it lost
+            its last element, and ``nodes.keep_free`` is off or it has no mass).
         energies: ``bundles.NodeEnergies``, written: per-node internal and external work
             increments over [x^{n−1}, x^n], kinetic energy at t^n (½ m v^{n−1/2} ·
-            v^{n+1/2}, see the module docstring), and kinetic energy removed with nodes
-            eroded this step.
+            v^{n+1/2}, see the module docstring; free nodes included), and kinetic
+            energy removed with nodes that left the model this step.
 
     Returns:
         the number of nodes whose position x^{n+1} is not finite (0 when all is well).
@@ -214,6 +225,7 @@ def gather_and_update(node_map, elements, nodes, f_con, amplitude, dt_old, dt_ne
     bc_code = nodes.bc_code
     bc_velocity = nodes.bc_velocity
     body_accel = nodes.body_accel
+    keep_free = nodes.keep_free
     f_int = forces.f_int
     f_int_old = forces.f_int_old
     f_ext_old = forces.f_ext_old
@@ -240,9 +252,9 @@ def gather_and_update(node_map, elements, nodes, f_con, amplitude, dt_old, dt_ne
         f_int[n, 4] = f4
         f_int[n, 5] = f5
         update_node(
-            n, mass, inertia, bc_code, bc_velocity, body_accel, f_con, amplitude, dt_old,
-            dt_mid, dt_new, f_int, f_int_old, f_ext_old, live, x, v, omega, node_active, f_ext,
-            w_int, w_ext, ke, ke_eroded,
+            n, mass, inertia, bc_code, bc_velocity, body_accel, keep_free, f_con, amplitude,
+            dt_old, dt_mid, dt_new, f_int, f_int_old, f_ext_old, live, x, v, omega, node_active,
+            f_ext, w_int, w_ext, ke, ke_eroded,
         )
         if not (math.isfinite(x[n, 0]) and math.isfinite(x[n, 1]) and math.isfinite(x[n, 2])):
             n_bad += 1

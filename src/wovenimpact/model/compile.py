@@ -180,7 +180,8 @@ def node_set(mesh: Mesh, name: str, key: str) -> np.ndarray:
 def erode_at_start(model: Model, state: State, er, key: str) -> None:
     """Erode the elements whose centroid lies within er.radius of the line through
     er.centre along er.cylinder_axis (a hole through the plies); nodes left without a
-    live element leave the model."""
+    live element leave the model, whatever ``run.eroded_nodes`` says (the hole's
+    material is not there at t = 0; that option is about material eroded in the run)."""
     from wovenimpact.kernels import shell_layout as SL
 
     centroid = model.x0[model.quads].mean(axis=1)
@@ -494,6 +495,7 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         mass_scaling_fraction=spec.run.mass_scaling_fraction,
         max_added_mass_fraction=spec.run.max_added_mass_fraction,
         stable_step=spec.run.stable_step,
+        eroded_nodes=spec.run.eroded_nodes,
     )
     v = np.zeros((mesh.n_nodes, 3))
     w = np.zeros((mesh.n_nodes, 3))

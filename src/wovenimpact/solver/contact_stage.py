@@ -63,7 +63,10 @@ def contact_forces(model, state, cb: ContactBuffers, dt: float, elem_alive,
     ``elem_alive`` (n_elems,) are the elements alive at the end of this step's element
     stage; when ``eroded_now`` of them eroded in it, the nodes they left without a live
     element take no contact force (they leave the model in this step's node update,
-    so nothing could react to it: the body would be pushed by a node that is gone).
+    so nothing could react to it: the body would be pushed by a node that is gone) —
+    unless ``run.eroded_nodes = "keep"``: they then stay in the model as free nodes and
+    take contact like any active node, against the bodies and, as slave nodes, the live
+    segments of the other surfaces (with the offsets and penalty masses they had).
 
     Penalty stiffness k = β m / Δt_k² with Δt_k = max(Δt, Δt_first): it follows a step
     that grows (so that ω Δt stays below 2) but not one that falls. When a crushed
@@ -77,7 +80,7 @@ def contact_forces(model, state, cb: ContactBuffers, dt: float, elem_alive,
     cb.f_con[:] = 0.0
     dt = max(dt, state.dt_first)
     active = state.node_active
-    if eroded_now:
+    if eroded_now and model.eroded_nodes != "keep":
         nodes_with_live_elements(model.node_ptr, model.node_elem, elem_alive, state.node_active,
                                  cb.active)
         active = cb.active

@@ -258,7 +258,8 @@ def release(model, state: State) -> None:
     """Erode the model's release elements still alive (a blade's fragment breaking free
     of its hub part at ``model.release_time``); their energies are booked as eroded
     internal energy, once. Their nodes left without a live element leave the model in
-    the node update that follows."""
+    the node update that follows (or, with ``run.eroded_nodes = "keep"``, fly on as free
+    nodes)."""
     idx = model.release_elems
     live = idx[state.elem[idx, SL.E_ALIVE] != 0.0]
     if not live.size:
@@ -291,7 +292,8 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     n_bad = gather_and_update(
         ws.node_map, ws.results,
         NodeModel(mass=ws.node_mass, inertia=ws.node_inertia, bc_code=model.bc_code,
-                  bc_velocity=model.bc_velocity, body_accel=model.body_accel),
+                  bc_velocity=model.bc_velocity, body_accel=model.body_accel,
+                  keep_free=model.eroded_nodes == "keep"),
         cb.f_con, amplitude, state.dt, dt_new,
         NodeForces(f_int=ws.f_int, f_int_old=state.f_int, f_ext_old=state.f_ext,
                    f_ext=ws.f_ext),
@@ -375,8 +377,9 @@ def body_force_work(model, state: State) -> float:
     """Work of the body forces (gravity) up to the last whole step t^n, like every work of
     :func:`energy_balance`: Σ_a m_a g_a · (x_a^n − X_a), exact for the constant loads
     m_a g_a that the trapezoid rule integrates; x^n = x^{n+1} − Δt^{n+1/2} v^{n+1/2}
-    (the State already holds x^{n+1}). A node stops moving, and its body force working,
-    when it erodes (its velocity is then zero)."""
+    (the State already holds x^{n+1}). A node that leaves the model stops moving, and its
+    body force working (its velocity is then zero); a free node (``run.eroded_nodes =
+    "keep"``) keeps both."""
     g = model.body_accel[:, :3]
     if not np.any(g):
         return 0.0

@@ -52,8 +52,9 @@ Schema (see README and examples/cases/)::
     [[initial_erosion]]  centre, radius, plies?: elements eroded at t = 0 (a hole: centroid
                       within radius of the axis through centre along cylinder_axis)
     [run]             end_time, field_interval, history_interval, checkpoint_interval,
-                      alpha, erode_dt_fraction, erode_inverted, mass_scaling_fraction,
-                      max_added_mass_fraction, threads, max_steps (the
+                      alpha, erode_dt_fraction, erode_inverted, eroded_nodes (remove |
+                      keep), mass_scaling_fraction, max_added_mass_fraction, threads,
+                      max_steps (the
                       predicted step count end_time/Δt₁ above which the run is refused;
                       5e6; docs/inputs.md)
 """
@@ -372,6 +373,11 @@ class RunSpec(BaseModel):
     # perforation (0.28 % with the material option erode_intact_crush = 0.1; the
     # default's up to 0.2 %); not yet the default
     stable_step: Literal["isotropic", "yarn"] = "isotropic"
+    # what becomes of a node that loses its last live element (docs/theory.md §5, "Eroded
+    # nodes"): "remove" leaves the model with its kinetic energy (eroded_kinetic; the
+    # default), "keep" flies on as a free node with its mass and momentum, contact-active
+    # against impactors and other plies' segments (LS-DYNA's ENMASS = 2)
+    eroded_nodes: Literal["remove", "keep"] = "remove"
     # the run stops once the added mass exceeds this fraction of the model's mass
     max_added_mass_fraction: quantity("dimensionless", gt=0, le=1, example="0.02") = 0.02
     threads: int | None = Field(default=None, ge=1)

@@ -17,15 +17,17 @@ from wovenimpact.errors import InputError
 from wovenimpact.model.mesh import Mesh
 
 
-def _divisions(extent: float, size: float, label: str) -> int:
+def _divisions(extent: float, size: float, label: str, size_key: str = "element_size") -> int:
+    """Elements along an edge of length ``extent`` at target size ``size`` (``size_key``
+    names it in messages)."""
     if not (math.isfinite(extent) and extent > 0.0):
         raise InputError(f"{label} = {extent:.6g} m must be > 0")
     if not (math.isfinite(size) and size > 0.0):
-        raise InputError(f"element_size = {size:.6g} m must be > 0")
+        raise InputError(f"{size_key} = {size:.6g} m must be > 0")
     n = int(math.ceil(extent / size - 1e-9))
     if n > 20000:
-        raise InputError(f"{label} / element_size = {extent / size:.3g} elements along one "
-                         "edge; choose a larger element_size")
+        raise InputError(f"{label} / {size_key} = {extent / size:.3g} elements along one "
+                         f"edge; choose a larger {size_key}")
     return max(n, 1)
 
 
@@ -209,6 +211,7 @@ def blade_mesh(
     stagger: float = 0.0,
     twist: float = 0.0,
     tip_curve: float = 0.0,
+    size_key: str = "element_size",
 ) -> Mesh:
     """A tapered blade from ``root_radius`` to ``tip_radius`` along the radial
     direction at ``angle`` (degrees from +x), its chord along z (linear taper from
@@ -233,6 +236,9 @@ def blade_mesh(
     the fragment then flies free, the hub part keeps turning). Sets: nodes ``root``
     (r = root_radius), ``hub``, ``fragment``; elements ``hub``, ``fragment``
     (``release`` included in neither), ``blade``.
+
+    ``element_size`` is the blade's own (a containment case's ``mesh.blade.element_size``,
+    or its casing's size when that is not given); ``size_key`` names it in messages.
     """
     if not (0.0 < root_radius < crack_radius < tip_radius):
         raise InputError(f"blade radii: need 0 < root_radius ({root_radius:.6g}) < crack_radius "
@@ -248,9 +254,10 @@ def blade_mesh(
         if not (math.isfinite(a) and abs(a) <= 90.0 + 1e-9):  # "90 deg" read through radians
             raise InputError(f"blade {label} = {a:.6g} deg must lie within [−90, 90] deg (the "
                              "chord turned from the axial direction towards the tangential)")
-    n_in = _divisions(crack_radius - root_radius, element_size, "blade hub length")
-    n_out = _divisions(tip_radius - crack_radius, element_size, "blade fragment length")
-    n_c = _divisions(min(root_chord, tip_chord), element_size, "blade chord")
+    n_in = _divisions(crack_radius - root_radius, element_size, "blade hub length", size_key)
+    n_out = _divisions(tip_radius - crack_radius, element_size, "blade fragment length",
+                       size_key)
+    n_c = _divisions(min(root_chord, tip_chord), element_size, "blade chord", size_key)
     r = np.concatenate([np.linspace(root_radius, crack_radius, n_in + 1),
                         np.linspace(crack_radius, tip_radius, n_out + 1)[1:]])
     u = np.linspace(-0.5, 0.5, n_c + 1)

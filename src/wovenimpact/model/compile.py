@@ -237,7 +237,9 @@ def check_impactor_clearance(model: Model) -> None:
 
 def containment_mesh(m, sections) -> tuple[Mesh, list[str], np.ndarray]:
     """Casing layers and blade of a containment case (model.casing), each element's
-    section and warp direction (circumferential on the casing, radial on the blade)."""
+    section and warp direction (circumferential on the casing, radial on the blade).
+    The casing is meshed at ``mesh.element_size`` (graded to ``coarse_element_size``),
+    the blade at ``mesh.blade.element_size`` when given, else at the casing's size."""
     c, b = m.casing, m.blade
     radii, names = [], []
     outer = c.inner_radius
@@ -259,12 +261,15 @@ def containment_mesh(m, sections) -> tuple[Mesh, list[str], np.ndarray]:
             centre_angle=math.degrees(c.centre_angle),
             fine_sector=None if c.fine_sector is None else math.degrees(c.fine_sector),
             coarse_size=c.coarse_element_size, offset_layers=c.offset_layers)
-        blade = blade_mesh(b.root_radius, b.tip_radius, b.crack_radius, b.root_chord,
-                           b.tip_chord, m.element_size, angle=math.degrees(b.angle),
-                           stagger=math.degrees(b.stagger), twist=math.degrees(b.twist),
-                           tip_curve=b.tip_curve)
     except InputError as err:
         raise InputError(f"mesh: {err}") from None
+    try:  # the blade's own size (mesh.blade.element_size), else the casing's
+        blade = blade_mesh(b.root_radius, b.tip_radius, b.crack_radius, b.root_chord,
+                           b.tip_chord, m.blade_element_size, angle=math.degrees(b.angle),
+                           stagger=math.degrees(b.stagger), twist=math.degrees(b.twist),
+                           tip_curve=b.tip_curve, size_key=m.blade_size_key)
+    except InputError as err:
+        raise InputError(f"mesh.blade: {err}") from None
     # a staggered chord reaches beyond tip_radius at its corners (√(r² + (c/2 sin s)²))
     reach = float(np.hypot(blade.nodes[:, 0], blade.nodes[:, 1]).max())
     if not reach < c.inner_radius:

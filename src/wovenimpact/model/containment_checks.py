@@ -53,7 +53,9 @@ def _radius(x: np.ndarray) -> np.ndarray:
 
 def check_spin_speed(spec, model, mesh, dt: float) -> None:
     """The blade's tip speed ω r_max times the first step Δt₁ must stay below half the
-    smallest element (contact and element kinematics assume small increments)."""
+    smallest element (contact and element kinematics assume small increments): the
+    smallest edge of the whole model, the blade's or the casing's, whichever is finer
+    (the blade may have its own size, ``mesh.blade.element_size``)."""
     if spec.spin is None or not (math.isfinite(dt) and dt > 0.0):
         return
     blade = np.unique(mesh.quads[mesh.elem_sets["blade.blade"]])

@@ -33,7 +33,8 @@ Schema (see README and examples/cases/)::
                       length, sector, centre_angle, fine_sector, coarse_element_size,
                       inner_section, layer_section, layers, layer_spacing,
                       offset_layers), [mesh.blade] (section, root/crack/tip_radius,
-                      root/tip_chord, angle, stagger, twist, tip_curve)
+                      root/tip_chord, angle, stagger, twist, tip_curve, element_size:
+                      the blade's own, default mesh.element_size)
     [[boundary]]      nodes = SET, type = clamped | pinned | symmetry_x | symmetry_y |
                       symmetry_z | velocity (with dof and velocity)
     [spin]            rate, release_time, relaxation_tolerance (containment cases)
@@ -252,6 +253,10 @@ class BladeSpec(BaseModel):
     released fragment (the airfoil outboard of the crack) weighs 0.229 kg, its centre of
     mass at r = 143.5 mm moving at 150.2 m/s at 1047 rad/s (5 mm elements).
 
+    ``element_size``: the blade's own target element edge (hub part, release row and
+    fragment); not given, the casing's ``mesh.element_size`` (theory §8, "The blade's
+    own element size").
+
     ``stagger``: the chord turned from the axial direction towards the tangential one
     at the root; ``twist``: how much more it is turned at the tip (linear along the
     span); ``tip_curve``: the depth of a curved tip edge (a circular arc whose corners
@@ -271,6 +276,9 @@ class BladeSpec(BaseModel):
     stagger: quantity("angle", example="30 deg") = DEFAULT_STAGGER
     twist: quantity("angle", example="25 deg") = DEFAULT_TWIST
     tip_curve: quantity("length", ge=0, example="10 mm") = 0.005
+    # the blade's own element size (hub part, release row, fragment); absent: the
+    # casing's mesh.element_size, so that a casing mesh study can keep the blade fixed
+    element_size: quantity("length", gt=0, example="5 mm") | None = None
 
 
 class ContainmentMeshSpec(BaseModel):
@@ -280,9 +288,20 @@ class ContainmentMeshSpec(BaseModel):
 
     model_config = STRICT
     kind: Literal["containment"]
-    element_size: Length
+    element_size: Length  # the casing's (and the blade's, unless mesh.blade.element_size)
     casing: CasingSpec
     blade: BladeSpec
+
+    @property
+    def blade_element_size(self) -> float:
+        """The blade's element size: ``mesh.blade.element_size``, or ``element_size``."""
+        return self.element_size if self.blade.element_size is None else self.blade.element_size
+
+    @property
+    def blade_size_key(self) -> str:
+        """The case key that sets :attr:`blade_element_size` (for messages)."""
+        return "mesh.element_size" if self.blade.element_size is None else (
+            "mesh.blade.element_size")
 
 
 class SpinSpec(BaseModel):
@@ -570,24 +589,42 @@ def check_mesh_size(m) -> list[Problem]:
         context = f"side {m.side:g} m, {m.plies} plies"
     elif isinstance(m, ContainmentMeshSpec):
         c, b = m.casing, m.blade
-        shortest = min(c.length, b.tip_radius - b.crack_radius)  # casing length, fragment
-        if m.element_size > shortest / 2.0:
-            return [Problem("mesh.element_size", f"gives fewer than 2 elements along the "
-                            f"casing's length or the released fragment ({shortest:g} m)",
-                            m.element_size, f"element_size ≤ {shortest / 2.0:.4g} m")]
+        fragment = b.tip_radius - b.crack_radius
+        if b.element_size is None:  # one size: the shorter of casing length and fragment
+            edges = [("mesh.element_size", m.element_size, min(c.length, fragment),
+                      "the casing's length or the released fragment")]
+        else:
+            edges = [("mesh.element_size", m.element_size, c.length, "the casing's length"),
+                     ("mesh.blade.element_size", b.element_size, fragment,
+                      "the released fragment")]
+        few = [Problem(key, f"gives fewer than 2 elements along {where} ({edge:g} m)", h,
+                       f"element_size ≤ {edge / 2.0:.4g} m")
+               for key, h, edge, where in edges if h > edge / 2.0]
+        if few:
+            return few
         arc = c.sector  # a graded ring: its coarse part as the equivalent fine arc
         if c.fine_sector is not None and c.coarse_element_size is not None:
             fine = min(c.fine_sector, c.sector)
             arc = fine + (c.sector - fine) * min(m.element_size / c.coarse_element_size, 1.0)
-        area = (arc * c.inner_radius * c.length * (c.layers + 1)
-                + (b.tip_radius - b.root_radius) * max(b.root_chord, b.tip_chord))
-        count = area / m.element_size / m.element_size  # no underflow to 0 at 1e-300
+        casing = arc * c.inner_radius * c.length * (c.layers + 1)
+        blade = (b.tip_radius - b.root_radius) * max(b.root_chord, b.tip_chord)
+        hb = m.blade_element_size
+        # no underflow to 0 at 1e-300: each area over the size, then over it again
+        in_casing, in_blade = casing / m.element_size / m.element_size, blade / hb / hb
+        count = in_casing + in_blade
         context = f"casing and blade, {c.layers} layers"
+        if in_blade > in_casing and b.element_size is not None:
+            return _too_many(count, "mesh.blade.element_size", hb, context)
     else:
         return []
+    return _too_many(count, "mesh.element_size", m.element_size, context)
+
+
+def _too_many(count: float, key: str, size: float, context: str) -> list[Problem]:
+    """A count of elements above MAX_ELEMENTS, blamed on ``key`` (= ``size``)."""
     if count > MAX_ELEMENTS:
-        return [Problem("mesh.element_size", f"gives about {count:.3g} elements ({context})",
-                        m.element_size, f"at most {MAX_ELEMENTS:g} elements in the mesh")]
+        return [Problem(key, f"gives about {count:.3g} elements ({context})", size,
+                        f"at most {MAX_ELEMENTS:g} elements in the mesh")]
     return []
 
 

@@ -384,6 +384,7 @@ def casing_summary(model, state, h: dict) -> dict:
     per_area = sum(float(np.sum(areal[e] * model.area0[e]) / np.sum(model.area0[e]))
                    for e in layer_elements(model) if e.size)
     bulge = np.asarray(h.get("outer_layer_bulge_m", ()), dtype=float)
+    absorbed = layer_absorbed_energies(model, state)
     return {
         **outcome,
         "fragment_exit_speed_settled": exit_speed_settled(h, outcome["outcome"]),
@@ -392,7 +393,9 @@ def casing_summary(model, state, h: dict) -> dict:
         # the largest over the history rows and the end state (a bulge that springs back
         # is still the casing's largest deflection)
         "max_bulge_m": max([outer_layer_bulge(model, state), *bulge.tolist()]),
-        "absorbed_energy_per_layer_J": layer_absorbed_energies(model, state),
+        "absorbed_energy_per_layer_J": absorbed,
+        # the whole casing's, the figure of the mesh-convergence studies (a sweep metric)
+        "casing_absorbed_energy_J": float(sum(absorbed)),
         "held_energy_per_layer_J": layer_energies(model, state),
         "absorbed_energy_per_material_J": energy_per_material(model, state),
         "casing_mass_kg": mass,

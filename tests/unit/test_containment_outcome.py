@@ -160,6 +160,7 @@ def test_containment_outputs_bulge_layer_and_material_energies_and_fragment_plot
     assert per_material[names[0]] == pytest.approx(per_layer[0], rel=1e-12)  # aluminium
     assert per_material[names[1]] == pytest.approx(per_layer[1] + per_layer[2], rel=1e-12)
     assert sum(per_layer) > 0.0
+    assert summary["casing_absorbed_energy_J"] == pytest.approx(sum(per_layer), rel=1e-12)
     # absorbed = the contact work the layer's nodes received: the run's per-node sums
     # (final checkpoint) add up to the whole contact work, the blade gave what the layers
     # took plus what the contact dashpots dissipated and the penalty springs hold

@@ -6,7 +6,10 @@ the run" before anything else:
 1. the verdicts, each green (``pass``), red (``fail``) or grey (``n/a``, key absent):
    outcome (green when the impactor was stopped, or a blade fragment contained),
    residual velocity (a fragment's exit speed; green at 0, with the rebound velocity), energy error against :data:`ENERGY_ERROR_LIMIT` (1 %) and
-   hourglass share ``hourglass_fraction`` against :data:`HOURGLASS_LIMIT` (10 %);
+   hourglass share ``hourglass_fraction`` against :data:`HOURGLASS_LIMIT` (10 %), and the
+   mesh: each failing material's element lengths against the range its failure law is
+   calibrated for (:mod:`wovenimpact.mesh_verdict`; red for a law that is not
+   regularised, on elements away from its reference size);
 2. the whole summary as a table;
 3. every PNG of ``plots/``, inlined as base64;
 4. the case as run: the TOML text with the ``--set`` overrides (a study variant: the
@@ -94,7 +97,22 @@ def verdicts(summary: dict) -> list[Verdict]:
         Verdict("hourglass_fraction", "hourglass share of internal work",
                 "n/a" if hourglass is None else f"{hourglass:.1%}", f"≤ {HOURGLASS_LIMIT:.0%}",
                 _status(None if hourglass is None else hourglass <= HOURGLASS_LIMIT)),
+        mesh_box(summary),
     ]
+
+
+def mesh_box(summary: dict) -> Verdict:
+    """The mesh verdict (:mod:`wovenimpact.mesh_verdict`): green when every failing
+    material's elements lie at its reference size or within its calibrated range."""
+    from wovenimpact.mesh_verdict import SUMMARY_KEY, verdict_text
+
+    found = summary.get(SUMMARY_KEY)
+    if found is None:
+        return Verdict(SUMMARY_KEY, "mesh", "n/a", "failure calibrated for these elements",
+                       "na")
+    text, ok = verdict_text(found)
+    return Verdict(SUMMARY_KEY, "mesh", text, "failure calibrated for these elements",
+                   _status(ok))
 
 
 def _value_text(v) -> str:
@@ -102,6 +120,8 @@ def _value_text(v) -> str:
         return f"{v:.6g}"
     if isinstance(v, list):
         return ", ".join(_value_text(x) for x in v)
+    if isinstance(v, dict):
+        return "; ".join(f"{k}: {_value_text(x)}" for k, x in v.items())
     return "—" if v is None else str(v)
 
 

@@ -1,0 +1,120 @@
+"""How far a run's failure can be trusted on its mesh: each failing material's element
+lengths against the range its failure law was calibrated for (docs/theory.md §1.4, §7.3).
+
+A material whose failure is not regularised (no ``[material.regularisation]`` table)
+holds its answers only on elements of its reference length (a fabric: the crossover
+cell, 2ℓ0; a metal: none given, so any size is outside it); a regularised one within
+the lengths its table was calibrated on (the table's first and last rows). The lengths
+judged are those of the material's elements that failed (eroded) in the run, or all of
+its elements if none did: a contained or stopped run is judged by where it could have
+failed.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from wovenimpact.kernels import fabric_layout as FL
+from wovenimpact.kernels import j2_layout as JL
+from wovenimpact.kernels import shell_layout as SL
+
+REFERENCE_TOLERANCE = 0.1  # an unregularised law: elements within 10 % of its reference length
+SUMMARY_KEY = "mesh_verdict"
+
+
+def _law(model, m: int):
+    """(reference lengths (k,), the calibrated range of l/l_ref (2,) or None, the lengths
+    (n, k) of the n elements of material m, and those elements) — k = 2 yarn families for
+    a fabric, 1 for a metal. A metal without a reference length gets reference 0 (every
+    size outside)."""
+    p = model.mat_params[m]
+    elems = np.flatnonzero(model.sections[model.elem_section, SL.C_MAT] == m)
+    if model.mat_kind[m] == SL.MAT_FABRIC:
+        ref = p[FL.P_REG_LENGTH:FL.P_REG_LENGTH + 2]
+        rows = int(p[FL.P_REG_ROWS])
+        table = p[FL.P_REG_TABLE:FL.P_REG_TABLE + 2 * rows:2]
+        lengths = model.elem_length[elems]
+    else:
+        ref = p[JL.P_FRAC_LENGTH:JL.P_FRAC_LENGTH + 1]
+        rows = int(p[JL.P_FRAC_ROWS])
+        table = p[JL.P_FRAC_TABLE:JL.P_FRAC_TABLE + 2 * rows:2]
+        lengths = model.elem_length[elems, :1]
+    calibrated = np.array([table.min(), table.max()]) if rows else None
+    return ref, calibrated, lengths, elems
+
+
+def fails(model, m: int) -> bool:
+    """Whether material m has a failure law at all (a fabric always; a J2 metal with a
+    fracture strain or Johnson–Cook damage; an elastic one never)."""
+    kind = model.mat_kind[m]
+    if kind == SL.MAT_FABRIC:
+        return True
+    if kind == SL.MAT_J2:
+        p = model.mat_params[m]
+        return bool(p[JL.P_FRACTURE] > 0.0 or p[JL.P_DAMAGE] != 0.0)
+    return False
+
+
+def mesh_verdict(model, state) -> dict:
+    """Per failing material (by its name): the element lengths judged (mm, smallest and
+    largest), the reference length (mm), the calibrated range (mm, or None), whether any
+    of its elements failed, and the verdict — "at the reference size", "within the
+    calibrated range", "coarser than the calibrated range", "finer than the calibrated
+    range" or "not regularised" — with ``ok`` True for the first two."""
+    out = {}
+    if model.elem_length.shape[0] != model.n_elems:
+        return out
+    eroded = state.elem[:, SL.E_ALIVE] == 0.0
+    for m in range(len(model.mat_kind)):
+        if not fails(model, m):
+            continue
+        ref, calibrated, lengths, elems = _law(model, m)
+        if not elems.size:
+            continue
+        failed = eroded[elems]
+        judged = lengths[failed] if failed.any() else lengths
+        lo, hi = float(judged.min()), float(judged.max())
+        ratio_lo = judged.min(axis=0) / np.where(ref > 0.0, ref, np.inf)
+        ratio_hi = judged.max(axis=0) / np.where(ref > 0.0, ref, np.inf)
+        if calibrated is not None:
+            if np.all(ratio_lo >= calibrated[0] * (1.0 - 1e-9)) and np.all(
+                    ratio_hi <= calibrated[1] * (1.0 + 1e-9)):
+                verdict, ok = "within the calibrated range", True
+            elif np.any(ratio_hi > calibrated[1]):
+                verdict, ok = "coarser than the calibrated range", False
+            else:
+                verdict, ok = "finer than the calibrated range", False
+            span = [float(calibrated[0] * ref.min() * 1e3), float(calibrated[1] * ref.max() * 1e3)]
+        else:
+            span = None
+            near = np.all(ref > 0.0) and np.all(np.abs(ratio_lo - 1.0) <= REFERENCE_TOLERANCE) \
+                and np.all(np.abs(ratio_hi - 1.0) <= REFERENCE_TOLERANCE)
+            verdict, ok = ("at the reference size", True) if near else ("not regularised", False)
+        name = model.material_names[m] or f"material {m}"
+        out[name] = {
+            "element_length_mm": [lo * 1e3, hi * 1e3],
+            "reference_length_mm": float(ref.max() * 1e3) if np.any(ref > 0.0) else None,
+            "calibrated_range_mm": span,
+            "judged_on": "eroded elements" if failed.any() else "all its elements",
+            "verdict": verdict,
+            "ok": bool(ok),
+        }
+    return out
+
+
+def verdict_text(verdicts: dict) -> tuple[str, bool | None]:
+    """One line for the report's mesh box, and whether every material passed (None
+    when no material can fail)."""
+    if not verdicts:
+        return "no failing material", None
+    parts = []
+    for name, v in verdicts.items():
+        lo, hi = v["element_length_mm"]
+        size = f"{lo:.3g} mm" if abs(hi - lo) <= 1e-6 * hi else f"{lo:.3g}–{hi:.3g} mm"
+        ref = v["calibrated_range_mm"] or (
+            [v["reference_length_mm"]] * 2 if v["reference_length_mm"] else None)
+        against = "" if ref is None else (
+            f" (calibrated {ref[0]:.3g}–{ref[1]:.3g} mm)" if v["calibrated_range_mm"]
+            else f" (reference {ref[0]:.3g} mm)")
+        parts.append(f"{name}: {size}, {v['verdict']}{against}")
+    return "; ".join(parts), all(v["ok"] for v in verdicts.values())

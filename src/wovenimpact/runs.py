@@ -49,6 +49,8 @@ from wovenimpact.io.report import write_run_report
 from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.metal_state import has_metal, plastic_work
 from wovenimpact.model.compile import CompiledCase, compile_case
+from wovenimpact.mesh_verdict import SUMMARY_KEY as MESH_VERDICT_KEY
+from wovenimpact.mesh_verdict import mesh_verdict
 from wovenimpact.quantities import (
     impactor_row,
     intact_material_ahead,
@@ -515,6 +517,8 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
         "energy_tolerance": spec.run.energy_tolerance,
         "energy_check": "pass" if error <= spec.run.energy_tolerance else "fail",
         "symmetry_factor": factor,
+        # each failing material's element lengths against its calibrated range (theory §1.4)
+        MESH_VERDICT_KEY: mesh_verdict(model, state),
         "max_displacement_m": float(np.sqrt(np.max(np.sum((state.x - model.x0) ** 2, axis=1)))),
     }
 
@@ -536,7 +540,8 @@ IMPACT_SUMMARY_KEYS = ("outcome", "perforated", "residual_velocity_m_per_s",
 CONTAINMENT_SUMMARY_KEYS = ("outcome", "contained", "fragment_exit_speed_m_per_s",
                             "fragment_speed_at_end_m_per_s", "fragment_exit_speed_settled", "fragment_mass_kg", "fragment_initial_speed_m_per_s", "max_bulge_m",
                             "casing_mass_kg", "casing_mass_per_area_kg_per_m2", "casing_layers",
-                            "absorbed_energy_per_layer_J", "held_energy_per_layer_J",
+                            "absorbed_energy_per_layer_J", "casing_absorbed_energy_J",
+                            "held_energy_per_layer_J",
                             "absorbed_energy_per_material_J", "stopped_when_decided")
 COMMON_SUMMARY_KEYS = (
     "summary_version", "case", "end_time_s", "steps", "elements", "nodes", "first_time_step_s",
@@ -548,7 +553,7 @@ COMMON_SUMMARY_KEYS = (
     "eroded_kinetic_energy_J", "hourglass_fraction", "external_work_J", "body_force_work_J",
     "reaction_work_J", "contact_energy_J", "eroded_elements", "energy_error_fraction",
     "energy_tolerance", "energy_check", "symmetry_factor", "max_displacement_m",
-    "restarted_from_step", "provenance", "finished_utc",
+    "restarted_from_step", "provenance", "finished_utc", "mesh_verdict",
     "plastic_work_J",  # runs with a metal section only
     # runs with mass scaling only
     "added_mass_kg", "added_mass_fraction", "mass_scaling_energy_J", "mass_scaled_elements",

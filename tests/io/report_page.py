@@ -84,9 +84,13 @@ def expected_status(summary: dict, key: str) -> str:
         v = summary.get("fragment_exit_speed_m_per_s")
     if v is None:
         return "na"
+    if key == "mesh_verdict" and not v:  # no failing material
+        return "na"
     rule = {"outcome": lambda: v in ("stopped", "contained"),
             "residual_velocity_m_per_s": lambda: v == 0.0,
-            "energy_error_fraction": lambda: v <= 0.01, "hourglass_fraction": lambda: v <= 0.10}
+            "energy_error_fraction": lambda: v <= 0.01, "hourglass_fraction": lambda: v <= 0.10,
+            # every failing material at its reference size or in its calibrated range
+            "mesh_verdict": lambda: all(m["ok"] for m in v.values())}
     ok = rule[key]()
     return "pass" if ok else "fail"
 
@@ -101,7 +105,7 @@ def check_run_page(out: Path) -> Page:
     pngs = sorted(p.name for p in (out / "plots").glob("*.png"))
     assert pngs and sorted(decoded_images(page)) == pngs
     assert set(page.verdicts) == {"outcome", "residual_velocity_m_per_s",
-                                  "energy_error_fraction", "hourglass_fraction"}
+                                  "energy_error_fraction", "hourglass_fraction", "mesh_verdict"}
     for key, v in page.verdicts.items():
         assert v["status"] == expected_status(summary, key), (key, v, summary.get(key))
         assert v["status"] in v["class"].split()

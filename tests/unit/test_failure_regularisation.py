@@ -17,6 +17,7 @@ each test is one that a law without the regularisation fails:
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -214,3 +215,20 @@ def test_a_metal_point_without_regularisation_fails_at_onset_as_before():
 
     row = j2_state(mat)[0]
     assert row[JL.S_FRAC_SCALE] == 1.0 and row[JL.S_EVOLUTION] == 0.0
+
+
+def test_a_case_can_add_a_regularisation_to_a_material_file_that_has_none(tmp_path):
+    """``materials.NAME.set.regularisation…`` (a study's ``--set``) adds the table the shipped
+    file does not have; a table the material schema does not know is refused by name."""
+    from wovenimpact.errors import InputError
+    from wovenimpact.model.compile import load_case_material
+    from wovenimpact.spec.case import MaterialRef
+
+    base = Path(__file__).resolve().parents[2] / "examples" / "materials"
+    ref = MaterialRef(file="kevlar_thesis.toml",
+                      set={"regularisation": {"erosion_opening": "0.94 mm"}})
+    kevlar = load_case_material(base, "kevlar", ref)
+    assert kevlar.regularisation.erosion_opening == pytest.approx(0.94e-3)
+    bad = MaterialRef(file="kevlar_thesis.toml", set={"regularization": {"x": "1 mm"}})
+    with pytest.raises(InputError, match="regularization"):
+        load_case_material(base, "kevlar", bad)

@@ -73,11 +73,16 @@ def _material_path(base: Path, name: str, rel: str) -> Path:
 
 
 def _merge(into: dict, new: dict, where: str) -> None:
-    """Replace entries of ``into`` by those of ``new``, recursing into tables."""
+    """Replace entries of ``into`` by those of ``new``, recursing into tables. A table the
+    file does not have is added (an optional one such as ``regularisation``: the material's
+    schema then refuses a name it does not know, naming it)."""
     for k, v in new.items():
         if isinstance(v, dict):
-            if not isinstance(into.get(k), dict):
-                raise InputError(f"{where}.{k}: the material file has no table {k!r}")
+            if k not in into:
+                into[k] = {}
+            if not isinstance(into[k], dict):
+                raise InputError(f"{where}.{k}: the material file's {k!r} is a value, not a "
+                                 "table")
             _merge(into[k], v, f"{where}.{k}")
         else:
             into[k] = v

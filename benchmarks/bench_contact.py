@@ -9,7 +9,9 @@ their height, for any number of plies), with Coulomb friction μ = 0.2.
 ``ShellContact.forces`` is timed twice: with a search at every call (skin 0: broad +
 narrow phase + assembly) and reusing its candidates (the default skin, positions fixed:
 narrow phase + assembly, what most steps cost); the broad phase with the skin alone is
-also reported. The cost per
+also reported, and 'book': the energy books of a step's pairs (``ShellContact.book``
+twice, as the solver calls it: the spring, dashpot and friction work per interface). The
+cost per
 node must stay about constant as plies multiply (linear scaling).
 ``--threads=1,2`` chooses the thread counts, ``--plies=1,2,4,6`` the stacks,
 ``--calls=N`` the timed calls per batch (50, best of 5 batches), ``--json`` prints
@@ -26,6 +28,7 @@ import numba
 import numpy as np
 
 from wovenimpact.contact import ShellContact
+from wovenimpact.interfaces import empty_books, part_arrays
 from wovenimpact.jit import set_threads
 from wovenimpact.materials.metal import MetalParameters
 from wovenimpact.model import Section, build_model
@@ -80,6 +83,14 @@ def run_case(n_plies: int, threads: int, calls: int) -> dict:
     searched = best_time(lambda: every_call.forces(x, v, dt, alive, active, out), calls)
     reused = best_time(lambda: contact.forces(x, v, dt, alive, active, out), calls)
     pairs = contact.n_pairs
+    node_part, elem_part, _ = part_arrays(model)
+    books = empty_books(model)[0]
+
+    def book():  # the two halves of a step (the second at other velocities: the same v)
+        contact.book(0.5 * dt, books, node_part, elem_part)
+        contact.book(0.5 * dt, books, node_part, elem_part, v=v)
+
+    booking = best_time(book, calls)
     broad = best_time(lambda: contact._search(x, contact.sigma), calls)
     n = model.n_nodes
     return {
@@ -87,6 +98,7 @@ def run_case(n_plies: int, threads: int, calls: int) -> dict:
         "pairs": every_call.n_pairs, "pairs_with_skin": pairs, "active": n_active,
         "energy_J": energy, "ns_per_node": 1e9 * searched / n,
         "reused_ns_per_node": 1e9 * reused / n, "broad_ns_per_node": 1e9 * broad / n,
+        "book_ns_per_node": 1e9 * booking / n,
         "ms_per_call": 1e3 * searched,
     }
 
@@ -103,13 +115,15 @@ def main(argv: list[str]) -> None:
         return
     print(f"threading layer: {numba.threading_layer()}; best of 5 × {calls} calls")
     print("ns per node and call: 'search' with a search every call, 'reuse' with the "
-          "candidates of the skin kept, 'broad' the search with the skin alone")
+          "candidates of the skin kept, 'broad' the search with the skin alone, 'book' the "
+          "energy books of a step's pairs")
     print(f"{'plies':>5} {'thr':>3} {'nodes':>7} {'pairs':>7} {'+skin':>7} {'active':>7} "
-          f"{'search':>7} {'reuse':>7} {'broad':>7} {'ratio':>6}")
+          f"{'search':>7} {'reuse':>7} {'broad':>7} {'book':>7} {'ratio':>6}")
     for c in cases:
         print(f"{c['plies']:>5} {c['threads']:>3} {c['nodes']:>7} {c['pairs']:>7} "
               f"{c['pairs_with_skin']:>7} {c['active']:>7} {c['ns_per_node']:>7.1f} "
               f"{c['reused_ns_per_node']:>7.1f} {c['broad_ns_per_node']:>7.1f} "
+              f"{c['book_ns_per_node']:>7.1f} "
               f"{c['ns_per_node'] / c['reused_ns_per_node']:>6.2f}")
 
 

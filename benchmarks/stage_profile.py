@@ -100,9 +100,9 @@ def contact_parts(sc, state) -> None:
           f"{t_query / max(nodes, 1) * 1e6:.0f} ns per node)")
     segment_geometry(x, sc.quads, sc.seg_on, sc.seg_geo)
     args = (x, state.v, sc.quads, sc.ply, sc.node_mass, sc.h_node, sc.h_seg, sc.margin,
-            sc.overlap, sc.beta, sc.damping, sc.friction, float(state.dt), sc.seg_geo,
-            sc.seg_on, sc.node_on, sc.pair_ptr, sc.pair_seg, sc.geo, sc.pair_on, sc.pair_f,
-            sc.pair_w, sc.pair_e, sc.node_f)
+            sc.overlap, sc.beta, sc.damping, sc.friction, sc.approach, float(state.dt),
+            sc.seg_geo, sc.seg_on, sc.node_on, sc.pair_ptr, sc.pair_seg, sc.geo, sc.pair_on,
+            sc.pair_f, sc.pair_w, sc.pair_e, sc.pair_sd, sc.power, sc.node_f)
     sc.geo[:n, GEO_SIDE] = 0.0  # the narrow phase writes the rows of projected pairs only
     t_pen, _ = best_ms(lambda: penalty_forces(*args))
     projected = int((sc.geo[:n, GEO_SIDE] != 0).sum())
@@ -121,11 +121,17 @@ def contact_parts(sc, state) -> None:
     out = np.zeros((x.shape[0], 3))
     t_asm, _ = best_ms(lambda: assemble_contact_forces(
         sc.quads, sc.pair_ptr, sc.pair_seg, sc.pair_on, sc.pair_f, sc.pair_w, sc.pair_e,
-        sc.node_f, sc.seg_ptr, sc.seg_entry, sc.cursor, out, True))
+        sc.node_f, sc.seg_ptr, sc.seg_entry, sc.cursor, out, True, sc.active))
     work = np.zeros(x.shape[0])
     t_pow, _ = best_ms(lambda: force_pair_power(out, out, state.v, float(state.dt), work))
+    sc.n_active = int((sc.pair_on[:n] != 0).sum())  # the pairs the assembly listed
+    books = np.zeros((3, int(sc.ply.max()) + 1, int(sc.ply.max()) + 1))
+    node_part = np.maximum(sc.node_ply, 0)
+    t_book, _ = best_ms(lambda: (sc.book(0.5 * state.dt, books, node_part, sc.ply),
+                                 sc.book(0.5 * state.dt, books, node_part, sc.ply, v=state.v)))
     print(f"  per step besides: masks {t_mask:.2f}, reuse test {t_valid:.2f}, segment "
-          f"geometry {t_geo:.2f}, assembly {t_asm:.2f}, contact power {t_pow:.2f} ms")
+          f"geometry {t_geo:.2f}, assembly {t_asm:.2f}, contact power {t_pow:.2f}, "
+          f"energy books (both halves) {t_book:.2f} ms")
 
 
 if __name__ == "__main__":

@@ -38,6 +38,7 @@ from wovenimpact.kernels.contact_update import (
     surfaces_joined,
     widest_box,
 )
+from wovenimpact.kernels.contact_energy import N_KINDS, book_shell_powers, shell_pair_powers
 from wovenimpact.kernels.contact_narrow import (
     N_GEO,
     N_SEG_GEO,
@@ -58,6 +59,9 @@ INCREMENTAL_FLOOR = 256
 # an update also re-anchors the nodes that would leave their skins within this many
 # steps at their speed
 AHEAD_STEPS = 4.0
+# the laws of the pair dashpot (theory §6): on the relative normal velocity whenever the
+# pair overlaps, or only while it closes
+DAMPING_MODES = ("always", "approach")
 
 
 class SegmentBins:
@@ -164,6 +168,9 @@ class ShellContact:
         damping: ζ, the pair dashpot as a fraction of critical 2 √(k m_red) (0–2;
             default 0.3: struck plies part at about 15 % of their closing speed,
             theory §6.3).
+        damping_mode: "always" (default): the dashpot acts on the relative normal
+            velocity while the pair overlaps, closing or separating; "approach": only
+            while it closes (v_n < 0), so that a rebound is not damped (theory §6).
         friction: Coulomb coefficient μ ≥ 0 (0: frictionless, the default).
         plies: the plies taking part (default all); or
         elements: the element indices taking part (overrides ``plies``).
@@ -190,6 +197,7 @@ class ShellContact:
         beta: float = 0.1,
         damping: float = 0.3,
         friction: float = 0.0,
+        damping_mode: str = "always",
         plies=None,
         elements=None,
         self_contact: bool = False,
@@ -206,11 +214,16 @@ class ShellContact:
                              "critical damping; default 1)")
         if not (math.isfinite(friction) and friction >= 0.0):
             raise InputError(f"contact friction = {friction!r}; valid: a coefficient μ ≥ 0")
+        if damping_mode not in DAMPING_MODES:
+            raise InputError(f"contact damping_mode = {damping_mode!r}; valid: "
+                             f"{' or '.join(map(repr, DAMPING_MODES))}")
         if not (math.isfinite(margin) and margin >= 0.0):
             raise InputError(f"contact margin = {margin!r} m; valid: ≥ 0")
         self.beta = float(beta)
         self.damping = float(damping)
         self.friction = float(friction)
+        self.damping_mode = str(damping_mode)
+        self.approach = damping_mode == "approach"
         self.self_contact = bool(self_contact)
         self.margin = float(margin)
         quads = np.ascontiguousarray(model.quads, dtype=np.int64)
@@ -292,6 +305,7 @@ class ShellContact:
         self.overlap = np.zeros(nn)
         self.grow_count = 0
         self.n_pairs = 0
+        self.n_active = 0  # pairs acting at the last forces() (rows of self.active)
         self.cell = 0.0
         if capacity is None:
             capacity = max(64, 8 * int(self.node_part.sum()))
@@ -325,6 +339,9 @@ class ShellContact:
         self.pair_f = np.zeros((cap, 3))
         self.pair_w = np.zeros((cap, 4))
         self.pair_e = np.zeros(cap)
+        self.pair_sd = np.zeros((cap, 2))  # spring and dashpot normal forces (energy books)
+        self.active = np.zeros((cap, 2), dtype=np.int64)  # (node, pair) of the acting pairs
+        self.power = np.zeros((cap, N_KINDS))  # and their powers (book)
         self.seg_entry = np.zeros(4 * cap, dtype=np.int64)
 
     def _alloc_entries(self, capacity: int) -> None:
@@ -452,6 +469,7 @@ class ShellContact:
         contact_masks(alive, self.elem_part, active, self.node_part, self.seg_on, self.node_on)
         n = self._search(np.ascontiguousarray(x, dtype=float), self.no_skin)
         self.searched = False  # the lists of forces() are gone
+        self.n_active = 0  # and with them the pairs of the last forces() call
         nodes = np.repeat(np.arange(nn, dtype=np.int64), np.diff(self.pair_ptr))
         return nodes, self.pair_seg[:n].copy()
 
@@ -482,13 +500,34 @@ class ShellContact:
         segment_geometry(x, self.quads, self.seg_on, self.seg_geo)
         penalty_forces(
             x, v, self.quads, self.ply, self.node_mass, self.h_node, self.h_seg, self.margin,
-            self.overlap, self.beta, self.damping, self.friction, float(dt), self.seg_geo,
-            self.seg_on, self.node_on, self.pair_ptr, self.pair_seg,
-            self.geo, self.pair_on, self.pair_f, self.pair_w, self.pair_e, self.node_f,
+            self.overlap, self.beta, self.damping, self.friction, self.approach, float(dt),
+            self.seg_geo, self.seg_on, self.node_on, self.pair_ptr, self.pair_seg,
+            self.geo, self.pair_on, self.pair_f, self.pair_w, self.pair_e, self.pair_sd,
+            self.power, self.node_f,
         )
         energy, n_active = assemble_contact_forces(
             self.quads, self.pair_ptr, self.pair_seg, self.pair_on, self.pair_f, self.pair_w,
             self.pair_e, self.node_f, self.seg_ptr, self.seg_entry, self.cursor,
-            out_force, bool(accumulate),
+            out_force, bool(accumulate), self.active,
         )
+        self.n_active = int(n_active)
         return float(energy), int(n_active)
+
+    def book(self, weight: float, books, node_part, seg_part, v=None) -> None:
+        """Add the work of the pairs of the last :meth:`forces` call to the energy books:
+        books[kind, a, b] −= weight · P_kind (kernels.contact_energy: kind SPRING,
+        DAMPING, FRICTION; a = node_part[node], b = seg_part[segment]), the powers at the
+        velocities the forces were computed with (written by the narrow phase), or with
+        ``v`` at those velocities. ``weight`` is ½ Δt of the solver's trapezoid rule:
+        called once without ``v`` and with the step before, once with the velocities
+        after the step and that step, the books hold what the solver's contact work
+        holds, split by part and by pair. (After a call with ``v`` the powers are those
+        at ``v``.)"""
+        if self.n_active == 0:
+            return
+        if v is not None:
+            shell_pair_powers(v, self.quads, self.pair_seg, self.pair_w, self.geo,
+                              self.pair_f, self.pair_sd, self.active, self.n_active,
+                              self.friction > 0.0, self.power)
+        book_shell_powers(self.power, self.active, self.n_active, self.pair_seg, node_part,
+                          seg_part, float(weight), books)

@@ -46,6 +46,8 @@ from wovenimpact.io.checkpoint import (
 from wovenimpact.io.fields import FieldWriter
 from wovenimpact.io.history import History
 from wovenimpact.io.report import write_run_report
+from wovenimpact.interfaces import booked_totals, interface_energies
+from wovenimpact.kernels.contact_energy import DAMPING, FRICTION
 from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.metal_state import has_metal, plastic_work
 from wovenimpact.model.compile import CompiledCase, compile_case
@@ -80,7 +82,8 @@ HISTORY_COLUMNS = (
     "time_s", "step", "dt_s", "structure_kinetic_energy_part_J", "internal_work_part_J",
     "stored_energy_part_J", "hourglass_energy_part_J", "external_work_part_J",
     "eroded_kinetic_energy_part_J", "eroded_internal_energy_part_J", "contact_energy_part_J",
-    "contact_dissipated_part_J", "body_force_work_part_J", "reaction_work_part_J",
+    "contact_dissipated_part_J", "contact_damping_energy_part_J",
+    "contact_friction_energy_part_J", "body_force_work_part_J", "reaction_work_part_J",
     "energy_drift_part_J", "energy_error_fraction", "energy_normaliser_part_J",
     "max_displacement_m", "eroded_elements",
 )
@@ -110,7 +113,10 @@ def history_columns(model) -> tuple[str, ...]:
     ``body_force_work_part_J`` and ``reaction_work_part_J`` (supports and prescribed
     motions) are the two parts of ``external_work_part_J``.
     ``contact_energy_part_J`` is −(work of the contact forces): the penalty springs' energy
-    plus ``contact_dissipated_part_J``, what contact dashpots and friction dissipated.
+    plus ``contact_dissipated_part_J``, what contact dashpots and friction dissipated;
+    of it, ``contact_damping_energy_part_J`` and ``contact_friction_energy_part_J`` are
+    the dashpots' and friction's own work, booked pair by pair (wovenimpact.interfaces;
+    the rest is the penalty's discretisation: k follows Δt, docs/theory.md §6).
     ``plastic_work_part_J`` (models with a metal section): the plastic work of the J2
     points (metal_state.plastic_work), a part of the internal work. With mass scaling
     (``run.mass_scaling_fraction``): ``added_mass_part_kg``, ``mass_scaling_energy_part_J``
@@ -129,6 +135,7 @@ def history_row(model, state: State, normaliser: float = 0.0,
     the run's :class:`~wovenimpact.containment.CasingWatch` (containment models; made
     for the row when not given)."""
     eb = energy_balance(model, state)
+    booked = booked_totals(state.contact_books[0])
     scale = max(normaliser, eb["scale_J"])
     disp = np.sqrt(np.max(np.sum((state.x - model.x0) ** 2, axis=1)))
     impact = {}
@@ -152,6 +159,8 @@ def history_row(model, state: State, normaliser: float = 0.0,
         "eroded_internal_energy_part_J": eb["eroded_internal_J"],
         "contact_energy_part_J": eb["contact_energy_J"],
         "contact_dissipated_part_J": eb["contact_dissipated_J"],
+        "contact_damping_energy_part_J": booked["damping"],
+        "contact_friction_energy_part_J": booked["friction"],
         "body_force_work_part_J": eb["body_force_work_J"],
         "reaction_work_part_J": eb["reaction_work_J"], "energy_drift_part_J": eb["drift_J"],
         "energy_error_fraction": error_fraction(eb["drift_J"], scale),
@@ -448,6 +457,9 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
       energy put into the model (its last ``energy_normaliser_part_J``), and ``energy_check``
       "pass" if it is at most ``energy_tolerance`` (``run.energy_tolerance``), else "fail"
       (the CLI then exits with code 4);
+    - ``contact_damping_energy_J`` and ``contact_friction_energy_J``: what the contact
+      dashpots and friction dissipated, and the same per interface
+      (``*_by_interface_J``, :func:`contact_damping_summary`);
     - ``element_cycles``, ``wall_time_s`` and ``ns_per_element_cycle`` of every
       invocation that made this result (a restarted run's included).
     """
@@ -512,6 +524,7 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
         "body_force_work_J": factor * eb["body_force_work_J"],
         "reaction_work_J": factor * eb["reaction_work_J"],
         "contact_energy_J": factor * eb["contact_energy_J"],
+        **contact_damping_summary(model, state, factor),
         "eroded_elements": int(np.sum(state.elem[:, SL.E_ALIVE] == 0.0)),
         "energy_error_fraction": error,
         "energy_tolerance": spec.run.energy_tolerance,
@@ -520,6 +533,23 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
         # each failing material's element lengths against its calibrated range (theory §1.4)
         MESH_VERDICT_KEY: mesh_verdict(model, state),
         "max_displacement_m": float(np.sqrt(np.max(np.sum((state.x - model.x0) ** 2, axis=1)))),
+    }
+
+
+def contact_damping_summary(model, state: State, factor: float) -> dict:
+    """summary.json keys of the energy the contact dashpots and friction dissipated (J,
+    whole problem): in all and per interface, {"layer0-layer1": J, "ply0-impactor": J,
+    …} over the interfaces where contact acted (wovenimpact.interfaces; docs/theory.md
+    §6, "Contact energy per interface")."""
+    books = state.contact_books[0]
+    totals = booked_totals(books)
+    return {
+        "contact_damping_energy_J": factor * totals["damping"],
+        "contact_friction_energy_J": factor * totals["friction"],
+        "contact_damping_energy_by_interface_J": interface_energies(model, books, DAMPING,
+                                                                    factor),
+        "contact_friction_energy_by_interface_J": interface_energies(model, books, FRICTION,
+                                                                     factor),
     }
 
 
@@ -551,7 +581,9 @@ COMMON_SUMMARY_KEYS = (
     "initial_impactor_kinetic_energy_J", "internal_work_J", "stored_energy_J",
     "hourglass_energy_J", "eroded_internal_energy_J", "eroded_hourglass_energy_J",
     "eroded_kinetic_energy_J", "hourglass_fraction", "external_work_J", "body_force_work_J",
-    "reaction_work_J", "contact_energy_J", "eroded_elements", "energy_error_fraction",
+    "reaction_work_J", "contact_energy_J", "contact_damping_energy_J",
+    "contact_friction_energy_J", "contact_damping_energy_by_interface_J",
+    "contact_friction_energy_by_interface_J", "eroded_elements", "energy_error_fraction",
     "energy_tolerance", "energy_check", "symmetry_factor", "max_displacement_m",
     "restarted_from_step", "provenance", "finished_utc", "mesh_verdict",
     "plastic_work_J",  # runs with a metal section only

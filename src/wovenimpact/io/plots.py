@@ -22,7 +22,8 @@ def energy_curves(h: dict, symmetry_factor: float = 1.0) -> dict[str, np.ndarray
 
     Keys: ``structure kinetic``, ``impactor kinetic`` (with an impactor), ``contact
     energy`` and its part ``contact dissipated`` (dashpots and friction, when the
-    history has it), ``internal work`` with its parts ``stored (live elements)``,
+    history has it), of which ``contact damping`` (the dashpots' own work, booked pair by
+    pair) and, when any, ``contact friction``, ``internal work`` with its parts ``stored (live elements)``,
     ``hourglass (live elements)``, ``eroded internal (at erosion)`` and, for metal
     runs, ``plastic dissipation`` (the J2 points' plastic work, live and eroded
     elements), ``eroded kinetic``, ``external work``, and ``balance error`` =
@@ -39,6 +40,10 @@ def energy_curves(h: dict, symmetry_factor: float = 1.0) -> dict[str, np.ndarray
     damping = next((c for c in DAMPING_COLUMNS if c in h), None)
     if damping:
         out["contact dissipated"] = f * h[damping]
+    if "contact_damping_energy_part_J" in h:
+        out["contact damping"] = f * h["contact_damping_energy_part_J"]
+    if np.any(h.get("contact_friction_energy_part_J", 0.0)):
+        out["contact friction"] = f * h["contact_friction_energy_part_J"]
     out["internal work"] = f * h["internal_work_part_J"]
     out["stored (live elements)"] = f * h["stored_energy_part_J"]
     out["hourglass (live elements)"] = f * h["hourglass_energy_part_J"]
@@ -54,7 +59,8 @@ def energy_curves(h: dict, symmetry_factor: float = 1.0) -> dict[str, np.ndarray
 def energy_plot(h: dict, path: str | Path, title: str = "", symmetry_factor: float = 1.0) -> Path:
     """Energies of the whole system against time (:func:`energy_curves`, whole-problem
     values): structure and impactor kinetic energy, internal work and its parts (dashed),
-    contact energy and what contact dashpots and friction dissipated of it (dashed),
+    contact energy and what contact dashpots and friction dissipated of it (dashed; the
+    dashpots' and friction's own shares dash-dotted),
     eroded, external work, and the balance error, with a line at 1 % of the initial
     kinetic energy for scale."""
     path = Path(path)
@@ -63,13 +69,15 @@ def energy_plot(h: dict, path: str | Path, title: str = "", symmetry_factor: flo
     curves = energy_curves(h, symmetry_factor)
     dashed = {"stored (live elements)", "hourglass (live elements)",
               "eroded internal (at erosion)", "contact dissipated", "plastic dissipation"}
+    dotted = {"contact damping", "contact friction"}
     fig, ax = plt.subplots(figsize=(7.5, 4.6))
     for label, y in curves.items():
         if label == "balance error":
             ax.plot(t, y, "k:", lw=1.6,
                     label="balance error |drift| (energy_error_fraction × energy put in)")
         else:
-            ax.plot(t, y, "--" if label in dashed else "-", label=label)
+            ax.plot(t, y, "--" if label in dashed else "-." if label in dotted else "-",
+                    label=label)
     e0 = symmetry_factor * (h["structure_kinetic_energy_part_J"][0]
                             + (h["impactor_kinetic_energy_part_J"][0]
                                if "impactor_kinetic_energy_part_J" in h else 0.0))

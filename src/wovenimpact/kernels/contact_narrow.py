@@ -37,7 +37,9 @@ with v_n = v_r · n the normal part of the velocity of the node relative to the 
 point, v_r = v_p − Σ N_I(ξ, η) v_I, and ζ the damping as a fraction of critical (the
 dashpot acts while the pair overlaps, also as it separates: with ζ ≥ 1 struck
 surfaces come to rest on each other, a plastic impact, instead of bouncing apart at
-twice the speed). The cap keeps the explicit dashpot stable: a node and a segment
+twice the speed; with ``approach`` — ``[contact] damping_mode = "approach"`` — only
+while the pair closes, v_n < 0: c = 0 while it separates, docs/theory.md §6). The cap
+keeps the explicit dashpot stable: a node and a segment
 over it are paired twice (both passes), and together the two pairs then remove at most
 the relative normal velocity in one step — the plastic impact.
 
@@ -57,7 +59,10 @@ Assembly without scatter (``assemble_contact_forces``): each pair k stores its f
 f_k and weights N_I in its own rows; a node sums its own pairs (node-major already);
 the segment side is gathered through a CSR (segment node → (pair, corner)) built by
 a serial counting sort in pair order. Energy and active count are summed serially
-in pair order. Results are bitwise independent of the thread count.
+in pair order, and the active pairs listed (node, pair) in that order for the energy
+books (``kernels.contact_energy``: each pair's spring, dashpot and friction forces,
+``pair_sd``, give the work of each per interface). Results are bitwise independent of
+the thread count.
 """
 
 from __future__ import annotations
@@ -301,8 +306,9 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, seg_on, pa
 
 @loop_kernel
 def penalty_forces(
-    x, v, quads, ply, node_mass, h_node, h_seg, margin, overlap, beta, zeta, mu, dt,
-    seg, seg_on, node_on, pair_ptr, pair_seg, geo, pair_on, pair_f, pair_w, pair_e, node_f,
+    x, v, quads, ply, node_mass, h_node, h_seg, margin, overlap, beta, zeta, mu, approach, dt,
+    seg, seg_on, node_on, pair_ptr, pair_seg, geo, pair_on, pair_f, pair_w, pair_e, pair_sd,
+    pair_pw, node_f,
 ):
     """Penalty (and friction) force of every candidate pair (module docstring).
 
@@ -313,6 +319,8 @@ def penalty_forces(
         overlap: (n_nodes,) o_p (m).
         beta: penalty scale β; zeta: damping ζ (fraction of critical); mu: friction
             coefficient μ (0: frictionless).
+        approach: the dashpot acts only while the pair closes (v_n < 0; the
+            ``damping_mode = "approach"`` law), not while it separates.
         dt: the time step the forces are for (s), > 0.
         seg: (n_elems, N_SEG_GEO) the segments' table at x (:func:`segment_geometry`).
         seg_on, node_on: (n_elems,), (n_nodes,) int8: the segments and nodes taking part
@@ -325,6 +333,13 @@ def penalty_forces(
             reader looks at them).
         pair_w: (capacity, 4) written for the active pairs: N_I(ξ, η) of each pair.
         pair_e: (capacity,) written for the active pairs: ½ k g² of each pair (J).
+        pair_sd: (capacity, 2) written for the active pairs: the normal force of the
+            spring, −k g, and of the dashpot, −c v_n, on the node (N; the rest of
+            pair_f is friction): what the energy books split the pair's work by
+            (kernels.contact_energy).
+        pair_pw: (capacity, 3) written for the active pairs: the powers of the spring,
+            the dashpot and friction at v (W; kernels.contact_energy, where the same are
+            computed at other velocities).
         node_f: (n_nodes, 3) written: Σ of each node's own pair forces (N).
     """
     n_nodes = x.shape[0]
@@ -358,20 +373,32 @@ def penalty_forces(
             k_pen = beta * min(m_p, m_s) * inv_dt2
             m_red = m_p * m_s / (m_p + m_s)
             nx, ny, nz = geo[k, GEO_N], geo[k, GEO_N + 1], geo[k, GEO_N + 2]
-            if zeta > 0.0 or mu > 0.0:
-                vx = v[p, 0] - (n1 * v[q0, 0] + n2 * v[q1, 0] + n3 * v[q2, 0] + n4 * v[q3, 0])
-                vy = v[p, 1] - (n1 * v[q0, 1] + n2 * v[q1, 1] + n3 * v[q2, 1] + n4 * v[q3, 1])
-                vz = v[p, 2] - (n1 * v[q0, 2] + n2 * v[q1, 2] + n3 * v[q2, 2] + n4 * v[q3, 2])
-            else:
-                vx = vy = vz = 0.0
+            # the relative velocity (the dashpot's, friction's and the energy books'; with
+            # neither a dashpot nor friction it only books the spring's work)
+            vx = v[p, 0] - (n1 * v[q0, 0] + n2 * v[q1, 0] + n3 * v[q2, 0] + n4 * v[q3, 0])
+            vy = v[p, 1] - (n1 * v[q0, 1] + n2 * v[q1, 1] + n3 * v[q2, 1] + n4 * v[q3, 1])
+            vz = v[p, 2] - (n1 * v[q0, 2] + n2 * v[q1, 2] + n3 * v[q2, 2] + n4 * v[q3, 2])
             # at most ½ m_red/Δt: the two passes of a pair then remove at most its whole
             # relative normal velocity in one step (a stable explicit dashpot)
             c_pen = min(2.0 * zeta * math.sqrt(k_pen * m_red), 0.5 * m_red / dt)
+            vn = vx * nx + vy * ny + vz * nz
+            if approach and vn > 0.0:  # separating: no dashpot in the approach-only law
+                c_pen = 0.0
             gx, gy, gz = pair_force(-k_pen * g, c_pen, vx, vy, vz, nx, ny, nz, mu, m_red, dt)
             pair_f[k, 0] = gx
             pair_f[k, 1] = gy
             pair_f[k, 2] = gz
             pair_e[k] = 0.5 * k_pen * g * g
+            # the spring's and the dashpot's normal forces (their sum is pair_force's f_n
+            # bitwise: s − c v_n = s + (−(c v_n)))
+            sp = -k_pen * g
+            dp = -(c_pen * vn)
+            pair_sd[k, 0] = sp
+            pair_sd[k, 1] = dp
+            # their powers at v (kernels.contact_energy.shell_pair_powers at other v)
+            pair_pw[k, 0] = sp * vn
+            pair_pw[k, 1] = dp * vn
+            pair_pw[k, 2] = (gx * vx + gy * vy + gz * vz - (sp + dp) * vn) if mu > 0.0 else 0.0
             fx += gx
             fy += gy
             fz += gz
@@ -413,7 +440,7 @@ def initial_overlap(x, quads, ply, h_node, h_seg, margin, seg, seg_on, pair_ptr,
 @loop_kernel
 def assemble_contact_forces(
     quads, pair_ptr, pair_seg, pair_on, pair_f, pair_w, pair_e, node_f,
-    seg_ptr, seg_entry, cursor, out, accumulate,
+    seg_ptr, seg_entry, cursor, out, accumulate, active,
 ):
     """Nodal contact forces: out[n] (=, or += with ``accumulate``) node_f[n] − Σ N_I f_k
     over the pairs k whose segment has n as its corner I; the segment side is gathered
@@ -426,33 +453,38 @@ def assemble_contact_forces(
             (n_nodes,) int64: scratch.
         out: (n_nodes, ≥ 3) columns 0–2 written (or added to).
         accumulate: add to out instead of overwriting it.
+        active: (capacity, 2) int64, rows 0 … n_active − 1 written: (node, pair) of the
+            active pairs in pair order (the energy books read them,
+            kernels.contact_energy).
 
     Returns:
         (energy, n_active): Σ ½ k g² (J), summed in pair order, and the active pairs.
     """
     n_nodes = pair_ptr.shape[0] - 1
-    n_pairs = pair_ptr[n_nodes]
     for n in range(n_nodes + 1):
         seg_ptr[n] = 0
     energy = 0.0
     n_active = 0
-    for k in range(n_pairs):
-        if pair_on[k] != 0:
-            energy += pair_e[k]
-            n_active += 1
-            s = pair_seg[k]
-            for c in range(4):
-                seg_ptr[quads[s, c] + 1] += 1
+    for p in range(n_nodes):  # the pairs in order, node by node
+        for k in range(pair_ptr[p], pair_ptr[p + 1]):
+            if pair_on[k] != 0:
+                energy += pair_e[k]
+                active[n_active, 0] = p
+                active[n_active, 1] = k
+                n_active += 1
+                s = pair_seg[k]
+                for c in range(4):
+                    seg_ptr[quads[s, c] + 1] += 1
     for n in range(n_nodes):
         seg_ptr[n + 1] += seg_ptr[n]
         cursor[n] = seg_ptr[n]
-    for k in range(n_pairs):
-        if pair_on[k] != 0:
-            s = pair_seg[k]
-            for c in range(4):
-                q = quads[s, c]
-                seg_entry[cursor[q]] = 4 * k + c
-                cursor[q] += 1
+    for j in range(n_active):
+        k = active[j, 1]
+        s = pair_seg[k]
+        for c in range(4):
+            q = quads[s, c]
+            seg_entry[cursor[q]] = 4 * k + c
+            cursor[q] += 1
     for n in prange(n_nodes):
         fx, fy, fz = node_f[n, 0], node_f[n, 1], node_f[n, 2]
         for j in range(seg_ptr[n], seg_ptr[n + 1]):

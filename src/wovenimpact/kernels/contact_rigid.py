@@ -85,7 +85,7 @@ def node_gap(x, i, offset, tip, axis, prof_z, prof_r, reach, length):
 @loop_kernel
 def rigid_contact_forces(
     x, v, node_active, node_mass, offset, beta, zeta, mu, dt, body_mass, tip, axis, body_v,
-    body_w, body_c, prof_z, prof_r, reach, force, energy,
+    body_w, body_c, prof_z, prof_r, reach, force, energy, parts, contact_list,
 ):
     """Penalty, damping and friction forces on the nodes from a rigid body of revolution.
 
@@ -120,6 +120,14 @@ def rigid_contact_forces(
             nodes farther are skipped.
         force: (n, 3) written: contact force on each node (N).
         energy: (n,) written: penalty energy ½ k g² of each node (J).
+        parts: (n, 8) written for the nodes in contact: the normal forces of the spring
+            k g and of the dashpot −c v_n (N), the normal n, the force f (what the
+            energy books split the pair's work by, kernels.contact_energy).
+        contact_list: (n,) int64, its first ``count`` entries written: the nodes in
+            contact, in node order.
+
+    Returns:
+        count: the nodes in contact.
     """
     n = x.shape[0]
     length = prof_z[prof_z.shape[0] - 1]
@@ -138,9 +146,12 @@ def rigid_contact_forces(
             force[i, 1] = ny
             force[i, 2] = nz
     m_contact = 0.0
+    count = 0
     for i in range(n):
         if energy[i] > 0.0:
             m_contact += node_mass[i]
+            contact_list[count] = i
+            count += 1
     c_factor = min(2.0 * zeta * math.sqrt(beta), 1.0) / (1.0 + m_contact / body_mass)
     # pass 2: forces
     for i in prange(n):
@@ -161,6 +172,15 @@ def rigid_contact_forces(
         force[i, 1] = fy
         force[i, 2] = fz
         energy[i] = 0.5 * k * gap * gap
+        parts[i, 0] = k * gap
+        parts[i, 1] = -(c * (vrx * nx + vry * ny + vrz * nzz))
+        parts[i, 2] = nx
+        parts[i, 3] = ny
+        parts[i, 4] = nzz
+        parts[i, 5] = fx
+        parts[i, 6] = fy
+        parts[i, 7] = fz
+    return count
 
 
 @kernel

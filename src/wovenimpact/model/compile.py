@@ -115,7 +115,7 @@ def make_mesh(spec: CaseSpec, base: Path, sections: dict | None = None
         # touching plies: generated one thickness apart, then stacked by their own
         spacing = m.spacing if thick is None else max(thick)
         mesh = plate_mesh(m.side, m.element_size, plies=m.plies, spacing=spacing or 0.0,
-                          quarter=m.quarter)
+                          quarter=m.quarter, width=m.width)
         if m.ply_sections is None:
             return mesh, [m.section] * mesh.n_elems
         if thick is not None:
@@ -211,6 +211,25 @@ def erode_at_start(model: Model, state: State, er, key: str) -> None:
     state.omega[~live] = 0.0
 
 
+def check_quarter_sideways(im, geometry: Impactor) -> None:
+    """A body flying sideways in a quarter model (symmetry on x = 0 and y = 0) must be
+    symmetric about both planes: travelling along z, its axis along x or y, its middle
+    (the tip plus half its length along the axis) on the z axis."""
+    axis = np.asarray(im.axis, dtype=float)
+    axis = axis / np.linalg.norm(axis)
+    middle = np.asarray(im.position, dtype=float) + 0.5 * geometry.total_length * axis
+    along = np.count_nonzero(np.abs(axis) > 1e-12) == 1 and abs(axis[2]) == 0.0
+    if (not along or abs(im.direction[0]) > 0 or abs(im.direction[1]) > 0
+            or abs(middle[0]) > 1e-12 or abs(middle[1]) > 1e-12):
+        raise InputError(
+            f"impactor: in a quarter model a body flying sideways must be symmetric about "
+            f"x = 0 and y = 0: travelling along z (direction {list(im.direction)}), its axis "
+            f"along x or y (axis {list(im.axis)}) and its middle, position + length/2 along "
+            f"the axis, on the z axis (x = y = 0; it is at "
+            f"{np.round(middle[:2] * 1e3, 9).tolist()} mm): e.g. axis = [0, 1, 0] and "
+            "position = [0, −length/2, z]")
+
+
 def check_impactor_clearance(model: Model) -> None:
     """Every node must start outside each impactor by at least its contact offset."""
     n = model.n_nodes
@@ -227,7 +246,8 @@ def check_impactor_clearance(model: Model) -> None:
         rigid_contact_forces(model.x0, np.zeros((n, 3)), np.ones(n, np.int8), np.ones(n),
                              model.node_offset, 1.0, 0.0, 0.0, 1.0, 1.0, tip, axis, zero, zero, zero,
                              np.ascontiguousarray(prof[:, 0]), np.ascontiguousarray(prof[:, 1]),
-                             p[RB.BP_REACH] + float(model.node_offset.max()), force, energy)
+                             p[RB.BP_REACH] + float(model.node_offset.max()), force, energy,
+                             np.zeros((n, 8)), np.zeros(n, dtype=np.int64))
         bad = np.flatnonzero(energy > 0.0)
         if bad.size:
             worst = int(bad[np.argmax(energy[bad])])
@@ -479,15 +499,20 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         except InputError as err:
             raise InputError(f"impactor: {err}") from None
         quarter = isinstance(spec.mesh, PlateMeshSpec) and spec.mesh.quarter
-        if quarter and (abs(im.position[0]) > 1e-12 or abs(im.position[1]) > 1e-12
-                        or abs(im.direction[0]) > 0 or abs(im.direction[1]) > 0):
+        if quarter and im.axis is None and (
+                abs(im.position[0]) > 1e-12 or abs(im.position[1]) > 1e-12
+                or abs(im.direction[0]) > 0 or abs(im.direction[1]) > 0):
             raise InputError("impactor: in a quarter model the impactor must sit on the "
                              "symmetry axis (position x = y = 0) and travel along z")
-        # a quarter model carries a quarter of the impactor, which moves along its axis
+        if quarter and im.axis is not None:
+            check_quarter_sideways(im, geometry)
+        # a quarter model carries a quarter of the impactor, which moves along its line
+        # of travel
         bodies.append(RigidBody(geometry, tip=im.position, direction=im.direction,
                                 speed=im.velocity, mass=im.mass, beta=im.contact_stiffness,
                                 damping=im.contact_damping, friction=im.friction,
-                                fraction=0.25 if quarter else 1.0, axial_only=quarter))
+                                fraction=0.25 if quarter else 1.0, axial_only=quarter,
+                                axis=im.axis))
     used = {s: i for i, s in enumerate(dict.fromkeys(elem_sections))}
     model = build_model(
         mesh.nodes, mesh.quads, {s: sections[s] for s in used},
@@ -498,7 +523,8 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         shell_contact=ShellContactParams(
             enabled=spec.contact.surfaces != "none" or spec.contact.self_contact,
             beta=spec.contact.penalty_scale, damping=spec.contact.damping,
-            friction=spec.contact.friction, self_contact=spec.contact.self_contact),
+            friction=spec.contact.friction, self_contact=spec.contact.self_contact,
+            damping_mode=spec.contact.damping_mode),
         release_elems=mesh.elem_sets.get("blade.release") if spin is not None else None,
         release_time=spec.spin.release_time if spin is not None else math.inf,
         erode_inverted=spec.run.erode_inverted,

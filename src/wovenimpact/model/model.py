@@ -17,7 +17,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from wovenimpact.errors import InputError
-from wovenimpact.impactor import BODY_PENALTY_SCALE, Impactor
+from wovenimpact.impactor import BODY_PENALTY_SCALE, SIDEWAYS_COS, Impactor
 from wovenimpact.kernels.integrate import FIXED, PRESCRIBED, ROTATING
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as SL
@@ -37,6 +37,10 @@ def is_plastic(material) -> bool:
 MEMBRANE_POINTS = {"full": SL.MEMBRANE_FULL, "reduced": SL.MEMBRANE_REDUCED}
 # what becomes of a node that loses its last live element (Model.eroded_nodes)
 ERODED_NODES = ("remove", "keep")
+# a rigid body's direction of travel in its own frame (Model.body_travel): nose first,
+# along −(axis of revolution), or sideways, along the second body axis
+DEFAULT_TRAVEL = (-1.0, 0.0, 0.0)
+SIDEWAYS_TRAVEL = (0.0, 1.0, 0.0)
 GAUSS = 1.0 / np.sqrt(3.0)  # 2×2 Gauss points at (±1/√3, ±1/√3), weights 1
 GAUSS_XI = np.array([-GAUSS, GAUSS, GAUSS, -GAUSS])  # point g next to corner g
 GAUSS_ETA = np.array([-GAUSS, -GAUSS, GAUSS, GAUSS])
@@ -209,8 +213,12 @@ class RigidBody:
         friction: Coulomb coefficient μ between the body and the nodes.
         fraction: the share of the body in the model (0.25 in a quarter model: mass
             and inertia are scaled by it).
-        axial_only: the body translates along its axis only, without rotating (a
-            body cut by symmetry planes through its axis).
+        axial_only: the body translates along its line of travel only, without
+            rotating (a body cut by symmetry planes through its line of travel).
+        axis: the body's axis of revolution (tip → tail), perpendicular to
+            ``direction``: the body flies sideways (a cylinder lying across a strip
+            strikes it with its side); ``tip`` is then the point of the axis where the
+            profile starts. None (default): the axis is −direction, nose first.
     """
 
     impactor: Impactor
@@ -223,6 +231,13 @@ class RigidBody:
     friction: float = 0.0
     fraction: float = 1.0
     axial_only: bool = False
+    axis: tuple[float, float, float] | None = None
+
+    @property
+    def travel_in_body(self) -> tuple[float, float, float]:
+        """The direction of travel in the body's frame (first axis: the axis of
+        revolution): (−1, 0, 0) nose first, (0, 1, 0) sideways (:meth:`pack`)."""
+        return DEFAULT_TRAVEL if self.axis is None else SIDEWAYS_TRAVEL
 
     def pack(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(parameter row, profile polyline, initial state row) for the Model/State."""
@@ -232,10 +247,19 @@ class RigidBody:
         m, i_a, i_t = m * scale, i_a * scale, i_t * scale
         travel = np.asarray(self.direction, dtype=float)
         travel = travel / np.linalg.norm(travel)
-        axis = -travel  # body axis: tip → tail
-        helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-        e2 = np.cross(axis, helper)
-        e2 /= np.linalg.norm(e2)
+        if self.axis is None:
+            axis = -travel  # body axis: tip → tail
+            helper = (np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9
+                      else np.array([0.0, 1.0, 0.0]))
+            e2 = np.cross(axis, helper)
+            e2 /= np.linalg.norm(e2)
+        else:  # sideways: the second body axis is the travel (travel_in_body)
+            axis = np.asarray(self.axis, dtype=float)
+            axis = axis / np.linalg.norm(axis)
+            if abs(float(axis @ travel)) > SIDEWAYS_COS:
+                raise InputError(f"rigid body: axis {axis.tolist()} is not perpendicular to "
+                                 f"the direction of travel {travel.tolist()}")
+            e2 = travel
         e3 = np.cross(axis, e2)
         rot = np.stack([axis, e2, e3], axis=1)  # columns: body axes in global coordinates
         profile = imp.profile()
@@ -317,6 +341,11 @@ class Model:
         body_params: (n_bodies, N_BODY_PARAM) rigid impactors (kernels.rigid_body).
         body_profiles: (n_bodies, n_points, 2) their meridian polylines (ζ, ρ), padded.
         body_state0: (n_bodies, N_BODY_STATE) their state at t = 0.
+        body_travel: (n_bodies, 3) each body's direction of travel in its own frame
+            (constant): DEFAULT_TRAVEL (−1, 0, 0), nose first, or SIDEWAYS_TRAVEL
+            (0, 1, 0), a body whose axis lies across its travel (RigidBody.axis). A
+            Model built without it (empty) has every body nose first
+            (:func:`flies_sideways`, :func:`travel_of_row`).
         node_sets, elem_sets: named index arrays (outputs, BCs).
         shell_contact: parameters of the shell–shell contact between the surfaces
             (``ply`` labels the surfaces: plies, element sets or connected parts).
@@ -395,6 +424,7 @@ class Model:
     elem_length: np.ndarray = field(default_factory=lambda: np.zeros((0, 2)))
     elem_failure: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
     eroded_nodes: str = "remove"
+    body_travel: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
     @property
     def n_nodes(self) -> int:
@@ -425,8 +455,49 @@ class Model:
             h.update(self.eroded_nodes.encode())
         if self.shell_contact.damping_mode != "always":  # (likewise)
             h.update(self.shell_contact.damping_mode.encode())
+        if any(flies_sideways(self, b) for b in range(self.body_params.shape[0])):
+            h.update(b"body_travel" + np.ascontiguousarray(self.body_travel).tobytes())
         h.update(np.ascontiguousarray(self.release_elems).tobytes())
         return h.hexdigest()
+
+
+def flies_sideways(model, b: int = 0) -> bool:
+    """Whether body b's axis lies across its travel (RigidBody.axis given)."""
+    t = model.body_travel
+    return t.shape[0] > b and tuple(t[b]) != DEFAULT_TRAVEL
+
+
+def travel_of_row(model, row, b: int = 0) -> np.ndarray:
+    """The unit direction of travel of body b whose state row is ``row``: −(its axis)
+    for a body flying nose first (the expression used before sideways bodies existed),
+    its rotation times ``body_travel[b]`` for one flying sideways."""
+    rot = row[RB.B_R:RB.B_R + 9].reshape(3, 3)
+    if not flies_sideways(model, b):
+        return -rot[:, 0]
+    return rot @ model.body_travel[b]
+
+
+def sideways_shadow(model, row, b: int, x) -> tuple[np.ndarray, np.ndarray]:
+    """Points ``x`` (m, 3) seen from body b flying sideways (state row ``row``): s,
+    their distance ahead of its leading line along the travel d (the line of the body's
+    surface farthest along d, R ahead of its axis, R the profile's largest radius), and
+    how far each lies outside the body's shadow — the rectangle the body sweeps, its
+    length L along the axis a by 2R across (e = d × a) — ≤ 0 inside:
+    max(|(x − tip)·e| − R, −(x − tip)·a, (x − tip)·a − L). For a cylinder the shadow
+    is exact; for another profile it is the bounding rectangle."""
+    p = model.body_params[b]
+    rot = row[RB.B_R:RB.B_R + 9].reshape(3, 3)
+    a = rot[:, 0]
+    d = travel_of_row(model, row, b)
+    e = np.cross(d, a)
+    tip = row[RB.B_X:RB.B_X + 3] - p[RB.BP_TIP] * a
+    n = int(p[RB.BP_NPTS])
+    radius = float(np.max(model.body_profiles[b, :n, 1]))
+    length = float(model.body_profiles[b, n - 1, 0])
+    rel = np.asarray(x, dtype=float) - tip
+    along = rel @ a
+    outside = np.maximum(np.abs(rel @ e) - radius, np.maximum(-along, along - length))
+    return rel @ d - radius, outside
 
 
 def rotary_inertia(x0, quads, sec_table, elem_section, mat_kind, mat_params, area0, ref_grad):
@@ -772,6 +843,8 @@ def build_model(
     for c in range(4):
         np.maximum.at(node_offset, q[:, c], 0.5 * thick)
     packed = [b.pack() for b in (bodies or [])]
+    body_travel = np.array([b.travel_in_body for b in (bodies or [])],
+                           dtype=float).reshape(-1, 3)
     n_pts = max((len(p[1]) for p in packed), default=0)
     body_params = np.zeros((len(packed), RB.N_BODY_PARAM))
     body_profiles = np.zeros((len(packed), n_pts, 2))
@@ -791,7 +864,7 @@ def build_model(
         erode_dt_fraction=float(erode_dt_fraction),
         ply=np.zeros(len(q), dtype=np.int64) if ply is None else np.asarray(ply, dtype=np.int64),
         node_offset=node_offset, body_params=body_params, body_profiles=body_profiles,
-        body_state0=body_state0,
+        body_state0=body_state0, body_travel=body_travel,
         node_sets=dict(node_sets or {}), elem_sets=dict(elem_sets or {}),
         shell_contact=shell_contact or ShellContactParams(),
         release_elems=release_array(release_elems, len(q)), release_time=float(release_time),

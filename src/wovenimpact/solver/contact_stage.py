@@ -10,14 +10,17 @@ also has a dashpot (ζ of critical) and optional Coulomb friction.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
+from wovenimpact.interfaces import n_parts, part_arrays
 from wovenimpact.kernels import rigid_body as RB
+from wovenimpact.kernels.contact_energy import N_KINDS, body_pair_powers, book_body_powers
 from wovenimpact.kernels.contact_rigid import add_body_forces, rigid_contact_forces
 from wovenimpact.kernels.gather import nodes_with_live_elements, node_sum
 from wovenimpact.kernels.rigid_body import advance_body
+from wovenimpact.model.model import flies_sideways
 
 
 @dataclass
@@ -32,6 +35,18 @@ class ContactBuffers:
     shell_energy: float = 0.0
     shell_pairs: int = 0
     penalty_energy: float = 0.0  # Σ ½ k g² of every body and shell pair at x^n (J)
+    # the energy books per interface (wovenimpact.interfaces, kernels.contact_energy):
+    # the part of each node, element and body, and of each body's pairs at x^n the
+    # spring, dashpot, normal and force of each node in contact (contact_rigid ``parts``)
+    # and the list of those nodes
+    node_part: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    elem_part: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    body_part: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    n_parts: int = 0
+    body_parts: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 8)))
+    body_list: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), dtype=np.int64))
+    body_count: list = field(default_factory=list)
+    body_power: np.ndarray = field(default_factory=lambda: np.zeros((0, N_KINDS)))
 
     @classmethod
     def for_model(cls, model) -> ContactBuffers:
@@ -44,9 +59,15 @@ class ContactBuffers:
             from wovenimpact.contact import ShellContact
 
             shells = ShellContact(model, beta=p.beta, damping=p.damping, friction=p.friction,
-                                  self_contact=p.self_contact)
+                                  damping_mode=p.damping_mode, self_contact=p.self_contact)
+        nb = model.body_params.shape[0]
+        node_part, elem_part, body_part = part_arrays(model)
         return cls(np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n),
-                   np.zeros(n, dtype=np.int8), shells)
+                   np.zeros(n, dtype=np.int8), shells, node_part=node_part,
+                   elem_part=elem_part, body_part=body_part, n_parts=n_parts(model),
+                   body_parts=np.zeros((nb, n, 8)),
+                   body_list=np.zeros((nb, n), dtype=np.int64), body_count=[0] * nb,
+                   body_power=np.zeros((n if nb else 0, N_KINDS)))
 
 
 def body_frame(state_row, params):
@@ -93,20 +114,25 @@ def contact_forces(model, state, cb: ContactBuffers, dt: float, elem_alive,
         rot = row[RB.B_R:RB.B_R + 9].reshape(3, 3)
         spin = rot @ row[RB.B_W:RB.B_W + 3]
         prof = model.body_profiles[b, : int(p[RB.BP_NPTS])]
-        rigid_contact_forces(
+        cb.body_count[b] = rigid_contact_forces(
             state.x, state.v, active, model.node_mass, model.node_offset, p[RB.BP_BETA],
             p[RB.BP_DAMPING], p[RB.BP_FRICTION], dt, p[RB.BP_MASS], tip, axis,
             np.ascontiguousarray(row[RB.B_V:RB.B_V + 3]), spin,
             np.ascontiguousarray(row[RB.B_X:RB.B_X + 3]),
             np.ascontiguousarray(prof[:, 0]), np.ascontiguousarray(prof[:, 1]),
             p[RB.BP_REACH] + float(model.node_offset.max()), cb.f_body, cb.e_body,
+            cb.body_parts[b], cb.body_list[b],
         )
         cb.penalty_energy += node_sum(cb.e_body)
         fx, fy, fz, tx, ty, tz = add_body_forces(state.x, row[RB.B_X:RB.B_X + 3], cb.f_body,
                                                  cb.f_con)
         force = np.array([fx, fy, fz])
-        if p[RB.BP_AXIAL_ONLY]:  # symmetry planes through the axis: no torque, no drift
-            force = (force @ axis) * axis
+        if p[RB.BP_AXIAL_ONLY]:  # symmetry planes through the travel: no torque, no drift
+            if flies_sideways(model, b):  # the line of travel is across the axis
+                d = rot @ model.body_travel[b]
+                force = (force @ d) * d
+            else:
+                force = (force @ axis) * axis
             torque = np.zeros(3)
         else:
             torque = np.array([tx, ty, tz])
@@ -116,6 +142,28 @@ def contact_forces(model, state, cb: ContactBuffers, dt: float, elem_alive,
             state.x, state.v, dt, elem_alive, active, cb.f_con, accumulate=True)
         cb.penalty_energy += cb.shell_energy
     return resultants
+
+
+def book_contact_work(model, state, cb: ContactBuffers, weight: float, books,
+                      after: bool) -> None:
+    """Add the work of this step's contact forces (the pairs of :func:`contact_forces`)
+    at the State's velocities — the nodes' ``state.v`` and the bodies' translation — times
+    ``weight`` to ``books`` (N_KINDS, P, P) by interface and kind (kernels.contact_energy).
+    The solver calls it twice per step, like its trapezoid rule: with ½ Δt^{n−1/2} and
+    the velocities the forces were computed with, then (``after``) with ½ Δt^{n+1/2} and
+    the velocities after the node update."""
+    if cb.shells is not None:
+        cb.shells.book(weight, books, cb.node_part, cb.elem_part,
+                       v=state.v if after else None)
+    for b, count in enumerate(cb.body_count):
+        if count == 0:
+            continue
+        row = state.bodies[b]
+        body_pair_powers(state.v, np.ascontiguousarray(row[RB.B_V:RB.B_V + 3]),
+                         cb.body_parts[b], cb.body_list[b], count,
+                         model.body_params[b, RB.BP_FRICTION] > 0.0, cb.body_power)
+        book_body_powers(cb.body_power, cb.body_list[b], count, cb.node_part,
+                         int(cb.body_part[b]), float(weight), books)
 
 
 def advance_bodies(model, state, resultants, dt_old: float, dt_new: float) -> tuple[float, float]:

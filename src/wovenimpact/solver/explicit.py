@@ -29,6 +29,7 @@ import numba
 import numpy as np
 
 from wovenimpact.errors import SimulationError
+from wovenimpact.interfaces import empty_books
 from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.kernels.bundles import (
     ElementResults,
@@ -43,7 +44,12 @@ from wovenimpact.kernels.bundles import (
 from wovenimpact.kernels.gather import gather_nodal_forces
 from wovenimpact.kernels.integrate import force_pair_power, gather_and_update, smooth_step
 from wovenimpact.kernels.mass_scaling import node_masses, scale_element_masses, scaled_node_masses
-from wovenimpact.solver.contact_stage import ContactBuffers, advance_bodies, contact_forces
+from wovenimpact.solver.contact_stage import (
+    ContactBuffers,
+    advance_bodies,
+    book_contact_work,
+    contact_forces,
+)
 from wovenimpact.solver.element_blocks import block_plan, block_scratch
 from wovenimpact.kernels.shell import internal_force_for_shells
 from wovenimpact.kernels.shell_blocks import internal_force_blocks
@@ -284,9 +290,18 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     # work of the contact forces on the nodes over [x^{n−1}, x^n] (trapezoid), before
     # the velocities move on
     w_con_nodes = 0.0
+    books = state.contact_books
     if resultants or cb.shells is not None:
         w_con_nodes = force_pair_power(state.f_contact, cb.f_con, state.v, state.dt,
                                        state.contact_work) * state.dt
+        if books.shape[-1] != cb.n_parts:  # a State built by hand, without its books
+            books = state.contact_books = empty_books(model)
+        # the same work by interface and kind (interfaces, kernels.contact_energy): the
+        # last step's forces against these velocities (booked after that step), and
+        # this step's
+        books[0] += books[1]
+        books[1] = 0.0
+        book_contact_work(model, state, cb, 0.5 * state.dt, books[0], after=False)
     t0 = ws.tick("contact", t0)
     amplitude = smooth_step(state.t + 0.5 * dt_new, model.ramp_time)
     n_bad = gather_and_update(
@@ -304,6 +319,8 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
         n = int(np.flatnonzero(~np.isfinite(state.x).all(axis=1))[0])
         raise SimulationError(f"node {n} has a non-finite position at t = {state.t:.6e} s")
     ke_bodies, w_con_bodies = advance_bodies(model, state, resultants, state.dt, dt_new)
+    if resultants or cb.shells is not None:  # this step's forces against v^{n+1/2}
+        book_contact_work(model, state, cb, 0.5 * dt_new, books[1], after=True)
     en = state.energy
     if state.step == 1:
         first_step_work_correction(model, state)

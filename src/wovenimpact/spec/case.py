@@ -23,7 +23,8 @@ Schema (see README and examples/cases/)::
                       points? (1: resultant section; odd n ≥ 3: n Simpson points),
                       membrane? ("full": 2×2 in-plane points, fabric default;
                       "reduced": one point + hourglass springs, metal default)
-    [mesh]            kind = "plate": side, element_size, plies, spacing, quarter,
+    [mesh]            kind = "plate": side, width? (a rectangle: side along x, width
+                      along y), element_size, plies, spacing, quarter,
                       section, warp_direction   | kind = "abaqus" | "gmsh": file,
                       sections = {ELSET = SECTION}, length_unit?, warp_direction?
                       (vector | "circumferential"), axis?, [mesh.containment]? (blade,
@@ -45,11 +46,13 @@ Schema (see README and examples/cases/)::
     [body_force]      acceleration = [ax, ay, az]
     [impactor]        shape = sphere | cylinder, radius, length, nose, nose_length, fillet,
                       density | mass, position (nose tip), direction, velocity,
+                      axis? (⟂ direction: the body flies sideways, e.g. a cylinder's
+                      side as an edge; default along the direction, nose first),
                       contact_stiffness (penalty factor β of k = β m / Δt²; 0.3),
                       contact_damping (ζ, fraction of critical; 1), friction (μ; 0)
     [contact]         shell–shell contact: surfaces = plies | parts | element_sets |
                       none, self_contact, penalty_scale (β; 0.1), damping (ζ; 0.3),
-                      friction (μ; 0)
+                      damping_mode (always | approach), friction (μ; 0)
     [[initial_erosion]]  centre, radius, plies?: elements eroded at t = 0 (a hole: centroid
                       within radius of the axis through centre along cylinder_axis)
     [run]             end_time, field_interval, history_interval, checkpoint_interval,
@@ -71,7 +74,7 @@ from typing import Annotated, Any, Literal
 from pydantic import AfterValidator, BaseModel, Field, ValidationError, model_validator
 
 from wovenimpact.errors import InputWarning
-from wovenimpact.impactor import BODY_PENALTY_SCALE
+from wovenimpact.impactor import BODY_PENALTY_SCALE, SIDEWAYS_COS
 from wovenimpact.spec.fields import (
     STRICT,
     Problem,
@@ -135,11 +138,14 @@ class SectionSpec(BaseModel):
 
 
 class PlateMeshSpec(BaseModel):
-    """``[mesh] kind = "plate"``: square plies from the structured generator."""
+    """``[mesh] kind = "plate"``: square plies from the structured generator, or
+    rectangular ones (``side`` along x, ``width`` along y: a strip)."""
 
     model_config = STRICT
     kind: Literal["plate"]
     side: Length
+    # the plate's extent along y; not given: side (a square, the mesh as before the key)
+    width: Length | None = None
     element_size: Length
     plies: int = Field(default=1, ge=1)
     spacing: Length | None = None
@@ -428,6 +434,14 @@ class ImpactorSpec(BaseModel):
     ``position`` is the nose tip at t = 0, ``direction`` the direction of travel (the
     nose leads), ``velocity`` the speed along it. Mass from ``density`` (steel by
     default) unless ``mass`` is given (the density is then scaled to match).
+
+    ``axis`` (optional) turns the body's axis of revolution across its travel: it must
+    be perpendicular to ``direction``, and the body flies sideways — a cylinder lying
+    across a strip strikes it with its side, a round edge of its diameter. ``position``
+    is then still the tip, the point of the axis where the profile starts (a
+    cylinder's first end face's centre), and the body extends ``length`` from it along
+    ``axis``. Not given: the axis is the direction of travel, nose first (the model as
+    before the key, bit for bit).
     """
 
     model_config = STRICT
@@ -441,6 +455,7 @@ class ImpactorSpec(BaseModel):
     mass: quantity("mass", gt=0, example="1.1 g") | None = None
     position: tuple[Coordinate, Coordinate, Coordinate]
     direction: Direction = (0.0, 0.0, -1.0)
+    axis: Direction | None = None
     velocity: quantity("velocity", gt=0, example="120 m/s")
     contact_stiffness: quantity("dimensionless", gt=0, le=0.5,
                                  example="0.3") = BODY_PENALTY_SCALE
@@ -453,6 +468,22 @@ class ImpactorSpec(BaseModel):
     def _cylinder_needs_length(self):
         if self.shape == "cylinder" and self.length is None:
             raise ValueError("a cylinder needs length (with unit)")
+        return self
+
+    @model_validator(mode="after")
+    def _axis_across_the_travel(self):
+        if self.axis is None:
+            return self
+        a, d = self.axis, self.direction
+        cos = sum(x * y for x, y in zip(a, d)) / (math.hypot(*a) * math.hypot(*d))
+        if abs(cos) > SIDEWAYS_COS:
+            raise ValueError(
+                f"axis = {list(self.axis)} is not perpendicular to direction = "
+                f"{list(self.direction)} (the angle between them is "
+                f"{math.degrees(math.acos(max(-1.0, min(1.0, cos)))):.6g}°; valid: a "
+                "vector perpendicular to the direction, for a body flying sideways such as "
+                "a cylinder whose side strikes as an edge, or no axis: the body's axis "
+                "along its direction, nose first)")
         return self
 
 
@@ -471,6 +502,10 @@ class ContactSpec(BaseModel):
     penalty_scale: quantity("dimensionless", gt=0, le=0.5, example="0.1") = 0.1
     damping: quantity("dimensionless", ge=0, le=2, example="0.3") = 0.3
     friction: quantity("dimensionless", ge=0, le=10, example="0.2") = 0.0
+    # the pair dashpot's law (docs/theory.md §6): "always" acts on the relative normal
+    # velocity while the pair overlaps, closing or separating; "approach" only while it
+    # closes, so a rebound is not damped and surfaces part freely
+    damping_mode: Literal["always", "approach"] = "always"
 
 
 class InitialErosionSpec(BaseModel):
@@ -576,17 +611,26 @@ def check_mesh_size(m) -> list[Problem]:
     plate's edge is half the side; a casing's length and the released fragment) and at
     most MAX_ELEMENTS elements in all."""
     if isinstance(m, PlateMeshSpec):
-        edge = m.side / 2.0  # the generator puts round(side/2 / h) elements on a half side
-        ratio = edge / m.element_size  # a float: 1e30 mm / 1e-300 mm must not overflow
-        per_half = round(ratio) if ratio < 1e15 else ratio
-        if per_half < 2:
-            where = "the quarter plate's edge" if m.quarter else "each half of the plate's side"
-            return [Problem("mesh.element_size", f"gives {per_half} element(s) along {where} "
-                            f"({edge:g} m)", m.element_size,
-                            f"element_size ≤ {edge / 1.5:.4g} m (2 elements or more)")]
-        per_side = float(per_half) * (1 if m.quarter else 2)
-        count = per_side * per_side * m.plies
-        context = f"side {m.side:g} m, {m.plies} plies"
+        counts = []
+        for name, length in (("side", m.side), ("width", m.width)):
+            if length is None:  # a square: the width's count is the side's
+                counts.append(counts[0])
+                continue
+            edge = length / 2.0  # the generator puts round(L/2 / h) elements on a half
+            ratio = edge / m.element_size  # a float: 1e30 mm / 1e-300 mm must not overflow
+            per_half = round(ratio) if ratio < 1e15 else ratio
+            if per_half < 2:
+                where = ("the quarter plate's edge" if m.quarter
+                         else "each half of the plate's side")
+                if m.width is not None:
+                    where += f" (mesh.{name})"
+                return [Problem("mesh.element_size", f"gives {per_half} element(s) along "
+                                f"{where} ({edge:g} m)", m.element_size,
+                                f"element_size ≤ {edge / 1.5:.4g} m (2 elements or more)")]
+            counts.append(float(per_half) * (1 if m.quarter else 2))
+        count = counts[0] * counts[1] * m.plies
+        context = (f"side {m.side:g} m, {m.plies} plies" if m.width is None
+                   else f"side {m.side:g} m, width {m.width:g} m, {m.plies} plies")
     elif isinstance(m, ContainmentMeshSpec):
         c, b = m.casing, m.blade
         fragment = b.tip_radius - b.crack_radius

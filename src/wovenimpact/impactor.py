@@ -30,6 +30,11 @@ STEEL_DENSITY = 7922.0  # kg/m³, thesis Table 7-1
 # plate meshes (0.1 left the coarse mesh 9–14 % short: the penalty lag ~Δt/√β grows
 # with the element), with ω Δt = √β·… well below the stability limit of 2.
 BODY_PENALTY_SCALE = 0.3
+# A body flying sideways (``[impactor] axis``): its axis must be perpendicular to its
+# travel to this |cos| (1e-9 rad), so that its shadow across the travel, which the
+# outcome reads (quantities.intact_material_ahead), is the rectangle of its length and
+# diameter
+SIDEWAYS_COS = 1e-9
 Nose = Literal["flat", "hemispherical", "conical", "ogive"]
 
 

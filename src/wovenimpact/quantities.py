@@ -15,6 +15,7 @@ import numpy as np
 from wovenimpact.errors import InputError
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as SL
+from wovenimpact.model.model import flies_sideways, sideways_shadow, travel_of_row
 
 QUIET_TIME = 10e-6  # contact must have been light this long to call a perforation
 LIGHT_CONTACT = 0.01  # "light": below this fraction of the peak contact force
@@ -34,14 +35,16 @@ def symmetry_factor(model) -> float:
 
 
 def travel_direction(model, state, b: int = 0) -> np.ndarray:
-    """Unit vector of the body's direction of travel (tip leading): −(body axis)."""
-    return -state.bodies[b, RB.B_R:RB.B_R + 9].reshape(3, 3)[:, 0]
+    """Unit vector of the body's direction of travel: −(body axis), tip leading, or,
+    for a body flying sideways, its rotation times its travel in its own frame
+    (model.model.travel_of_row)."""
+    return travel_of_row(model, state.bodies[b], b)
 
 
 def impactor_row(model, state, b: int = 0) -> dict:
     """Velocity and displacement along the initial travel direction, and the contact
     force resisting it (full-problem value), of impactor b."""
-    d0 = -model.body_state0[b, RB.B_R:RB.B_R + 9].reshape(3, 3)[:, 0]
+    d0 = travel_of_row(model, model.body_state0[b], b)
     row = state.bodies[b]
     x0 = model.body_state0[b, RB.B_X:RB.B_X + 3]
     factor = 1.0 / model.body_params[b, RB.BP_FRACTION]
@@ -123,13 +126,17 @@ def intact_material_ahead(model, state, b: int = 0) -> dict:
         else 0.
     """
     d = travel_direction(model, state, b)
-    tip = nose_tip(model, state, b)
     live = np.flatnonzero(attached_nodes(model, state) & (state.node_active != 0))
-    rel = state.x[live] - tip
-    s = rel @ d
-    rho = np.sqrt(np.maximum(np.sum(rel * rel, axis=1) - s * s, 0.0))
     h = model.node_offset[live]
-    near = rho <= impactor_radius(model, b) + h
+    if flies_sideways(model, b):
+        s, outside = sideways_shadow(model, state.bodies[b], b, state.x[live])
+        near = outside <= h
+    else:
+        tip = nose_tip(model, state, b)
+        rel = state.x[live] - tip
+        s = rel @ d
+        rho = np.sqrt(np.maximum(np.sum(rel * rel, axis=1) - s * s, 0.0))
+        near = rho <= impactor_radius(model, b) + h
     if not np.any(near):
         return {"impactor_nose_ahead_of_intact_m": math.inf, "intact_material_ahead": 0}
     lead = float(np.max(s[near] + h[near]))

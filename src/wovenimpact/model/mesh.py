@@ -102,41 +102,58 @@ def plate_mesh(
     spacing: float = 0.0,
     quarter: bool = False,
     z0: float = 0.0,
+    width: float | None = None,
 ) -> Mesh:
-    """Square plate of ``plies`` plies in the planes z = z0 + k·spacing.
+    """Square (or rectangular) plate of ``plies`` plies in the planes z = z0 + k·spacing.
 
-    The full plate spans [−side/2, side/2]², the quarter model [0, side/2]² (with
-    symmetry on x = 0 and y = 0). The quarter model has round(side / 2 / element_size)
-    elements per edge (at least 1); the full plate twice that, so that a node always
-    sits at the centre and the full plate is the mirror image of the quarter model.
-    Each ply has its own nodes (numbered ply by ply, x fastest).
+    The full plate spans [−side/2, side/2] × [−width/2, width/2] (width = side unless
+    given: a square), the quarter model [0, side/2] × [0, width/2] (with symmetry on
+    x = 0 and y = 0). The quarter model has round(side / 2 / element_size) elements
+    along x and round(width / 2 / element_size) along y (at least 1 each); the full
+    plate twice that, so that a node always sits at the centre and the full plate is
+    the mirror image of the quarter model. Each ply has its own nodes (numbered ply by
+    ply, x fastest).
 
     Node sets: "all", "edge_outer" (the clamped edges: all four for the full plate,
-    x = side/2 and y = side/2 for the quarter model), "symmetry_x" / "symmetry_y"
-    (quarter model: nodes on x = 0 / y = 0), "centre" (the node at x = y = 0 of each
-    ply) and "ply{k}". Element sets: "all" and "ply{k}".
+    x = side/2 and y = width/2 for the quarter model), "edge_x" / "edge_y" (the edges
+    normal to x, x = ±side/2, and to y, y = ±width/2; in the quarter model the outer
+    one only: a strip along x is clamped at its ends by "edge_x"), "symmetry_x" /
+    "symmetry_y" (quarter model: nodes on x = 0 / y = 0), "centre" (the node at
+    x = y = 0 of each ply) and "ply{k}". Element sets: "all" and "ply{k}".
 
     Args:
-        side: edge length of the full plate (m).
-        element_size: target element edge length (m), 0 < element_size ≤ side.
+        side: length of the full plate along x (m).
+        element_size: target element edge length (m), 0 < element_size ≤ side
+            and ≤ width.
         plies: number of plies, ≥ 1.
         spacing: distance between ply mid-planes (m), > 0 when plies > 1.
         quarter: build the quarter model instead of the full plate.
         z0: height of the first ply (m).
+        width: length of the full plate along y (m); None: ``side`` (a square).
     """
     _check_plate_arguments(side, element_size, plies, spacing, z0)
     coords = _axis_coordinates(side, element_size, quarter)
     n = len(coords) - 1
-    per_ply = (n + 1) ** 2
-    gx, gy = np.meshgrid(coords, coords)  # row j holds y = coords[j]
+    if width is None:
+        ycoords, ny = coords, n
+    else:
+        if not (_finite(width) and width > 0):
+            raise InputError(f"width = {width!r} m; valid: a finite length > 0")
+        if not element_size <= width:
+            raise InputError(f"element_size = {element_size!r} m; valid: 0 < element_size "
+                             f"≤ width ({width!r} m)")
+        ycoords = _axis_coordinates(width, element_size, quarter)
+        ny = len(ycoords) - 1
+    per_ply = (n + 1) * (ny + 1)
+    gx, gy = np.meshgrid(coords, ycoords)  # row j holds y = ycoords[j]
     nodes = np.concatenate([
         np.column_stack([gx.ravel(), gy.ravel(), np.full(per_ply, z0 + k * spacing)])
         for k in range(plies)
     ])
-    base = _grid_quads(n)
+    base = _grid_quads(n, ny)
     quads = np.concatenate([base + k * per_ply for k in range(plies)])
     ply = np.repeat(np.arange(plies, dtype=np.int64), len(base))
-    local = _plate_local_node_sets(n, quarter)
+    local = _plate_local_node_sets(n, quarter, ny)
     node_sets = {name: _per_ply(idx, per_ply, plies) for name, idx in local.items()}
     node_sets["all"] = np.arange(plies * per_ply, dtype=np.int64)
     elem_sets = {"all": np.arange(len(quads), dtype=np.int64)}
@@ -178,27 +195,35 @@ def _axis_coordinates(side: float, element_size: float, quarter: bool) -> np.nda
     return pos if quarter else np.concatenate([-pos[:0:-1], pos])
 
 
-def _grid_quads(n: int) -> np.ndarray:
-    """Quads of an (n+1)×(n+1) node grid, x fastest, counter-clockwise seen from +z."""
-    j, i = np.divmod(np.arange(n * n, dtype=np.int64), n)
+def _grid_quads(n: int, ny: int | None = None) -> np.ndarray:
+    """Quads of an (n+1)×(ny+1) node grid (ny = n by default), x fastest,
+    counter-clockwise seen from +z."""
+    ny = n if ny is None else ny
+    j, i = np.divmod(np.arange(n * ny, dtype=np.int64), n)
     n0 = j * (n + 1) + i
     return np.column_stack([n0, n0 + 1, n0 + n + 2, n0 + n + 1])
 
 
-def _plate_local_node_sets(n: int, quarter: bool) -> dict[str, np.ndarray]:
-    """Node sets of one ply's (n+1)² grid."""
-    j, i = np.divmod(np.arange((n + 1) ** 2, dtype=np.int64), n + 1)
+def _plate_local_node_sets(n: int, quarter: bool, ny: int | None = None
+                           ) -> dict[str, np.ndarray]:
+    """Node sets of one ply's (n+1)×(ny+1) grid (ny = n by default)."""
+    ny = n if ny is None else ny
+    j, i = np.divmod(np.arange((n + 1) * (ny + 1), dtype=np.int64), n + 1)
     where = np.flatnonzero
     if quarter:
         return {
-            "edge_outer": where((i == n) | (j == n)),
+            "edge_outer": where((i == n) | (j == ny)),
+            "edge_x": where(i == n),
+            "edge_y": where(j == ny),
             "symmetry_x": where(i == 0),
             "symmetry_y": where(j == 0),
             "centre": where((i == 0) & (j == 0)),
         }
     return {
-        "edge_outer": where((i == 0) | (i == n) | (j == 0) | (j == n)),
-        "centre": where((i == n // 2) & (j == n // 2)),
+        "edge_outer": where((i == 0) | (i == n) | (j == 0) | (j == ny)),
+        "edge_x": where((i == 0) | (i == n)),
+        "edge_y": where((j == 0) | (j == ny)),
+        "centre": where((i == n // 2) & (j == ny // 2)),
     }
 
 

@@ -33,7 +33,7 @@ import numpy as np
 from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as SL
-from wovenimpact.model.model import DOF_NAMES
+from wovenimpact.model.model import DOF_NAMES, flies_sideways, sideways_shadow
 
 MAX_WAVE_SPEED = 2.0e4  # m/s: above any engineering material's (diamond ~18 km/s)
 MAX_CROSSING = 0.5  # of the smallest element length moved in one step
@@ -274,12 +274,17 @@ def check_impactor(spec, model, state) -> None:
     tip = st[RB.B_X:RB.B_X + 3] - p[RB.BP_TIP] * axis
     direction = np.asarray(im.direction, dtype=float)
     direction = direction / np.linalg.norm(direction)
-    rel = model.x0 - tip
-    ahead = rel @ direction
-    radial = np.linalg.norm(rel - np.outer(ahead, direction), axis=1)
-    under = (radial <= im.radius) & (ahead > 0.0)
+    if flies_sideways(model, 0):  # ahead of its leading line, within its shadow
+        ahead, outside = sideways_shadow(model, st, 0, model.x0)
+        beside = outside <= 0.0
+    else:
+        rel = model.x0 - tip
+        ahead = rel @ direction
+        radial = np.linalg.norm(rel - np.outer(ahead, direction), axis=1)
+        beside = radial <= im.radius
+    under = beside & (ahead > 0.0)
     if not under.any():
-        behind = (radial <= im.radius) & (ahead <= 0.0)
+        behind = beside & (ahead <= 0.0)
         where = ("the structure is behind the nose (it moves away from it)" if behind.any()
                  else "no node lies within the impactor's radius of its line of flight")
         raise InputError(

@@ -266,10 +266,11 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
     model = compile_case(spec, Path(base)).model
     areal = float(model.sections[model.elem_section[0], C_AREAL_MASS])
     side = spec.mesh.side
+    width = side if spec.mesh.width is None else spec.mesh.width
     return {
         "plies_to_stop": plies,
         "areal_mass_kg_per_m2": plies * areal,
-        "pack_mass_kg": plies * areal * side * side,
+        "pack_mass_kg": plies * areal * side * width,
         "runs": {str(k): v for k, v in sorted(outcomes.items())},
         "reruns": reruns,
         "warning": monotonic_warning(plies, seen),

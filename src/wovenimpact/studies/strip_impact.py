@@ -11,11 +11,14 @@ Schiefer, Textile Research Journal 28, 1958) gives, with c0 = √(E/ρ):
     F = 2 E A ε sin θ,  tan θ = V / U            force on the projectile (two arms)
 
 The face covers x ∈ [−a, a]: the material under it moves with it and the kinks start
-at ±a. :func:`strip_impact` runs a quarter model (symmetry on x = 0 and y = 0, ends
+at ±a. With ``edge = True`` the body is a cylinder of radius a lying across the strip
+(its axis along the width, ``impactor.axis``) that strikes with its side, a round edge
+of diameter 2a: the strip wraps it over |x| ≤ a sin θ and leaves it tangentially at θ,
+so the force, the strain and the kink speed far from it are again Smith's. :func:`strip_impact` runs a quarter model (symmetry on x = 0 and y = 0, ends
 clamped beyond the reach of the longitudinal wave) and measures, after the first
-microsecond, the mean contact force, the kink speed (the point where the deflection is
-half the face's travel moves at U), the strain between face and kink, and how far the
-struck nodes stray from the face.
+microsecond (the force: after ``settle``, 1 µs by default), the mean contact force, the
+kink speed (the point where the deflection is half the face's travel moves at U), the
+strain between face and kink, and how far the struck nodes stray from the face.
 """
 
 from __future__ import annotations
@@ -70,6 +73,8 @@ class StripImpact:
     damping: float = 1.0
     membrane: str | None = None
     bending_ratio: float = 1e-4
+    edge: bool = False  # a cylinder's side (radius face_radius) across the strip
+    settle: float = 1e-6  # the means are taken from this long after the first contact
 
     def model(self):
         half_l, half_b = 0.5 * self.length, 0.5 * self.width
@@ -87,14 +92,28 @@ class StripImpact:
         bc.fix(np.flatnonzero(np.isclose(nodes[:, 0], half_l)))
         steel = MetalParameters(name="strip", kind="elastic", density=self.density,
                                 modulus=self.modulus, poisson=0.0)
-        face = Impactor("cylinder", self.face_radius, 4.0 * self.face_radius)
-        tip = (0.0, 0.0, 0.5 * self.thickness + 0.02e-3)
-        body = RigidBody(face, tip=tip, direction=(0.0, 0.0, -1.0), speed=self.speed,
-                         mass=self.mass, damping=self.damping, fraction=0.25, axial_only=True)
+        if self.edge:  # lying across the strip (axis y), centred on y = 0, longer than wide
+            length = self.width + 4.0 * self.face_radius
+            face = Impactor("cylinder", self.face_radius, length)
+            tip = (0.0, -0.5 * length, 0.5 * self.thickness + 0.02e-3 + self.face_radius)
+            body = RigidBody(face, tip=tip, direction=(0.0, 0.0, -1.0), speed=self.speed,
+                             mass=self.mass, damping=self.damping, fraction=0.25,
+                             axial_only=True, axis=(0.0, 1.0, 0.0))
+        else:
+            face = Impactor("cylinder", self.face_radius, 4.0 * self.face_radius)
+            tip = (0.0, 0.0, 0.5 * self.thickness + 0.02e-3)
+            body = RigidBody(face, tip=tip, direction=(0.0, 0.0, -1.0), speed=self.speed,
+                             mass=self.mass, damping=self.damping, fraction=0.25,
+                             axial_only=True)
         sec = Section(steel, thickness=self.thickness, membrane=self.membrane,
                       bending_modulus=self.bending_ratio * self.modulus)
         return build_model(nodes, quads, {"strip": sec}, np.zeros(len(quads), int), bcs=bc,
                            bodies=[body])
+
+
+def theory_sin_theta(p: StripImpact) -> float:
+    """sin θ of Smith's theory for the problem ``p``: where the strip leaves an edge."""
+    return smith_theory(p.modulus, p.density, p.speed)["sin_theta"]
 
 
 def half_deflection_point(x, w, half, start):
@@ -118,7 +137,10 @@ def strip_impact(problem: StripImpact | None = None) -> dict:
     x0 = model.x0
     axis_nodes = np.flatnonzero(x0[:, 1] == 0.0)
     axis_nodes = axis_nodes[np.argsort(x0[axis_nodes, 0])]
-    under = np.flatnonzero(x0[:, 0] <= p.face_radius - 1e-12)
+    # the nodes the face carries: under a flat face |x| < a; on an edge those the strip
+    # wraps it with, |x| < a sin θ
+    reach = p.face_radius * (theory_sin_theta(p) if p.edge else 1.0)
+    under = np.flatnonzero(x0[:, 0] <= reach - 1e-12)
     times, forces, kinks, stray = [], [], [], []
     t_contact = None
     while st.t < p.end_time:
@@ -131,25 +153,29 @@ def strip_impact(problem: StripImpact | None = None) -> dict:
         forces.append(row["contact_force_full_N"])
         w = -(st.x[axis_nodes, 2] - x0[axis_nodes, 2])
         x = st.x[axis_nodes, 0]  # laboratory positions: U is the kink's lab speed
-        kinks.append(half_deflection_point(x, w, 0.5 * travel, p.face_radius))
-        face_z = st.bodies[0, RB.B_X + 2] - model.body_params[0, RB.BP_TIP]
+        kinks.append(half_deflection_point(x, w, 0.5 * travel, reach))
+        if p.edge:  # the cylinder's surface below each node (its axis is its centre line)
+            face_z = st.bodies[0, RB.B_X + 2] - np.sqrt(np.maximum(
+                p.face_radius**2 - (st.x[under, 0] - st.bodies[0, RB.B_X]) ** 2, 0.0))
+        else:
+            face_z = st.bodies[0, RB.B_X + 2] - model.body_params[0, RB.BP_TIP]
         stray.append(float(np.max(np.abs(st.x[under, 2] - (face_z - 0.5 * p.thickness)))))
     t = np.array(times)
     f = np.array(forces)
     kink = np.array(kinks)
-    settle = (t_contact or 0.0) + 1e-6
+    settle = (t_contact or 0.0) + p.settle
     late = t >= settle
     f_theory = 2.0 * p.modulus * p.width * p.thickness * theory["strain"] * theory["sin_theta"]
     # kink speed: the half-deflection point sits at a + U t/2, so U is twice the slope
     # of a least-squares line through its positions after the first microsecond, once
     # it is four elements past the face's edge (before that the kink is not resolved)
-    ok = late & np.isfinite(kink)
-    ok &= kink > p.face_radius + 4.0 * p.element_size
+    ok = (t >= (t_contact or 0.0) + 1e-6) & np.isfinite(kink)
+    ok &= kink > reach + 4.0 * p.element_size
     slope = 2.0 * float(np.polyfit(t[ok], kink[ok], 1)[0]) if ok.sum() > 2 else math.nan
     # strain of the elements between the face and the kink at the end
     e_x = np.linalg.norm(st.elem[:, [0, 2]], axis=1) - 1.0  # |F e1| − 1 (corotational F)
     cx = st.x[model.quads].mean(axis=1)[:, 0]
-    between = (cx > p.face_radius + 2 * p.element_size) & (cx < kink[-1] - 2 * p.element_size)
+    between = (cx > reach + 2 * p.element_size) & (cx < kink[-1] - 2 * p.element_size)
     return {
         "theory": {**theory, "force_N": f_theory},
         "force_N": float(np.mean(f[late])),
@@ -162,6 +188,7 @@ def strip_impact(problem: StripImpact | None = None) -> dict:
         "max_stray_from_face_m": float(np.max(np.array(stray)[t >= (t_contact or 0.0)])),
         "thickness_m": p.thickness,
         "face_radius_m": p.face_radius,
+        "contact_half_width_m": reach,
         "first_contact_s": t_contact,
         "history": {"time_s": t, "contact_force_N": f, "kink_position_m": kink,
                     "stray_m": np.array(stray)},
@@ -196,7 +223,7 @@ def strip_impact_figure(result: dict, path: Path, title: str = "") -> Path:
     t0 = result["first_contact_s"] or 0.0
     a2.plot(t_us, h["kink_position_m"] * 1e3, lw=0.8, label="wovenimpact (half deflection)")
     tt = np.linspace(t0, h["time_s"][-1], 50)
-    a2.plot(tt * 1e6, (result["face_radius_m"] + 0.5 * th["kink_speed"] * (tt - t0)) * 1e3,
+    a2.plot(tt * 1e6, (result["contact_half_width_m"] + 0.5 * th["kink_speed"] * (tt - t0)) * 1e3,
             "k--", label="a + U t / 2 (theory)")
     a2.set_xlabel("time (µs)")
     a2.set_ylabel("position (mm)")

@@ -105,3 +105,58 @@ def test_compression_bad_file_exits_2_with_a_clean_message(tmp_path):
     assert "Traceback" not in r.output
     r = runner.invoke(app, ["calibrate", "compression", str(tmp_path / "none.csv")])
     assert r.exit_code == 2 and "cannot read the data file" in flat(r.output)
+
+
+# --- calibrate fracture ----------------------------------------------------------------
+MATERIALS = ROOT / "examples" / "materials"
+
+
+def test_fracture_writes_a_material_file_that_loads_with_the_fitted_table(tmp_path):
+    """The 2024-T3 file (which has a [material.regularisation] already: it is replaced,
+    not repeated) on 2 and 4 mm meshes, written about 2 mm: the file loads, carries the
+    table of the JSON answer (s = 1 at 2 mm, the 4 mm row below 1: that mesh fractures
+    later unregularised), the CSV shows the 4 mm mesh brought to the 2 mm elongation
+    (3.2 % apart before), and the figure exists."""
+    from wovenimpact.spec.material import load_material
+
+    src = MATERIALS / "al2024t3_johnson_cook.toml"
+    r = runner.invoke(app, ["calibrate", "fracture", str(src), "--out", str(tmp_path),
+                            "--sizes", "2 mm, 4 mm", "--json"])
+    assert r.exit_code == 0, r.output
+    out = json.loads(r.stdout)
+    mat = load_material(out["material_file"])
+    reg = mat.regularisation
+    assert reg.reference_length == pytest.approx(2e-3)
+    assert [list(row) for row in reg.fracture_scale] == out["fracture_scale"]
+    assert reg.fracture_scale[0] == (1.0, 1.0) and 0.9 < reg.fracture_scale[1][1] < 1.0
+    assert reg.failure_displacement == 0.0
+    assert mat.damage == load_material(src).damage  # the rest of the file as it was
+    # matched to the fit's tolerance: 1.5 × the end's travel in one 4 mm time step
+    tolerance = 1.5 * 10.0 * 0.9 * 4e-3 / mat.plane_stress_wave_speed
+    u_ref = out["reference_elongation_at_fracture_m"]
+    assert out["largest_error_before"] > 0.02
+    assert out["largest_error_after"] * u_ref <= tolerance
+    with open(out["csv_file"], newline="") as fh:
+        import csv
+
+        rows = list(csv.DictReader(fh))
+    assert [float(row["element_size_mm"]) for row in rows] == [2.0, 4.0]
+    assert abs(float(rows[1]["error_after"])) * u_ref <= tolerance
+    assert Path(out["figure_file"]).stat().st_size > 0
+
+
+def test_fracture_refuses_a_size_the_coupon_cannot_hold(tmp_path):
+    r = runner.invoke(app, ["calibrate", "fracture", str(MATERIALS / "aluminium.toml"),
+                            "--out", str(tmp_path), "--sizes", "3 mm, 4 mm"])
+    assert r.exit_code != 0
+    text = flat(r.output)
+    assert "--sizes" in text and "3 mm" in text and "does not divide" in text
+
+
+def test_fracture_refuses_a_material_without_fracture(tmp_path):
+    doc = (MATERIALS / "titanium.toml").read_text().replace("fracture_strain = 0.25", "")
+    path = tmp_path / "no_fracture.toml"
+    path.write_text(doc)
+    r = runner.invoke(app, ["calibrate", "fracture", str(path), "--out", str(tmp_path)])
+    assert r.exit_code != 0
+    assert "no fracture strain" in flat(r.output)

@@ -1,12 +1,16 @@
-"""``wovenimpact calibrate crimp|compression``: model parameters from measurements.
+"""``wovenimpact calibrate crimp|compression|fracture``: model parameters from measurements.
 
 - ``crimp``: crimp amplitude h0 from thread count and crimp (thesis eq. 5.2–5.5, Table 5-1).
 - ``compression``: a, b of the compaction law F = b·d/(a − d) from a force–compression
   curve (thesis eq. 5.8, §5.3.2, App. A), with a PNG of the fit.
+- ``fracture``: the element-size regularisation of a metal's fracture strain, fitted on
+  a simulated tension test at several meshes (docs/theory.md §7.3), written as the
+  material file's ``[material.regularisation]`` with a CSV and a figure.
 """
 
 from __future__ import annotations
 
+import json
 from pathlib import Path
 from typing import Annotated
 
@@ -124,3 +128,133 @@ def compression(
         as_json,
         "Compaction law F = b·d/(a − d), thesis eq. (5.8)",
     )
+
+
+@calibrate_app.command("fracture")
+def fracture(
+    material: Annotated[
+        Path, typer.Argument(help="A j2_plastic material file (fracture_strain or [material.damage]).")
+    ],
+    out: Annotated[
+        Path, typer.Option("--out", help="Directory for the regularised material file, CSV and figure.")
+    ],
+    sizes: Annotated[
+        str | None,
+        typer.Option(
+            "--sizes",
+            help=(
+                "Element sizes of the coupon meshes, comma-separated with units, e.g. "
+                "'0.5 mm, 1 mm, 2 mm'; the finest is the reference. Each must divide the "
+                "coupon's length (32 t) and width (8 t). Default: 0.25, 0.5, 1, 2, 4 × t."
+            ),
+        ),
+    ] = None,
+    thickness: Annotated[
+        str, typer.Option("--thickness", help="Coupon thickness t, e.g. '1 mm' (plan: 32 t × 8 t).")
+    ] = "1 mm",
+    reference_length: Annotated[
+        str | None,
+        typer.Option(
+            "--reference-length",
+            help=(
+                "reference_length written in the file, where s = 1 (e.g. the element size "
+                "the material's examples use); default: the finest size."
+            ),
+        ),
+    ] = None,
+    failure_displacement: Annotated[
+        str | None,
+        typer.Option(
+            "--failure-displacement",
+            help="Soften after onset over this plastic displacement (e.g. '0.05 mm') in every run; default: off.",
+        ),
+    ] = None,
+    speed: Annotated[
+        str, typer.Option("--speed", help="Speed of the pulled end, e.g. '10 m/s'.")
+    ] = "10 m/s",
+    threads: Annotated[
+        int, typer.Option("--threads", min=1, help="Kernel threads (a coupon is small: 1 is fastest).")
+    ] = 1,
+    as_json: Annotated[
+        bool, typer.Option("--json", help="Print one JSON object (SI units).")
+    ] = False,
+) -> None:
+    """Fit the element-size regularisation of a metal's fracture strain (docs/theory.md
+    §7.3) on a simulated quasi-static tension test of a flat coupon at several meshes:
+    each mesh's scale s makes it fracture at the finest mesh's elongation. Writes
+    MATERIAL_regularised.toml (the file with the fitted [material.regularisation]),
+    MATERIAL_fracture.csv and MATERIAL_fracture.png into --out."""
+    from wovenimpact.calibration.fracture_regularisation import (
+        DEFAULT_SIZES,
+        Coupon,
+        calibrate,
+        calibration_rows,
+        shipped_table,
+        write_calibration,
+    )
+    from wovenimpact.io.outdir import prepare_output_dir, write_failure
+    from wovenimpact.jit import capped_threads, set_threads
+    from wovenimpact.materials.metal import MetalParameters
+    from wovenimpact.spec.material import load_material
+    from wovenimpact.units import to_si
+
+    try:
+        t = to_si(thickness, "length", "--thickness", gt=0.0, example="1 mm")
+        v = to_si(speed, "velocity", "--speed", gt=0.0, example="10 m/s")
+        if sizes is None:
+            hs = [k * t for k in DEFAULT_SIZES]
+        else:
+            hs = [to_si(s.strip(), "length", "--sizes", gt=0.0, example="0.5 mm")
+                  for s in sizes.split(",") if s.strip()]
+        l_ref = (None if reference_length is None else
+                 to_si(reference_length, "length", "--reference-length", gt=0.0))
+        u_f = (0.0 if failure_displacement is None else
+               to_si(failure_displacement, "length", "--failure-displacement", gt=0.0))
+        mat = load_material(material)
+        if not isinstance(mat, MetalParameters) or mat.kind != "j2_plastic":
+            raise InputError(f"{material}: a fracture calibration needs a j2_plastic material")
+        if mat.fracture_strain is None and mat.damage is None:
+            raise InputError(f"{material}: the material has no fracture strain and no "
+                             "[material.damage] table: there is no fracture to regularise")
+        coupon = Coupon(mat, thickness=t, speed=v)
+        if len(hs) < 2 or len(set(hs)) != len(hs):
+            raise InputError(f"--sizes: give at least two different element sizes (got "
+                             f"{', '.join(f'{h * 1e3:g} mm' for h in hs)})")
+        for h in hs:
+            try:
+                coupon.check_size(h)
+            except InputError as err:
+                raise InputError(f"--sizes: {err}") from None
+        prepare_output_dir(out)
+    except InputError as err:
+        _fail_input(err)
+    import numba
+
+    before = numba.get_num_threads()
+    set_threads(capped_threads(threads, "--threads"))
+    say = None if as_json else (lambda msg: typer.echo(msg, err=True))
+    try:
+        cal = calibrate(coupon, hs, failure_displacement=u_f, progress=say)
+    finally:
+        set_threads(before)  # a program calling the command keeps its own setting
+    try:
+        paths = write_calibration(cal, material, out, l_ref)
+    except OSError as err:
+        _fail_input(InputError(write_failure(err, "the calibration")))
+    l_ship = cal.reference_size if l_ref is None else l_ref
+    rows = calibration_rows(cal)
+    result = {
+        "reference_size_m": cal.reference_size,
+        "reference_elongation_at_fracture_m": cal.reference.elongation_at_fracture,
+        "reference_length_m": l_ship,
+        "fracture_scale": [list(r) for r in shipped_table(cal, l_ship)],
+        "largest_error_before": max(abs(r["error_before"]) for r in rows),
+        "largest_error_after": max(abs(r["error_after"]) for r in rows),
+        "wall_s": cal.wall_s,
+        **{f"{k}_file": str(p) for k, p in paths.items()},
+    }
+    if as_json:
+        typer.echo(json.dumps(result))
+        return
+    emit({k: (str(v) if isinstance(v, list) else v) for k, v in result.items()}, False,
+         "Fracture regularisation, docs/theory.md §7.3")

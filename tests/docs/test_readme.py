@@ -159,7 +159,8 @@ def check_options_exist(args: list[str], where: str) -> None:
     """A command not run: its sub-command exists and lists every option used."""
     words = [a for a in args if not a.startswith("-")]
     sub = [w for w in words[:2] if w in ("design", "plies", "sweep", "run", "ballistics",
-                                         "calibrate", "element-test", "validate", "bench")]
+                                         "calibrate", "crimp", "compression", "fracture",
+                                         "element-test", "validate", "bench")]
     result = CliRunner().invoke(app, [*sub, "--help"], terminal_width=200)
     assert result.exit_code == 0, f"{where}: {result.output}"
     for a in args:

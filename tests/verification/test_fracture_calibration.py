@@ -75,3 +75,20 @@ def test_a_perfectly_plastic_coupon_necks_and_the_fit_matches_its_elongation():
     assert abs(coarse.after.elongation_at_fracture
                - ref.before.elongation_at_fracture) <= tolerance
     assert cal.rows == ((1.0, 1.0), (2.0, coarse.scale))
+
+
+def test_the_commented_aluminium_table_loads_once_uncommented(tmp_path):
+    """aluminium.toml ships its fitted table commented (docs/theory.md §7.3, "Shipped"):
+    uncommented it is a valid [material.regularisation], s = 1 at its 0.5 mm reference
+    and falling with the element (a coarser mesh fractured later)."""
+    text = (MATERIALS / "aluminium.toml").read_text(encoding="utf-8")
+    i = text.index("# [material.regularisation]")
+    block = "\n".join(ln[2:] if ln.startswith("# ") else ln for ln in text[i:].splitlines())
+    path = tmp_path / "aluminium_regularised.toml"
+    path.write_text(text[:i] + block + "\n", encoding="utf-8")
+    reg = load_material(path).regularisation
+    assert reg.reference_length == pytest.approx(0.5e-3)
+    assert (1.0, 1.0) in reg.fracture_scale
+    scales = [s for _, s in reg.fracture_scale]
+    assert all(b < a for a, b in zip(scales, scales[1:]))
+    assert load_material(MATERIALS / "aluminium.toml").regularisation is None

@@ -133,10 +133,12 @@ def compression(
 @calibrate_app.command("fracture")
 def fracture(
     material: Annotated[
-        Path, typer.Argument(help="A j2_plastic material file (fracture_strain or [material.damage]).")
+        Path,
+        typer.Argument(help="A j2_plastic material file (fracture_strain or [material.damage])."),
     ],
     out: Annotated[
-        Path, typer.Option("--out", help="Directory for the regularised material file, CSV and figure.")
+        Path,
+        typer.Option("--out", help="Directory for the regularised material file, CSV and figure."),
     ],
     sizes: Annotated[
         str | None,
@@ -150,7 +152,8 @@ def fracture(
         ),
     ] = None,
     thickness: Annotated[
-        str, typer.Option("--thickness", help="Coupon thickness t, e.g. '1 mm' (plan: 32 t × 8 t).")
+        str,
+        typer.Option("--thickness", help="Coupon thickness t, e.g. '1 mm' (plan: 32 t × 8 t)."),
     ] = "1 mm",
     reference_length: Annotated[
         str | None,
@@ -166,14 +169,18 @@ def fracture(
         str | None,
         typer.Option(
             "--failure-displacement",
-            help="Soften after onset over this plastic displacement (e.g. '0.05 mm') in every run; default: off.",
+            help=(
+                "Soften after onset over this plastic displacement (e.g. '0.05 mm') in "
+                "every run; default: off."
+            ),
         ),
     ] = None,
     speed: Annotated[
         str, typer.Option("--speed", help="Speed of the pulled end, e.g. '10 m/s'.")
     ] = "10 m/s",
     threads: Annotated[
-        int, typer.Option("--threads", min=1, help="Kernel threads (a coupon is small: 1 is fastest).")
+        int,
+        typer.Option("--threads", min=1, help="Kernel threads (a coupon is small: 1 is fastest)."),
     ] = 1,
     as_json: Annotated[
         bool, typer.Option("--json", help="Print one JSON object (SI units).")

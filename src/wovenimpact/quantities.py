@@ -211,7 +211,19 @@ def ply_energies(model, state) -> list[float]:
     the stored energy of its elements (for eroded elements, the energy at erosion).
     Energy dissipated by yarns that broke in elements that did not erode is not in it."""
     factor = symmetry_factor(model)
-    return [factor * held_energy(model, state, np.flatnonzero(model.ply == p))
+    return [float(factor * held_energy(model, state, np.flatnonzero(model.ply == p)))
+            for p in np.unique(model.ply)]
+
+
+def ply_contact_work(model, state) -> list[float]:
+    """Energy each ply took through contact (full-problem values, J): the work the
+    contact forces — the impactor's and the neighbouring plies' — did on its nodes
+    (``State.contact_work``), as containment.layer_absorbed_energies for a casing. Unlike
+    :func:`ply_energies` it counts what the ply dissipated (a metal's plastic work, the
+    work of yarns that broke) and what its eroded pieces carried away; a ply that passes
+    energy on to the next through contact counts only what it kept."""
+    factor = symmetry_factor(model)
+    return [float(factor * np.sum(state.contact_work[np.unique(model.quads[model.ply == p])]))
             for p in np.unique(model.ply)]
 
 

@@ -56,6 +56,7 @@ from wovenimpact.mesh_verdict import mesh_verdict
 from wovenimpact.quantities import (
     impactor_row,
     intact_material_ahead,
+    ply_contact_work,
     ply_deflections,
     ply_energies,
     residual_velocity,
@@ -482,6 +483,7 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
             "initial_velocity_m_per_s": float(h["impactor_velocity_m_per_s"][0]),
             "absorbed_energy_J": ke_body0 - ke1,
             "absorbed_energy_per_ply_J": per_ply,
+            "contact_work_per_ply_J": ply_contact_work(model, state),
             "max_deflection_m": max(ply_deflections(model, state)),
             "max_deflection_per_ply_m": ply_deflections(model, state),
             "peak_contact_force_N": float(np.max(h["contact_force_full_N"])),
@@ -565,7 +567,8 @@ def mass_scaling_summary(model, state: State, factor: float) -> dict:
 
 IMPACT_SUMMARY_KEYS = ("outcome", "perforated", "residual_velocity_m_per_s",
                        "rebound_velocity_m_per_s", "initial_velocity_m_per_s",
-                       "absorbed_energy_J", "absorbed_energy_per_ply_J", "max_deflection_m",
+                       "absorbed_energy_J", "absorbed_energy_per_ply_J",
+                       "contact_work_per_ply_J", "max_deflection_m",
                        "max_deflection_per_ply_m", "peak_contact_force_N")
 CONTAINMENT_SUMMARY_KEYS = ("outcome", "contained", "fragment_exit_speed_m_per_s",
                             "fragment_speed_at_end_m_per_s", "fragment_exit_speed_settled", "fragment_mass_kg", "fragment_initial_speed_m_per_s", "max_bulge_m",

@@ -297,3 +297,23 @@ def test_an_interrupted_variant_resumes_from_its_checkpoint(tmp_path: Path):
         assert run_study(study, tmp_path / "cut", workers=1)[0]["status"] == "done"
     again = summary(tmp_path / "cut")
     assert again["restarted_from_step"] is None and again["steps"] == whole["steps"]
+
+
+def test_a_metric_with_a_value_per_ply_is_plotted_one_line_per_ply(tmp_path: Path):
+    """absorbed_energy_per_ply_J (a list per run) gets a figure with one line per ply
+    beside the scalar metrics' (it stopped the sweep with a TypeError after results.csv)."""
+    from wovenimpact.studies.plots import study_plots
+    from wovenimpact.studies.sweep import StudyInfo, Variant
+
+    info = StudyInfo(name="s", case="c.toml", metrics=["absorbed_energy_J",
+                                                          "absorbed_energy_per_ply_J"])
+    variants = [Variant(id=f"v{k}", values={"mesh.element_size": h}, document={})
+                for k, h in enumerate(("1 mm", "2 mm"))]
+    rows = [{"mesh.element_size": "1 mm", "absorbed_energy_J": 3.0,
+             "absorbed_energy_per_ply_J": [1.0, 2.0]},
+            {"mesh.element_size": "2 mm", "absorbed_energy_J": 4.0,
+             "absorbed_energy_per_ply_J": [1.5, 2.5]}]
+    written = study_plots(info, variants, rows, tmp_path)
+    names = {p.name for p in written}
+    assert {"absorbed_energy_J.png", "absorbed_energy_per_ply_J.png"} <= names
+    assert all(p.stat().st_size > 0 for p in written)

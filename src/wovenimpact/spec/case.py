@@ -470,22 +470,6 @@ class ImpactorSpec(BaseModel):
             raise ValueError("a cylinder needs length (with unit)")
         return self
 
-    @model_validator(mode="after")
-    def _axis_across_the_travel(self):
-        if self.axis is None:
-            return self
-        a, d = self.axis, self.direction
-        cos = sum(x * y for x, y in zip(a, d)) / (math.hypot(*a) * math.hypot(*d))
-        if abs(cos) > SIDEWAYS_COS:
-            raise ValueError(
-                f"axis = {list(self.axis)} is not perpendicular to direction = "
-                f"{list(self.direction)} (the angle between them is "
-                f"{math.degrees(math.acos(max(-1.0, min(1.0, cos)))):.6g}°; valid: a "
-                "vector perpendicular to the direction, for a body flying sideways such as "
-                "a cylinder whose side strikes as an edge, or no axis: the body's axis "
-                "along its direction, nose first)")
-        return self
-
 
 class ContactSpec(BaseModel):
     """``[contact]``: shell–shell contact (plies on plies, layers on layers; theory §6.3).
@@ -592,6 +576,18 @@ def check_references(spec: CaseSpec) -> list[Problem]:
                                 list(spec.mesh.axis), "[0, 0, 1]: the blade turns and the "
                                 "casing's radii are measured about the z axis through the "
                                 "origin; place the model so"))
+    im = spec.impactor
+    if im is not None and im.axis is not None:
+        a, d = im.axis, im.direction
+        cos = sum(x * y for x, y in zip(a, d)) / (math.hypot(*a) * math.hypot(*d))
+        if abs(cos) > SIDEWAYS_COS:
+            angle = math.degrees(math.acos(max(-1.0, min(1.0, cos))))
+            problems.append(Problem(
+                "impactor.axis", f"is not perpendicular to impactor.direction = "
+                f"{list(d)} (the angle between them is {angle:.6g}°)", list(a),
+                "a vector perpendicular to the direction, for a body flying sideways such "
+                "as a cylinder whose side strikes as an edge; or no axis: the body's axis "
+                "along its direction, nose first"))
     plate = isinstance(spec.mesh, PlateMeshSpec)
     if plate and spec.mesh.ply_sections is not None and (
             len(spec.mesh.ply_sections) != spec.mesh.plies):
@@ -622,8 +618,8 @@ def check_mesh_size(m) -> list[Problem]:
             if per_half < 2:
                 where = ("the quarter plate's edge" if m.quarter
                          else "each half of the plate's side")
-                if m.width is not None:
-                    where += f" (mesh.{name})"
+                if m.width is not None:  # a rectangle: which of its lengths
+                    where = f"half of mesh.{name}"
                 return [Problem("mesh.element_size", f"gives {per_half} element(s) along "
                                 f"{where} ({edge:g} m)", m.element_size,
                                 f"element_size ≤ {edge / 1.5:.4g} m (2 elements or more)")]

@@ -32,7 +32,13 @@ def study_plots(info, variants, rows, out: Path) -> list[Path]:
         if not vals:
             continue
         fig, ax = plt.subplots(figsize=(7, 4))
-        ax.plot(range(len(vals)), [float(v) for _, v in vals], "o-")
+        if isinstance(vals[0][1], (list, tuple)):  # one value per ply or layer: a line each
+            for k in range(max(len(v) for _, v in vals)):
+                ax.plot(range(len(vals)), [float(v[k]) if k < len(v) else float("nan")
+                                           for _, v in vals], "o-", label=f"[{k}]")
+            ax.legend(fontsize=7)
+        else:
+            ax.plot(range(len(vals)), [float(v) for _, v in vals], "o-")
         ax.set_xticks(range(len(vals)), [lab for lab, _ in vals], rotation=30, ha="right",
                       fontsize=7)
         ax.set_ylabel(metric)

@@ -24,6 +24,8 @@ from wovenimpact.io.atomic import atomic_write_text
 from wovenimpact.io.report import write_index
 from wovenimpact.studies.ballistics import DECIDED
 from wovenimpact.studies.metal_validation import metal_section
+from wovenimpact.studies.strip_validation import STUDY as STRIP_STUDY
+from wovenimpact.studies.strip_validation import strip_section
 from wovenimpact.spec.fields import read_toml, set_dotted
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -32,7 +34,7 @@ THESIS_RESIDUAL = {"plies1_100": "82–85", "plies2_100": "58", "plies4_100": "1
                    "plies6_100": "0 (stopped)", "plies4_120": "— (ELVS data, not in text)"}
 STUDIES = ("thesis_velocity", "thesis_plies", "thesis_plate_size", "thesis_crimp",
            "thesis_compaction", "thesis_element_size", "thesis_velocity_v50",
-           "thesis_velocity_v50_2plies", "hourglass", "design_175")
+           "thesis_velocity_v50_2plies", "hourglass", "design_175", STRIP_STUDY)
 # the design search of the README: fewest plies that stop the FSP at 175 m/s, by runs
 DESIGN = {"design_175": ("plies1_100", ("impactor.velocity=175 m/s",), 2)}
 THESIS_STUDY_NOTE = {
@@ -389,6 +391,9 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
         if study in DESIGN:
             log(f"design search {study} → {work / study}")
             lines += design_lines(study, work, workers, log)
+            continue
+        if study == STRIP_STUDY:  # issue 36, V1: its own section (two variants, acceptance)
+            lines += strip_section(work, figures, workers=workers, log=log)
             continue
         path = ROOT / "examples" / "studies" / f"{study}.toml"
         if not path.exists():

@@ -1,0 +1,45 @@
+"""The blade-edge strip section of docs/validation.md (studies/strip_validation.py): its
+table, its spread and the acceptance verdict, on rows of the study's results."""
+
+from __future__ import annotations
+
+import pytest
+
+from wovenimpact.studies.strip_validation import spread, table_lines, verdict_line
+from wovenimpact.studies.sweep import load_study
+from wovenimpact.studies.strip_validation import ROOT, STUDY
+
+
+def rows(energies: dict) -> list[dict]:
+    return [{"mesh.element_size": h, "status": "done", "outcome": "perforated",
+             "residual_velocity_m_per_s": 145.0, "absorbed_energy_J": e,
+             "contact_work_per_ply_J": [1.0, 2.0, 3.0, 4.0, 5.0],
+             "eroded_kinetic_energy_J": 1.0, "energy_error_fraction": 1e-4,
+             "hourglass_fraction": 0.01, "added_mass_fraction": 0.001, "wall_time_s": 3.0}
+            for h, e in energies.items()]
+
+
+def test_the_spread_is_over_2_to_7_mm_and_the_verdict_follows_it():
+    """(max − min)/min over 2, 3, 5, 7 mm, the 0.94 mm reference left out: 100 → 109 J is
+    9 %, met; 100 → 120 J is 20 %, not met; a missing run gives no verdict."""
+    ok = rows({"0.94 mm": 50.0, "2 mm": 100.0, "3 mm": 109.0, "5 mm": 104.0, "7 mm": 101.0})
+    assert spread(ok) == pytest.approx(0.09)
+    assert "is 9% of the smallest — met" in verdict_line(ok)
+    bad = rows({"0.94 mm": 50.0, "2 mm": 100.0, "3 mm": 110.0, "5 mm": 115.0, "7 mm": 120.0})
+    assert spread(bad) == pytest.approx(0.20) and "not met" in verdict_line(bad)
+    short = rows({"0.94 mm": 50.0, "2 mm": 100.0, "3 mm": 110.0, "7 mm": 120.0})
+    assert spread(short) is None and "not all runs finished" in verdict_line(short)
+
+
+def test_the_table_has_a_row_per_mesh_with_the_ratio_to_the_reference():
+    lines = table_lines(rows({"0.94 mm": 50.0, "2 mm": 100.0}))
+    assert len(lines) == 4 and lines[0].count("|") == lines[2].count("|") == 12
+    assert "| 2.00 |" in lines[3] and "1.0 / 2.0 / 3.0 / 4.0 / 5.0" in lines[3]
+
+
+def test_the_study_sweeps_the_five_meshes_of_issue_36_on_the_strip_example():
+    info, variants, base = load_study(ROOT / "examples" / "studies" / f"{STUDY}.toml")
+    assert [v.values["mesh.element_size"] for v in variants] == [
+        "0.94 mm", "2 mm", "3 mm", "5 mm", "7 mm"]
+    assert (base / info.case).resolve() == (ROOT / "examples" / "strip" /
+                                            "blade_edge_strip.toml").resolve()

@@ -58,7 +58,11 @@ P_ERODE_OPENING = 44  # δ_e, a broken family erodes once opened by this (m): λ
 P_REG_ROWS = 45  # rows of the strength-scale table (0: no scaling, s = 1)
 P_REG_TABLE = 46  # row k: h_i/h_ref,i at P_REG_TABLE + 2k, scale s of T_u at + 2k + 1
 REG_ROWS_MAX = 16
-N_PARAM = P_REG_TABLE + 2 * REG_ROWS_MAX
+# the smallest T_u scale s_i of the model's points of this material, per family (1 without a
+# table): the vector element stage flags a point at s_floor T_u for the exact path, which
+# applies the point's own s_i T_u (shell_blocks.crossover_points). Set by build_model.
+P_TU_FLOOR = P_REG_TABLE + 2 * REG_ROWS_MAX
+N_PARAM = P_TU_FLOOR + 2
 
 CROSSOVER_EXACT = 0
 CROSSOVER_TABLE = 1

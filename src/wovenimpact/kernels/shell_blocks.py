@@ -130,11 +130,9 @@ V_KAPPA, V_M, V_Q, V_HG, V_U_BEND, V_U_HG = 0, 3, 6, 8, 13, 14
 N_OLD = 15
 N_OUT_EL = N_ELEM_STATE + 1  # the element state's columns, then the isotropic step
 N_BLK = 24  # corner I's force and moment (global) at 6 I + 0…5
-# per point: F seen by the material (4), then λ_w, λ_f, then the point's T_u scales s_w, s_f
-# (fabric_layout.S_TU_SCALE, copied at the gather)
-N_KIN = 8
+# per point: F seen by the material (4), then λ_w, λ_f
+N_KIN = 6
 Q_LAM = 4
-Q_TU_SCALE = 6
 N_COEF = 48  # per point: 4 corners × (W, H_w, H_f) × (f, f_x, f_y, f_xy), hermite_terms order
 N_GEO = 4  # per point: the cell's λ_w0, h_w, λ_f0, h_f
 # per point, crossover_point's results
@@ -358,13 +356,12 @@ def crossover_points(tid, kin, coef, geo, res, mc):
         # fabric.tabulated_crossover
         ell_w, ell_f, h_w, h_f, l_w, l_f, t_w, t_f = table_tensions(
             lam_w, lam_f, ell0_w, ell0_f, hw_tab, hf_tab, gw_tab, gf_tab)
-        # 3. failure (fabric.yarn_damage: instant at the point's s T_u, progressive from
-        # ε_u = s T_u/EA) and the intact sliver test (fabric.sliver_erodes): the scalar
-        # kernel's
-        tu_pw = kin[tid, atq(Q_TU_SCALE, q)] * tu_w
-        tu_pf = kin[tid, atq(Q_TU_SCALE + 1, q)] * tu_f
-        bad = bad | (t_w >= tu_pw) | (t_f >= tu_pf) | (t_w / ea_w >= tu_pw / ea_w) | (
-            t_f / ea_f >= tu_pf / ea_f) | ((intact > 0.0) & (lam_w * lam_f < intact))
+        # 3. failure (fabric.yarn_damage: instant at T_u, progressive from ε_u = T_u/EA)
+        # and the intact sliver test (fabric.sliver_erodes): the scalar kernel's. T_u here is
+        # the smallest regularised strength of the material's points (P_TU_FLOOR): a point
+        # at or above it goes to fabric_point, which applies its own s T_u
+        bad = bad | (t_w >= tu_w) | (t_f >= tu_f) | (t_w / ea_w >= tu_w / ea_w) | (
+            t_f / ea_f >= tu_f / ea_f) | ((intact > 0.0) & (lam_w * lam_f < intact))
         # 4a. fabric.yarn_resultant, the table's virial branch
         c_w, c_f, yarn_w, yarn_f, den_w, den_f = table_virial(
             gw_tab, gf_tab, lam_w, lam_f, sin_t, ell_w, ell_f, ea_w, ea_f, lt0_w, lt0_f)
@@ -429,7 +426,8 @@ def material_lanes(p, m):
     """The crossover constants :func:`crossover_points` reads, as one tuple."""
     return (p[m, FL.P_THICK], p[m, FL.P_ELL0], p[m, FL.P_ELL0 + 1], p[m, FL.P_LT0],
             p[m, FL.P_LT0 + 1], p[m, FL.P_E] * p[m, FL.P_AREA],
-            p[m, FL.P_E + 1] * p[m, FL.P_AREA + 1], p[m, FL.P_TU], p[m, FL.P_TU + 1],
+            p[m, FL.P_E + 1] * p[m, FL.P_AREA + 1], p[m, FL.P_TU] * p[m, FL.P_TU_FLOOR],
+            p[m, FL.P_TU + 1] * p[m, FL.P_TU_FLOOR + 1],
             p[m, FL.P_G1], p[m, FL.P_G2], p[m, FL.P_GAMMA1], p[m, FL.P_GAMMA2],
             p[m, FL.P_ERODE_INTACT])
 
@@ -801,9 +799,6 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
                     exact[tid, _U(g * LANES) + lu] = (
                         (0.0 if rows_in[r, FL.S_DAMAGE] == 0.0 else 1.0)
                         + (0.0 if rows_in[r, FL.S_DAMAGE + 1] == 0.0 else 1.0))
-                    kin[tid, atq(Q_TU_SCALE, _U(g * LANES) + lu)] = rows_in[r, FL.S_TU_SCALE]
-                    kin[tid, atq(Q_TU_SCALE + 1, _U(g * LANES) + lu)] = rows_in[
-                        r, FL.S_TU_SCALE + 1]
             flag[tid, lu] = worn
         # 2.–5.
         mu = sections[sec, C_AREAL_MASS]

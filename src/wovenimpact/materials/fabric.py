@@ -241,6 +241,7 @@ class FabricParameters:
             raise ValueError(f"strength_scale has {len(r.strength_scale)} rows; at most "
                              f"{L.REG_ROWS_MAX}")
         p[L.P_REG_ROWS] = len(r.strength_scale)
+        p[L.P_TU_FLOOR:L.P_TU_FLOOR + 2] = 1.0  # a model lowers it to its points' smallest s
         for k, (x, sc) in enumerate(r.strength_scale):
             p[L.P_REG_TABLE + 2 * k] = x
             p[L.P_REG_TABLE + 2 * k + 1] = sc

@@ -19,6 +19,7 @@ import numpy as np
 from wovenimpact.errors import InputError
 from wovenimpact.impactor import BODY_PENALTY_SCALE, SIDEWAYS_COS, Impactor
 from wovenimpact.kernels.integrate import FIXED, PRESCRIBED, ROTATING
+from wovenimpact.kernels import fabric_layout as FP
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.materials.fabric import FabricParameters
@@ -818,6 +819,11 @@ def build_model(
     elem_mat = sec_table[es, SL.C_MAT].astype(np.int64)
     elem_length = characteristic_lengths(x0, q, warp_direction, np.array(kinds)[elem_mat])
     elem_failure = failure_columns(kinds, params, elem_mat, elem_length)
+    for m, kind in enumerate(kinds):  # the vector stage's failure threshold (P_TU_FLOOR)
+        sel = elem_mat == m
+        if kind == SL.MAT_FABRIC and sel.any():
+            mat_params[m, FP.P_TU_FLOOR:FP.P_TU_FLOOR + 2] = np.minimum(
+                1.0, elem_failure[sel, 0:2].min(axis=0))
     # lumped masses: a quarter of each element's mass to each corner, and the rotary
     # inertia the element lumps on each corner (rotary_inertia: rotations never govern
     # the stable step at the reference geometry; theory §4, "Stable step")

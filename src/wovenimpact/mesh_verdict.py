@@ -65,6 +65,7 @@ def mesh_verdict(model, state) -> dict:
     if model.elem_length.shape[0] != model.n_elems:
         return out
     eroded = state.elem[:, SL.E_ALIVE] == 0.0
+    eroded[model.release_elems] = False  # a blade's release row is let go, not failed
     for m in range(len(model.mat_kind)):
         if not fails(model, m):
             continue

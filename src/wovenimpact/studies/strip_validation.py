@@ -88,7 +88,8 @@ def verdict_line(rows: list[dict]) -> str:
 
 def strip_section(work: Path, figures: Path, workers: int = 1, log=_quiet) -> list[str]:
     """Run (or reuse) the study in ``work/studies/mesh_strip_edge`` (and ``…_keep``) and
-    return the section's lines; the study's figures are copied into ``figures``."""
+    return the section's lines; its figures (absorbed energy against the element size,
+    the edge's speed against time) are copied into ``figures``."""
     from wovenimpact.studies.sweep import run_study
 
     path = ROOT / "examples" / "studies" / f"{STUDY}.toml"
@@ -120,12 +121,10 @@ def strip_section(work: Path, figures: Path, workers: int = 1, log=_quiet) -> li
         log(f"study {name} → {out}")
         rows = run_study(path, out, workers=workers, overrides=overrides)
         lines += [f"### {label}", "", *table_lines(rows), "", verdict_line(rows), ""]
-        for png in sorted((out / "plots").glob("*.png")):
-            target = figures / f"{name}_{png.name}"
-            figures.mkdir(parents=True, exist_ok=True)
-            shutil.copy(png, target)
         for png, what in (("absorbed_energy_J.png", "absorbed energy"),
                           ("impactor_velocity_m_per_s_histories.png", "the edge's speed")):
             if (out / "plots" / png).exists():
+                figures.mkdir(parents=True, exist_ok=True)
+                shutil.copy(out / "plots" / png, figures / f"{name}_{png}")
                 lines += [f"![{name}: {what}](validation/{name}_{png})", ""]
     return lines

@@ -9,8 +9,8 @@ their height, for any number of plies), with Coulomb friction μ = 0.2.
 ``ShellContact.forces`` is timed twice: with a search at every call (skin 0: broad +
 narrow phase + assembly) and reusing its candidates (the default skin, positions fixed:
 narrow phase + assembly, what most steps cost); the broad phase with the skin alone is
-also reported, and 'book': the energy books of a step's pairs (``ShellContact.book``
-twice, as the solver calls it: the spring, dashpot and friction work per interface). The
+also reported, and 'book': the energy books of a step's pairs (``ShellContact.book``,
+as the solver calls it once a step: the spring, dashpot and friction work per interface). The
 cost per
 node must stay about constant as plies multiply (linear scaling).
 ``--threads=1,2`` chooses the thread counts, ``--plies=1,2,4,6`` the stacks,
@@ -86,9 +86,8 @@ def run_case(n_plies: int, threads: int, calls: int) -> dict:
     node_part, elem_part, _ = part_arrays(model)
     books = empty_books(model)[0]
 
-    def book():  # the two halves of a step (the second at other velocities: the same v)
-        contact.book(0.5 * dt, books, node_part, elem_part)
-        contact.book(0.5 * dt, books, node_part, elem_part, v=v)
+    def book():  # both halves of a step (the second at the velocities after it: here v)
+        contact.book(v, 0.5 * dt, books, 0.5 * dt, books, node_part, elem_part)
 
     booking = best_time(book, calls)
     broad = best_time(lambda: contact._search(x, contact.sigma), calls)

@@ -127,8 +127,8 @@ def contact_parts(sc, state) -> None:
     sc.n_active = int((sc.pair_on[:n] != 0).sum())  # the pairs the assembly listed
     books = np.zeros((3, int(sc.ply.max()) + 1, int(sc.ply.max()) + 1))
     node_part = np.maximum(sc.node_ply, 0)
-    t_book, _ = best_ms(lambda: (sc.book(0.5 * state.dt, books, node_part, sc.ply),
-                                 sc.book(0.5 * state.dt, books, node_part, sc.ply, v=state.v)))
+    t_book, _ = best_ms(lambda: sc.book(state.v, 0.5 * state.dt, books, 0.5 * state.dt, books,
+                                        node_part, sc.ply))
     print(f"  per step besides: masks {t_mask:.2f}, reuse test {t_valid:.2f}, segment "
           f"geometry {t_geo:.2f}, assembly {t_asm:.2f}, contact power {t_pow:.2f}, "
           f"energy books (both halves) {t_book:.2f} ms")

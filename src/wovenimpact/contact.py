@@ -38,7 +38,12 @@ from wovenimpact.kernels.contact_update import (
     surfaces_joined,
     widest_box,
 )
-from wovenimpact.kernels.contact_energy import N_KINDS, book_shell_powers, shell_pair_powers
+from wovenimpact.kernels.contact_energy import (
+    N_KINDS,
+    book_compact,
+    book_shell_pairs,
+    shell_pair_powers,
+)
 from wovenimpact.kernels.contact_narrow import (
     N_GEO,
     N_SEG_GEO,
@@ -62,6 +67,10 @@ AHEAD_STEPS = 4.0
 # the laws of the pair dashpot (theory §6): on the relative normal velocity whenever the
 # pair overlaps, or only while it closes
 DAMPING_MODES = ("always", "approach")
+# the energy books recompute the acting pairs' powers in parallel from this many pairs on,
+# below in one serial pass with the sum (a parallel launch, 10–50 µs on a loaded 2-core
+# machine, costs more than a few hundred pairs' work; the books are bitwise the same)
+PARALLEL_BOOK_PAIRS = 4096
 
 
 class SegmentBins:
@@ -306,6 +315,9 @@ class ShellContact:
         self.grow_count = 0
         self.n_pairs = 0
         self.n_active = 0  # pairs acting at the last forces() (rows of self.active)
+        # the energy books' compact tables of the acting pairs (book; grown on demand)
+        self.act_if = np.zeros(0, dtype=np.int64)
+        self.act_pw = np.zeros((0, 2 * N_KINDS))
         self.cell = 0.0
         if capacity is None:
             capacity = max(64, 8 * int(self.node_part.sum()))
@@ -513,21 +525,33 @@ class ShellContact:
         self.n_active = int(n_active)
         return float(energy), int(n_active)
 
-    def book(self, weight: float, books, node_part, seg_part, v=None) -> None:
-        """Add the work of the pairs of the last :meth:`forces` call to the energy books:
-        books[kind, a, b] −= weight · P_kind (kernels.contact_energy: kind SPRING,
-        DAMPING, FRICTION; a = node_part[node], b = seg_part[segment]), the powers at the
-        velocities the forces were computed with (written by the narrow phase), or with
-        ``v`` at those velocities. ``weight`` is ½ Δt of the solver's trapezoid rule:
-        called once without ``v`` and with the step before, once with the velocities
-        after the step and that step, the books hold what the solver's contact work
-        holds, split by part and by pair. (After a call with ``v`` the powers are those
-        at ``v``.)"""
-        if self.n_active == 0:
+    def book(self, v, w_before: float, books_before, w_after: float, books_after,
+             node_part, seg_part) -> None:
+        """Book the work of the pairs of the last :meth:`forces` call in the energy books
+        (kernels.contact_energy): books[kind, a, b] −= w · P_kind (kind SPRING, DAMPING,
+        FRICTION; a = node_part[node], b = seg_part[segment]), with the powers at the
+        velocities the forces were computed with (written by the narrow phase) into
+        ``books_before`` and with those at ``v`` into ``books_after``. With the weights ½ Δt
+        of the solver's trapezoid rule — the step before the forces and the step after,
+        ``v`` the velocities after it — the books hold what the solver's contact work
+        holds, split by part and by pair. Few pairs (below PARALLEL_BOOK_PAIRS) are booked
+        in one serial pass, more with the powers computed in parallel into compact
+        tables and summed serially: the same books, bitwise."""
+        n = self.n_active
+        if n == 0:
             return
-        if v is not None:
-            shell_pair_powers(v, self.quads, self.pair_seg, self.pair_w, self.geo,
-                              self.pair_f, self.pair_sd, self.active, self.n_active,
-                              self.friction > 0.0, self.power)
-        book_shell_powers(self.power, self.active, self.n_active, self.pair_seg, node_part,
-                          seg_part, float(weight), books)
+        if n < PARALLEL_BOOK_PAIRS:
+            book_shell_pairs(v, self.quads, self.pair_seg, self.pair_w, self.geo, self.pair_f,
+                             self.pair_sd, self.power, self.active, n, self.friction > 0.0,
+                             node_part, seg_part, float(w_before), books_before,
+                             float(w_after), books_after)
+            return
+        if self.act_if.shape[0] < n:  # the compact tables grow with the acting pairs
+            self.act_if = np.zeros(int(1.5 * n), dtype=np.int64)
+            self.act_pw = np.zeros((int(1.5 * n), 2 * N_KINDS))
+        n_parts = books_before.shape[1]
+        shell_pair_powers(v, self.quads, self.pair_seg, self.pair_w, self.geo, self.pair_f,
+                          self.pair_sd, self.power, self.active, n, self.friction > 0.0,
+                          node_part, seg_part, n_parts, self.act_if, self.act_pw)
+        book_compact(self.act_if, self.act_pw, n, n_parts, float(w_before), books_before,
+                     float(w_after), books_after)

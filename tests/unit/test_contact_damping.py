@@ -114,7 +114,8 @@ def driven_contact(mode: str, zeta=0.3, beta=0.01, ratio=0.1, cycles=16):
     δ = F/k) while the big one moves harmonically along the normal, z_s = a sin Ω t,
     Ω = ``ratio`` ω, the contact never opening (δ = 10 m a Ω²/k, the relative amplitude's
     tenfold). Books both halves of every step's forces as the solver does
-    (ShellContact.book: ½ Δt against v^{n−1/2}, ½ Δt against v^{n+1/2}). Returns the
+    (ShellContact.book after the update: ½ Δt against v^{n−1/2}, ½ Δt against
+    v^{n+1/2}). Returns the
     energy the dashpots took over the last half of the cycles (J, from the books), that
     of the analytic steady state over as many cycles, and the books' spring + damping +
     friction, the direct sum of the trapezoid work of the pair forces and the contact's
@@ -154,11 +155,11 @@ def driven_contact(mode: str, zeta=0.3, beta=0.01, ratio=0.1, cycles=16):
             half = books.copy()
         contact.forces(x, v, DT, alive, active, f)
         work += 0.5 * DT * float(np.sum((f_old + f) * v))
-        contact.book(0.5 * DT, books, node_part, seg_part)
         v[SMALL] += DT * (f[SMALL] - [0.0, 0.0, force]) / m
         v[BIG, 2] = (z_big(n + 1) - z_big(n)) / DT
         x += DT * v
-        contact.book(0.5 * DT, books, node_part, seg_part, v=v)  # f^n against v^{n+1/2}
+        # f^n against v^{n−1/2} (the powers the narrow phase wrote) and v^{n+1/2}
+        contact.book(v, 0.5 * DT, books, 0.5 * DT, books, node_part, seg_part)
         f_old[:] = f
         assert np.all(x[SMALL, 2] - x[BIG[0], 2] < T)  # never apart
     work += 0.5 * DT * float(np.sum(f_old * v))  # the last forces' second half
@@ -215,10 +216,9 @@ def test_friction_books_the_kinetic_energy_of_a_quad_sliding_to_rest(mode):
     alive, active = np.ones(2), np.ones(8, dtype=np.int8)
     for _ in range(3000):
         contact.forces(x, v, DT, alive, active, f)
-        contact.book(0.5 * DT, books, *parts)
         v[SMALL] += DT * (f[SMALL] - [0.0, 0.0, force]) / m
         x[SMALL] += DT * v[SMALL]
-        contact.book(0.5 * DT, books, *parts, v=v)
+        contact.book(v, 0.5 * DT, books, 0.5 * DT, books, *parts)
     assert np.all(np.abs(v[SMALL, 0]) < 1e-6 * v0)
     slid = x[SMALL[0], 0] - model.x0[SMALL[0], 0]
     assert slid == pytest.approx(v0**2 / (2 * decel), rel=0.01)
@@ -226,6 +226,39 @@ def test_friction_books_the_kinetic_energy_of_a_quad_sliding_to_rest(mode):
     assert books[FRICTION].sum() == pytest.approx(lost, rel=1e-6)
     assert books[FRICTION, 1, 0] == books[FRICTION].sum()  # nodes of ply 1 on ply 0
     assert abs(books[SPRING].sum()) + abs(books[DAMPING].sum()) < 1e-6 * lost
+
+
+def test_the_serial_and_parallel_books_agree_bitwise(monkeypatch):
+    """ShellContact.book recomputes the acting pairs' powers in one serial pass when they
+    are few and in parallel (then a serial sum) when they are many: the same powers
+    summed in the same order, so the books are bitwise equal, for any thread count
+    (three plies pressed together under a dome and sliding, friction on)."""
+    import wovenimpact.contact as contact_module
+    from wovenimpact.model.mesh import plate_mesh
+
+    mesh = plate_mesh(20e-3, 1e-3, plies=3, spacing=0.5e-3, quarter=True)
+    model = build_model(mesh.nodes, mesh.quads, {"s": Section(STEEL, thickness=0.4998e-3)},
+                        np.zeros(mesh.n_elems, int), ply=mesh.ply)
+    r = np.linalg.norm(mesh.nodes[:, :2], axis=1) / 10e-3
+    level = mesh.nodes[:, 2] / 0.5e-3
+    x = model.x0.copy()
+    x[:, 2] -= 0.1e-3 * np.clip(1.0 - r, 0.0, None) ** 2 * level
+    v = np.zeros_like(x)
+    v[:, 0], v[:, 2] = 5.0 * level / 2, -20.0 * level / 2
+    contact = ShellContact(model, friction=0.2)
+    f = np.zeros_like(x)
+    contact.forces(x, v, DT, np.ones(model.n_elems), np.ones(model.n_nodes, np.int8), f)
+    assert contact.n_active > 100
+    v_after = v + DT * f / model.node_mass[:, None]
+    node_part, elem_part = np.minimum(contact.node_ply, 2), model.ply
+    out = []
+    for limit in (10**9, 0):  # serial, then parallel
+        monkeypatch.setattr(contact_module, "PARALLEL_BOOK_PAIRS", limit)
+        books = np.zeros((N_KINDS, 3, 3))
+        contact.book(v_after, 0.5 * DT, books, 0.5 * DT, books, node_part, elem_part)
+        out.append(books)
+    assert np.any(out[0] != 0.0) and np.any(out[0][FRICTION] != 0.0)
+    assert out[0].tobytes() == out[1].tobytes()
 
 
 def test_damping_mode_is_checked():

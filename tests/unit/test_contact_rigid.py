@@ -61,7 +61,7 @@ def test_penalty_force_pushes_nodes_out_along_the_normal():
     rigid_contact_forces(x, np.zeros((3, 3)), np.ones(3, np.int8), np.ones(3),
                          np.full(3, 0.25e-3), 1.0, 0.0, 0.0, 1e-3, 1e30, tip, axis, zero, zero,
                          zero,
-                         prof[:, 0], prof[:, 1], 10e-3, force, energy, np.zeros((3, 8)),
+                         prof[:, 0], prof[:, 1], 10e-3, force, energy, np.zeros((3, 11)),
                          np.zeros(3, dtype=np.int64))
     gap = 0.25e-3 - 0.1e-3
     assert force[0] == pytest.approx([0.0, 0.0, 1e6 * gap])
@@ -91,7 +91,7 @@ def test_dashpot_and_friction_act_on_the_velocity_relative_to_the_body():
     energy = np.zeros(2)
     rigid_contact_forces(x, v, np.ones(2, np.int8), np.full(2, m), np.full(2, 0.25e-3), beta,
                          zeta, mu, dt, 2.0 * m, tip, axis, body_v, body_w, centre, prof[:, 0],
-                         prof[:, 1], 10e-3, force, energy, np.zeros((2, 8)),
+                         prof[:, 1], 10e-3, force, energy, np.zeros((2, 11)),
                          np.zeros(2, dtype=np.int64))
     k = beta * m / dt**2
     c = 2.0 * zeta * np.sqrt(beta) * (m / 2.0) / dt

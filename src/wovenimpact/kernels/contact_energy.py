@@ -21,11 +21,15 @@ friction's are what they dissipated; the spring's is its stored energy ½ k g² 
 the penalty's discretisation: k follows Δt, and the trapezoid does not integrate the
 onset and release of a pair exactly).
 
-Two kernels each for shells and bodies: the powers of the pairs of the last contact
-call at given velocities (parallel, each pair its own row; for the shells, at the
-velocities the forces were computed with, ``penalty_forces`` writes them itself, from
-the relative velocity it has) and their sum into the books (serial, in pair order:
-deterministic for any thread count). No allocation.
+Both halves are booked after the node update, in one call per step: the powers at the
+velocities the forces were computed with are written by the force kernels themselves
+(``penalty_forces``, ``rigid_contact_forces``: they have the relative velocity), those at
+the velocities after the update are computed here — for the shells in parallel when the
+pairs are many (each pair its own row of compact tables: the interface and both halves'
+powers), then summed into the books serially in pair order (deterministic for any
+thread count), or in one serial pass with the sums when they are few (a parallel launch
+costs more than their work; bitwise the same books);
+for a body, one serial pass over its nodes in contact. No allocation.
 """
 
 from __future__ import annotations
@@ -40,13 +44,17 @@ N_KINDS = 3
 
 
 @loop_kernel
-def shell_pair_powers(v, quads, pair_seg, pair_w, geo, pair_f, pair_sd, active, n_active,
-                      friction, power):
-    """power[k] = (P_spring, P_damping, P_friction) (W) of each active pair k (the
-    active[j] = (node, k) of ``assemble_contact_forces``) at velocities v, its force and
-    weights as ``penalty_forces`` left them (the same expressions as its own, at v^{n−1/2});
-    P_friction = 0 unless ``friction`` (μ > 0: otherwise f = (s + d) n and the difference
-    is round-off)."""
+def shell_pair_powers(v, quads, pair_seg, pair_w, geo, pair_f, pair_sd, pair_pw, active,
+                      n_active, friction, node_part, seg_part, n_parts, act_if, act_pw):
+    """For each active pair j (node active[j, 0], pair k = active[j, 1]: the list of
+    ``assemble_contact_forces``), in rows j of compact tables: act_if[j] = a · n_parts + b,
+    a the part of the node and b of the segment, and act_pw[j] = the powers (P_spring,
+    P_damping, P_friction) at the velocities of the forces (``pair_pw``, written by
+    ``penalty_forces``) and then at velocities v, from its force and weights as
+    ``penalty_forces`` left them (the same expressions as its own; P_friction = 0 unless
+    ``friction``: with μ = 0, f = (s + d) n and the difference is round-off). Parallel,
+    each pair its own row: the pairs' scattered rows are read here, and the serial sum
+    (:func:`book_compact`) reads the compact tables in order."""
     for j in prange(n_active):
         p = active[j, 0]
         k = active[j, 1]
@@ -58,54 +66,102 @@ def shell_pair_powers(v, quads, pair_seg, pair_w, geo, pair_f, pair_sd, active, 
         vz = v[p, 2] - (w0 * v[q0, 2] + w1 * v[q1, 2] + w2 * v[q2, 2] + w3 * v[q3, 2])
         vn = vx * geo[k, GEO_N] + vy * geo[k, GEO_N + 1] + vz * geo[k, GEO_N + 2]
         sp, dp = pair_sd[k, 0], pair_sd[k, 1]
-        power[k, SPRING] = sp * vn
-        power[k, DAMPING] = dp * vn
+        act_if[j] = node_part[p] * n_parts + seg_part[s]
+        act_pw[j, 0] = pair_pw[k, SPRING]
+        act_pw[j, 1] = pair_pw[k, DAMPING]
+        act_pw[j, 2] = pair_pw[k, FRICTION]
+        act_pw[j, 3 + SPRING] = sp * vn
+        act_pw[j, 3 + DAMPING] = dp * vn
         if friction:
-            power[k, FRICTION] = (pair_f[k, 0] * vx + pair_f[k, 1] * vy + pair_f[k, 2] * vz
-                                  - (sp + dp) * vn)
+            act_pw[j, 3 + FRICTION] = (pair_f[k, 0] * vx + pair_f[k, 1] * vy
+                                       + pair_f[k, 2] * vz - (sp + dp) * vn)
         else:
-            power[k, FRICTION] = 0.0
+            act_pw[j, 3 + FRICTION] = 0.0
 
 
 @kernel
-def book_shell_powers(power, active, n_active, pair_seg, node_part, seg_part, weight, books):
-    """books[kind, a, b] −= weight · power[k, kind] for the active pairs k in order, a the
-    part of the pair's node and b of its segment (serial: deterministic)."""
+def book_compact(act_if, act_pw, n_active, n_parts, w_before, books_before, w_after,
+                 books_after):
+    """books_before[kind, a, b] −= w_before · act_pw[j, kind] for the rows j in order,
+    then books_after[kind, a, b] −= w_after · act_pw[j, 3 + kind] (a, b from act_if[j] =
+    a · n_parts + b; :func:`shell_pair_powers`). Serial: deterministic."""
+    for j in range(n_active):
+        a = act_if[j] // n_parts
+        b = act_if[j] - a * n_parts
+        for kind in range(N_KINDS):
+            books_before[kind, a, b] -= w_before * act_pw[j, kind]
+    for j in range(n_active):
+        a = act_if[j] // n_parts
+        b = act_if[j] - a * n_parts
+        for kind in range(N_KINDS):
+            books_after[kind, a, b] -= w_after * act_pw[j, 3 + kind]
+
+
+@kernel
+def book_shell_pairs(v, quads, pair_seg, pair_w, geo, pair_f, pair_sd, pair_pw, active,
+                     n_active, friction, node_part, seg_part, w_before, books_before,
+                     w_after, books_after):
+    """Both halves of a step's shell pairs in one serial pass each, for a few pairs (a
+    parallel launch costs more than their work): the powers at the velocities of the
+    forces (``pair_pw``, written by ``penalty_forces``) times ``w_before`` into
+    ``books_before``, then those at v (:func:`shell_pair_powers`) times ``w_after`` into
+    ``books_after`` — the same sums in the same order as :func:`shell_pair_powers` with
+    :func:`book_compact`, so bitwise the books of that parallel route."""
     for j in range(n_active):
         k = active[j, 1]
         a = node_part[active[j, 0]]
         b = seg_part[pair_seg[k]]
         for kind in range(N_KINDS):
-            books[kind, a, b] -= weight * power[k, kind]
+            books_before[kind, a, b] -= w_before * pair_pw[k, kind]
+    for j in range(n_active):
+        p = active[j, 0]
+        k = active[j, 1]
+        s = pair_seg[k]
+        q0, q1, q2, q3 = quads[s, 0], quads[s, 1], quads[s, 2], quads[s, 3]
+        w0, w1, w2, w3 = pair_w[k, 0], pair_w[k, 1], pair_w[k, 2], pair_w[k, 3]
+        vx = v[p, 0] - (w0 * v[q0, 0] + w1 * v[q1, 0] + w2 * v[q2, 0] + w3 * v[q3, 0])
+        vy = v[p, 1] - (w0 * v[q0, 1] + w1 * v[q1, 1] + w2 * v[q2, 1] + w3 * v[q3, 1])
+        vz = v[p, 2] - (w0 * v[q0, 2] + w1 * v[q1, 2] + w2 * v[q2, 2] + w3 * v[q3, 2])
+        vn = vx * geo[k, GEO_N] + vy * geo[k, GEO_N + 1] + vz * geo[k, GEO_N + 2]
+        sp, dp = pair_sd[k, 0], pair_sd[k, 1]
+        pf = 0.0
+        if friction:
+            pf = (pair_f[k, 0] * vx + pair_f[k, 1] * vy + pair_f[k, 2] * vz - (sp + dp) * vn)
+        a = node_part[p]
+        b = seg_part[s]
+        books_after[SPRING, a, b] -= w_after * (sp * vn)
+        books_after[DAMPING, a, b] -= w_after * (dp * vn)
+        books_after[FRICTION, a, b] -= w_after * pf
 
 
-@loop_kernel
-def body_pair_powers(v, body_v, parts, contact_list, count, friction, power):
-    """power[j] = (P_spring, P_damping, P_friction) (W) of node i = contact_list[j]
-    against a body moving at body_v, its forces as ``rigid_contact_forces`` left them in
-    ``parts``. The relative velocity is v_i − V: the solver books the work of the force on
-    the body with its translation only (solver.contact_stage.advance_bodies)."""
-    for j in prange(count):
+@kernel
+def book_body_pairs(v, body_v, parts, contact_list, count, friction, node_part, body_part,
+                    w_before, books_before, w_after, books_after):
+    """Both halves of a step's pairs of the nodes i = contact_list[j] in contact with a
+    body (a the part of the node), their forces as ``rigid_contact_forces`` left them in
+    ``parts``: the powers it wrote at the velocities of the forces times ``w_before``
+    into ``books_before[kind, a, body_part]``, then those at v and the body's velocity
+    body_v times ``w_after`` into ``books_after``: P_spring = s v_n, P_damping = d v_n,
+    P_friction = f · v_r − (s + d) v_n (0 without friction), v_r = v_i − V — the solver
+    books the work of the force on the body with its translation only
+    (solver.contact_stage.advance_bodies). Serial, in node order: the nodes in contact
+    with a body are few."""
+    for j in range(count):
+        i = contact_list[j]
+        a = node_part[i]
+        for kind in range(N_KINDS):
+            books_before[kind, a, body_part] -= w_before * parts[i, 8 + kind]
+    for j in range(count):
         i = contact_list[j]
         vx = v[i, 0] - body_v[0]
         vy = v[i, 1] - body_v[1]
         vz = v[i, 2] - body_v[2]
         vn = vx * parts[i, 2] + vy * parts[i, 3] + vz * parts[i, 4]
         sp, dp = parts[i, 0], parts[i, 1]
-        power[j, SPRING] = sp * vn
-        power[j, DAMPING] = dp * vn
+        pf = 0.0
         if friction:
-            power[j, FRICTION] = (parts[i, 5] * vx + parts[i, 6] * vy + parts[i, 7] * vz
-                                  - (sp + dp) * vn)
-        else:
-            power[j, FRICTION] = 0.0
-
-
-@kernel
-def book_body_powers(power, contact_list, count, node_part, body_part, weight, books):
-    """books[kind, a, body_part] −= weight · power[j, kind], a the part of node
-    contact_list[j] (serial, in node order)."""
-    for j in range(count):
-        a = node_part[contact_list[j]]
-        for kind in range(N_KINDS):
-            books[kind, a, body_part] -= weight * power[j, kind]
+            pf = parts[i, 5] * vx + parts[i, 6] * vy + parts[i, 7] * vz - (sp + dp) * vn
+        a = node_part[i]
+        books_after[SPRING, a, body_part] -= w_after * (sp * vn)
+        books_after[DAMPING, a, body_part] -= w_after * (dp * vn)
+        books_after[FRICTION, a, body_part] -= w_after * pf

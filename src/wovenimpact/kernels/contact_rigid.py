@@ -120,9 +120,11 @@ def rigid_contact_forces(
             nodes farther are skipped.
         force: (n, 3) written: contact force on each node (N).
         energy: (n,) written: penalty energy ½ k g² of each node (J).
-        parts: (n, 8) written for the nodes in contact: the normal forces of the spring
-            k g and of the dashpot −c v_n (N), the normal n, the force f (what the
-            energy books split the pair's work by, kernels.contact_energy).
+        parts: (n, 11) written for the nodes in contact: the normal forces of the
+            spring k g and of the dashpot −c v_n (N), the normal n, the force f, and the
+            powers of the spring, the dashpot and friction (W) with the node's velocity
+            relative to the body's translation, v − V (what the energy books split the
+            pair's work by, kernels.contact_energy; the friction power 0 if μ = 0).
         contact_list: (n,) int64, its first ``count`` entries written: the nodes in
             contact, in node order.
 
@@ -180,6 +182,13 @@ def rigid_contact_forces(
         parts[i, 5] = fx
         parts[i, 6] = fy
         parts[i, 7] = fz
+        # the powers with v − V (the solver books the body's work with its translation)
+        tx, ty, tz = v[i, 0] - body_v[0], v[i, 1] - body_v[1], v[i, 2] - body_v[2]
+        vn = tx * nx + ty * ny + tz * nzz
+        parts[i, 8] = parts[i, 0] * vn
+        parts[i, 9] = parts[i, 1] * vn
+        parts[i, 10] = (fx * tx + fy * ty + fz * tz - (parts[i, 0] + parts[i, 1]) * vn
+                        if mu > 0.0 else 0.0)
     return count
 
 

@@ -247,7 +247,7 @@ def check_impactor_clearance(model: Model) -> None:
                              model.node_offset, 1.0, 0.0, 0.0, 1.0, 1.0, tip, axis, zero, zero, zero,
                              np.ascontiguousarray(prof[:, 0]), np.ascontiguousarray(prof[:, 1]),
                              p[RB.BP_REACH] + float(model.node_offset.max()), force, energy,
-                             np.zeros((n, 8)), np.zeros(n, dtype=np.int64))
+                             np.zeros((n, 11)), np.zeros(n, dtype=np.int64))
         bad = np.flatnonzero(energy > 0.0)
         if bad.size:
             worst = int(bad[np.argmax(energy[bad])])

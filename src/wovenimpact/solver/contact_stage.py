@@ -16,7 +16,7 @@ import numpy as np
 
 from wovenimpact.interfaces import n_parts, part_arrays
 from wovenimpact.kernels import rigid_body as RB
-from wovenimpact.kernels.contact_energy import N_KINDS, body_pair_powers, book_body_powers
+from wovenimpact.kernels.contact_energy import book_body_pairs
 from wovenimpact.kernels.contact_rigid import add_body_forces, rigid_contact_forces
 from wovenimpact.kernels.gather import nodes_with_live_elements, node_sum
 from wovenimpact.kernels.rigid_body import advance_body
@@ -37,16 +37,15 @@ class ContactBuffers:
     penalty_energy: float = 0.0  # Σ ½ k g² of every body and shell pair at x^n (J)
     # the energy books per interface (wovenimpact.interfaces, kernels.contact_energy):
     # the part of each node, element and body, and of each body's pairs at x^n the
-    # spring, dashpot, normal and force of each node in contact (contact_rigid ``parts``)
-    # and the list of those nodes
+    # spring, dashpot, normal, force and powers of each node in contact (contact_rigid
+    # ``parts``) and the list of those nodes
     node_part: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     elem_part: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     body_part: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
     n_parts: int = 0
-    body_parts: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 8)))
+    body_parts: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 11)))
     body_list: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), dtype=np.int64))
     body_count: list = field(default_factory=list)
-    body_power: np.ndarray = field(default_factory=lambda: np.zeros((0, N_KINDS)))
 
     @classmethod
     def for_model(cls, model) -> ContactBuffers:
@@ -65,9 +64,8 @@ class ContactBuffers:
         return cls(np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n),
                    np.zeros(n, dtype=np.int8), shells, node_part=node_part,
                    elem_part=elem_part, body_part=body_part, n_parts=n_parts(model),
-                   body_parts=np.zeros((nb, n, 8)),
-                   body_list=np.zeros((nb, n), dtype=np.int64), body_count=[0] * nb,
-                   body_power=np.zeros((n if nb else 0, N_KINDS)))
+                   body_parts=np.zeros((nb, n, 11)),
+                   body_list=np.zeros((nb, n), dtype=np.int64), body_count=[0] * nb)
 
 
 def body_frame(state_row, params):
@@ -144,26 +142,27 @@ def contact_forces(model, state, cb: ContactBuffers, dt: float, elem_alive,
     return resultants
 
 
-def book_contact_work(model, state, cb: ContactBuffers, weight: float, books,
-                      after: bool) -> None:
-    """Add the work of this step's contact forces (the pairs of :func:`contact_forces`)
-    at the State's velocities — the nodes' ``state.v`` and the bodies' translation — times
-    ``weight`` to ``books`` (N_KINDS, P, P) by interface and kind (kernels.contact_energy).
-    The solver calls it twice per step, like its trapezoid rule: with ½ Δt^{n−1/2} and
-    the velocities the forces were computed with, then (``after``) with ½ Δt^{n+1/2} and
-    the velocities after the node update."""
+def book_contact_work(model, state, cb: ContactBuffers, w_before: float, books_before,
+                      w_after: float, books_after) -> None:
+    """Book the work of this step's contact forces (the pairs of :func:`contact_forces`)
+    by interface and kind (kernels.contact_energy) as the solver's trapezoid rule counts
+    it: against the velocities they were computed with (v^{n−1/2}; the force kernels
+    wrote those powers) times ``w_before`` = ½ Δt^{n−1/2} into ``books_before``, and
+    against the State's velocities after the node update (the nodes' v^{n+1/2}, the
+    bodies' translation) times ``w_after`` = ½ Δt^{n+1/2} into ``books_after`` (N_KINDS,
+    P, P each). Called once per step, after the bodies moved."""
     if cb.shells is not None:
-        cb.shells.book(weight, books, cb.node_part, cb.elem_part,
-                       v=state.v if after else None)
+        cb.shells.book(state.v, w_before, books_before, w_after, books_after, cb.node_part,
+                       cb.elem_part)
     for b, count in enumerate(cb.body_count):
         if count == 0:
             continue
         row = state.bodies[b]
-        body_pair_powers(state.v, np.ascontiguousarray(row[RB.B_V:RB.B_V + 3]),
-                         cb.body_parts[b], cb.body_list[b], count,
-                         model.body_params[b, RB.BP_FRICTION] > 0.0, cb.body_power)
-        book_body_powers(cb.body_power, cb.body_list[b], count, cb.node_part,
-                         int(cb.body_part[b]), float(weight), books)
+        book_body_pairs(state.v, np.ascontiguousarray(row[RB.B_V:RB.B_V + 3]),
+                        cb.body_parts[b], cb.body_list[b], count,
+                        model.body_params[b, RB.BP_FRICTION] > 0.0, cb.node_part,
+                        int(cb.body_part[b]), float(w_before), books_before, float(w_after),
+                        books_after)
 
 
 def advance_bodies(model, state, resultants, dt_old: float, dt_new: float) -> tuple[float, float]:

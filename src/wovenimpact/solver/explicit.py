@@ -290,18 +290,9 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     # work of the contact forces on the nodes over [x^{n−1}, x^n] (trapezoid), before
     # the velocities move on
     w_con_nodes = 0.0
-    books = state.contact_books
     if resultants or cb.shells is not None:
         w_con_nodes = force_pair_power(state.f_contact, cb.f_con, state.v, state.dt,
                                        state.contact_work) * state.dt
-        if books.shape[-1] != cb.n_parts:  # a State built by hand, without its books
-            books = state.contact_books = empty_books(model)
-        # the same work by interface and kind (interfaces, kernels.contact_energy): the
-        # last step's forces against these velocities (booked after that step), and
-        # this step's
-        books[0] += books[1]
-        books[1] = 0.0
-        book_contact_work(model, state, cb, 0.5 * state.dt, books[0], after=False)
     t0 = ws.tick("contact", t0)
     amplitude = smooth_step(state.t + 0.5 * dt_new, model.ramp_time)
     n_bad = gather_and_update(
@@ -319,8 +310,19 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
         n = int(np.flatnonzero(~np.isfinite(state.x).all(axis=1))[0])
         raise SimulationError(f"node {n} has a non-finite position at t = {state.t:.6e} s")
     ke_bodies, w_con_bodies = advance_bodies(model, state, resultants, state.dt, dt_new)
-    if resultants or cb.shells is not None:  # this step's forces against v^{n+1/2}
-        book_contact_work(model, state, cb, 0.5 * dt_new, books[1], after=True)
+    if resultants or cb.shells is not None:
+        # the same work by interface and kind (interfaces, kernels.contact_energy): the
+        # last step's forces against v^{n−1/2} (booked after that step into [1]), this
+        # step's against v^{n−1/2} — what the trapezoid above counted — and against
+        # v^{n+1/2} into [1], for the next step's trapezoid
+        t0 = ws.tick("bookkeeping", t0)
+        books = state.contact_books
+        if books.shape[-1] != cb.n_parts:  # a State built by hand, without its books
+            books = state.contact_books = empty_books(model)
+        books[0] += books[1]
+        books[1] = 0.0
+        book_contact_work(model, state, cb, 0.5 * state.dt, books[0], 0.5 * dt_new, books[1])
+        t0 = ws.tick("contact energy books", t0)
     en = state.energy
     if state.step == 1:
         first_step_work_correction(model, state)

@@ -5,9 +5,9 @@ A material whose failure is not regularised (no ``[material.regularisation]`` ta
 holds its answers only on elements of its reference length (a fabric: the crossover
 cell, 2ℓ0; a metal: none given, so any size is outside it); a regularised one within
 the lengths its table was calibrated on (the table's first and last rows). The lengths
-judged are those of the material's elements that failed (eroded) in the run, or all of
-its elements if none did: a contained or stopped run is judged by where it could have
-failed.
+judged are those of the material's elements that failed (eroded) in the run — not a
+blade's release row, which is let go — or all of its elements if none did: a contained or
+stopped run is judged by where it could have failed.
 """
 
 from __future__ import annotations

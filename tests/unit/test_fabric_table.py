@@ -13,6 +13,7 @@ from hypothesis import strategies as st
 
 from tests.conftest import reference_fabric, with_options
 from tests.unit.test_fabric_kernel import scaled_parameters, stretch_shear
+from wovenimpact.errors import InputError
 from wovenimpact.kernels import fabric_layout as L
 from wovenimpact.kernels.fabric_table import crossover_from_table_for_points
 from wovenimpact.materials import fabric_table as FT
@@ -75,6 +76,19 @@ def test_table_covers_compression_to_beyond_failure_and_marks_few_cells_exact():
     frac = data[:-1, :-1, L.T_EXACT].mean()
     print(f"\ntable {len(kw)} × {len(kf)} knots, {frac:.1%} of the cells solved exactly")
     assert 0.0 < frac < 0.05
+
+
+def test_a_failure_stretch_beyond_the_table_limit_is_an_input_error_naming_the_field():
+    """"Failure off" as T_u = 1 MN would ask for a grid of ~10⁹ cells (a run that ate all
+    memory before its first step); the largest allowed T_u is the inverse of λ_u."""
+    params = reference_fabric()
+    big = dataclasses.replace(params.fill, ultimate_tension=1e6)
+    with pytest.raises(InputError, match=r"fill\.ultimate_tension = 1e\+06 N .* λ_u = "):
+        FT.family_knots(big, params.warp, family="fill")
+    limit = FT._tension_at(params.fill, FT.MAX_FAILURE_STRETCH)
+    at = dataclasses.replace(params.fill, ultimate_tension=limit)
+    assert FT.failure_stretch(at) == pytest.approx(FT.MAX_FAILURE_STRETCH, rel=1e-12)
+    FT.family_knots(dataclasses.replace(at, ultimate_tension=0.999 * limit), params.warp)
 
 
 def sample_errors(params, n, seed):

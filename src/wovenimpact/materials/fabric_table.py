@@ -34,6 +34,7 @@ from pathlib import Path
 
 import numpy as np
 
+from wovenimpact.errors import InputError
 from wovenimpact.kernels import fabric_layout as L
 
 FD_STEP = 1e-6  # λ step of the central differences for the cross and height derivatives
@@ -46,6 +47,9 @@ FINE = 1e-3  # knot spacing around the onset of contact and the knee
 # cells"); the lookup's buckets keep the width of the knots outside the cluster, so a
 # point inside it steps through a few knots
 REST_STEPS = 1e-7 * 2.0 ** np.arange(12)  # 1e-7 … 2.05e-4
+# the table's largest failure stretch: λ_u = 3 is a yarn at 200 % strain, beyond any fibre;
+# a larger T_u (e.g. "failure off" as T_u = 1 MN, λ_u ≈ 350) would ask for ~10⁹ cells
+MAX_FAILURE_STRETCH = 3.0
 
 
 def _exact_parameters(params):
@@ -107,6 +111,11 @@ def failure_stretch(yarn) -> float:
     )
 
 
+def _tension_at(yarn, lam: float) -> float:
+    """T_u that puts the failure stretch at ``lam`` (inverse of :func:`failure_stretch`)."""
+    return (lam * yarn.half_length / yarn.truss_length - 1.0) * yarn.modulus * yarn.area
+
+
 def compressed_onset(own, other) -> float:
     """λ of family ``own`` below which it is slack even at height h_w0 + h_f0 (√(L0² − ℓ²) ≥ S)."""
     s = own.h0 + other.h0
@@ -130,9 +139,20 @@ def knots(lo: float, hi: float, fine: list[tuple[float, float]], coarse=COARSE, 
     return np.array(out)
 
 
-def family_knots(own, other, coarse=COARSE, dense=FINE) -> np.ndarray:
-    """Knots along one family's stretch (module docstring: the grid choice)."""
-    hi = FAILURE_MARGIN * failure_stretch(own)
+def family_knots(own, other, coarse=COARSE, dense=FINE, family: str = "yarn") -> np.ndarray:
+    """Knots along one family's stretch (module docstring: the grid choice).
+
+    Raises InputError when the family's failure stretch exceeds ``MAX_FAILURE_STRETCH``
+    (the grid would not fit in memory)."""
+    lam_u = failure_stretch(own)
+    if lam_u > MAX_FAILURE_STRETCH:
+        raise InputError(
+            f"{family}.ultimate_tension = {own.ultimate_tension:.6g} N puts the yarn's failure stretch "
+            f"at λ_u = {lam_u:.4g} (strain {lam_u - 1:.3g}); the crossover table spans up to "
+            f"1.02 λ_u and allows λ_u ≤ {MAX_FAILURE_STRETCH:g} (valid: ultimate_tension ≤ "
+            f"{_tension_at(own, MAX_FAILURE_STRETCH):.6g} N). To switch failure off, give a "
+            f"tension the run never reaches (e.g. 10 × the yarn's), or crossover = \"exact\"")
+    hi = FAILURE_MARGIN * lam_u
     taut = own.truss_length / own.half_length
     comp = compressed_onset(own, other)
     fine = [(0.985, taut + 0.012)]
@@ -391,8 +411,8 @@ def _cached_table(params) -> np.ndarray:
     key = table_key(params) if folder is not None else ""
     row = _read_table(folder / f"{key}.npz", key) if folder is not None else None
     if row is None:
-        kw = family_knots(params.warp, params.fill)
-        kf = family_knots(params.fill, params.warp)
+        kw = family_knots(params.warp, params.fill, family="warp")
+        kf = family_knots(params.fill, params.warp, family="fill")
         row = install(np.zeros(L.N_PARAM), kw, kf, tabulate(params, kw, kf))
         mark_exact_cells(params, row)
         if folder is not None:

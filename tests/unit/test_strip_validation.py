@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import pytest
 
-from wovenimpact.studies.strip_validation import spread, table_lines, verdict_line
+from wovenimpact.studies.strip_validation import early_loss, spread, table_lines, verdict_line
 from wovenimpact.studies.sweep import load_study
 from wovenimpact.studies.strip_validation import ROOT, STUDY
 
@@ -33,8 +33,22 @@ def test_the_spread_is_over_2_to_7_mm_and_the_verdict_follows_it():
 
 def test_the_table_has_a_row_per_mesh_with_the_ratio_to_the_reference():
     lines = table_lines(rows({"0.94 mm": 50.0, "2 mm": 100.0}))
-    assert len(lines) == 4 and lines[0].count("|") == lines[2].count("|") == 12
-    assert "| 2.00 |" in lines[3] and "1.0 / 2.0 / 3.0 / 4.0 / 5.0" in lines[3]
+    assert len(lines) == 4 and lines[0].count("|") == lines[2].count("|") == 13
+    assert "| 2.00 | — |" in lines[3] and "1.0 / 2.0 / 3.0 / 4.0 / 5.0" in lines[3]
+
+
+def test_the_early_loss_is_the_impactors_kinetic_energy_lost_by_20_us(tmp_path):
+    """From the run's history: E(0) − E(t nearest 20 µs); 100 → 70 J at 20 µs is 30 J (the
+    row at 30 µs, 60 J, is not the nearest), and a run without history gives a dash."""
+    run = tmp_path / "runs" / "abc"
+    run.mkdir(parents=True)
+    (run / "history.csv").write_text(
+        "time_s,impactor_kinetic_energy_part_J\n0,100\n1e-05,90\n2.1e-05,70\n3e-05,60\n")
+    assert early_loss(run) == pytest.approx(30.0)
+    r = rows({"0.94 mm": 50.0, "2 mm": 100.0})
+    r[0]["id"], r[1]["id"] = "abc", "missing"
+    lines = table_lines(r, tmp_path)
+    assert "| 1.00 | 30.0 |" in lines[2] and "| 2.00 | — |" in lines[3]
 
 
 def test_the_study_sweeps_the_five_meshes_of_issue_36_on_the_strip_example():

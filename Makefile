@@ -4,7 +4,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: venv run test bench bench-containment corpus clean
+.PHONY: venv run test bench bench-containment bench-flagship corpus clean
 
 venv: $(STAMP)
 
@@ -14,7 +14,7 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet -e '.[test]'
 	touch $(STAMP)
 
-# Flagship example: 4 Kevlar plies struck at 120 m/s (thesis ch. 7; its time: README),
+# Flagship example: 4 Kevlar plies struck at 120 m/s (thesis ch. 7; its time: docs/performance.md),
 # and the single-element report of the crossover model.
 run: venv
 	$(BIN)/wovenimpact run examples/plate_impact/plies4_120.toml --out out/plies4_120
@@ -29,18 +29,28 @@ test: venv
 	$(BIN)/python -m pytest -q
 
 # The machine line first; then the fabric kernel alone, the explicit step (the same as
-# `wovenimpact bench`) and the ply-on-ply contact.
+# `wovenimpact bench`) and the ply-on-ply contact; their figures (out/bench/*.json) rewrite
+# the `make bench` section of docs/performance.md.
 bench: venv
 	$(BIN)/python -c "from wovenimpact.benchmark import machine_line; print(machine_line())"
-	$(BIN)/python benchmarks/bench_fabric_kernel.py
-	$(BIN)/python benchmarks/bench_shell.py --no-machine-line
-	$(BIN)/python benchmarks/bench_contact.py
+	$(BIN)/python benchmarks/bench_fabric_kernel.py --save=out/bench/fabric_kernel.json
+	$(BIN)/python benchmarks/bench_shell.py --no-machine-line --save=out/bench/shell.json
+	$(BIN)/python benchmarks/bench_contact.py --save=out/bench/contact.json
+	$(BIN)/python benchmarks/performance_page.py
 
 # Issue 11's end-to-end figure: the 10-ply hybrid casing at ~55 k elements (5.5 mm, the graded ring) to
 # the end of the event (the case stops once its outcome is decided; 4 ms at most) on all cores,
 # against the 3-minute target (about 7 minutes here; not in `make bench`).
 bench-containment: venv
-	$(BIN)/python benchmarks/bench_containment.py
+	$(BIN)/python benchmarks/bench_containment.py --save=out/bench/containment.json
+	$(BIN)/python benchmarks/performance_page.py
+
+# The flagship `make run` case timed as the containment benchmark is (cached compilation,
+# no field frames or checkpoints); rewrites the flagship section of docs/performance.md.
+bench-flagship: venv
+	$(BIN)/python benchmarks/bench_containment.py --case=examples/plate_impact/plies4_120.toml \
+		--size=0.94mm --end=0.25ms --save=out/bench/flagship.json
+	$(BIN)/python benchmarks/performance_page.py
 
 # The acceptance corpus of issue 12: ~430 bad inputs written from the examples into
 # out/corpus and run in process; prints clean / traceback / hang / nonsense counts

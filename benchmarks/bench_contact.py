@@ -15,7 +15,7 @@ cost per
 node must stay about constant as plies multiply (linear scaling).
 ``--threads=1,2`` chooses the thread counts, ``--plies=1,2,4,6`` the stacks,
 ``--calls=N`` the timed calls per batch (50, best of 5 batches), ``--json`` prints
-{"cases": [...]}.
+{"cases": [...]}, ``--save=PATH`` also writes it to PATH.
 """
 
 from __future__ import annotations
@@ -23,6 +23,7 @@ from __future__ import annotations
 import json
 import sys
 import time
+from pathlib import Path
 
 import numba
 import numpy as np
@@ -109,6 +110,7 @@ def main(argv: list[str]) -> None:
     calls = int(opts.get("calls", "50"))
     plies = [int(p) for p in opts.get("plies", "1,2,4,6").split(",")]
     cases = [run_case(p, t, calls) for t in threads for p in plies]
+    save_json({"cases": cases}, argv)
     if "json" in opts:
         print(json.dumps({"cases": cases}))
         return
@@ -124,6 +126,16 @@ def main(argv: list[str]) -> None:
               f"{c['reused_ns_per_node']:>7.1f} {c['broad_ns_per_node']:>7.1f} "
               f"{c['book_ns_per_node']:>7.1f} "
               f"{c['ns_per_node'] / c['reused_ns_per_node']:>6.2f}")
+
+
+def save_json(doc: dict, argv: list[str]) -> None:
+    """``--save=PATH``: write ``doc`` (what ``--json`` prints) to PATH as well, for
+    benchmarks/performance_page.py (``make bench`` renders docs/performance.md from it)."""
+    for arg in argv:
+        if arg.startswith("--save="):
+            path = Path(arg.split("=", 1)[1])
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
 
 
 if __name__ == "__main__":

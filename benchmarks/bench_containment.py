@@ -13,7 +13,9 @@ Options: ``--case=PATH`` (default the 10-ply hybrid casing), ``--size=5.5mm`` (e
 size), ``--end=4ms`` (end time at most: the example stops once its outcome has held for
 ``run.stop_when_decided``, at 2.73 ms for the 10-ply casing — the end of the event),
 ``--threads=N`` (default: all cores), ``--set=KEY=VALUE`` (repeatable, passed on),
-``--out=DIR`` (default a temporary directory), ``--json``.
+``--out=DIR`` (default a temporary directory), ``--json``, ``--save=PATH`` (also writes the
+``--json`` object, with the machine line, to PATH: ``make bench-containment`` renders it into
+docs/performance.md).
 """
 
 from __future__ import annotations
@@ -67,8 +69,14 @@ def main(argv: list[str]) -> None:
         run(case, out / "warm", threads, [*sets, "run.end_time=1 us"])  # compile, cache
         summary = run(case, out / "run", threads, sets)
     row = {k: summary.get(k) for k in KEYS}
-    row.update(case=str(case), element_size=size, end_time=end, threads=threads,
-               target_s=TARGET_S, ratio_to_target=summary["wall_time_s"] / TARGET_S)
+    row.update(case=str(case.resolve().relative_to(ROOT)) if case.resolve().is_relative_to(ROOT)
+               else str(case), element_size=size, end_time=end, threads=threads,
+               target_s=TARGET_S, ratio_to_target=summary["wall_time_s"] / TARGET_S,
+               machine=machine_line())
+    if "save" in opts:
+        path = Path(opts["save"])
+        path.parent.mkdir(parents=True, exist_ok=True)
+        path.write_text(json.dumps(row, indent=1) + "\n", encoding="utf-8")
     if "json" in opts:
         print(json.dumps(row))
         return

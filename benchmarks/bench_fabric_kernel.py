@@ -5,7 +5,8 @@ Points are driven through a realistic step: from a random stretched/sheared stat
 at F_old, as the explicit solver will call it. The two crossover options (exact height
 solve, tabulated stored energy: theory §1.9) run interleaved in the same process, the
 minimum of ``repeats`` timings each, so that a loaded machine affects both alike. Prints
-one line per option and thread count, and the ratio; ``--json`` prints them as JSON.
+one line per option and thread count, and the ratio; ``--json`` prints them as JSON,
+``--save=PATH`` also writes that JSON to PATH.
 """
 
 from __future__ import annotations
@@ -15,6 +16,7 @@ import json
 import math
 import sys
 import time
+from pathlib import Path
 
 import numba
 import numpy as np
@@ -68,6 +70,7 @@ def main(n: int = 200_000, repeats: int = 7) -> None:
                 "ns_per_point_update": best[c] / n * 1e9,
                 "iterations_mean": float(iters[c].mean()), "iterations_max": int(iters[c].max()),
             })
+    save_json({"cases": results}, sys.argv[1:])
     if "--json" in sys.argv:
         print(json.dumps({"cases": results}))
         return
@@ -80,6 +83,16 @@ def main(n: int = 200_000, repeats: int = 7) -> None:
     for i in range(0, len(results), 2):
         print(f"{results[i]['threads']} thread(s): exact / table = "
               f"{results[i]['ns_per_point_update'] / results[i + 1]['ns_per_point_update']:.2f}×")
+
+
+def save_json(doc: dict, argv: list[str]) -> None:
+    """``--save=PATH``: write ``doc`` (what ``--json`` prints) to PATH as well, for
+    benchmarks/performance_page.py (``make bench`` renders docs/performance.md from it)."""
+    for arg in argv:
+        if arg.startswith("--save="):
+            path = Path(arg.split("=", 1)[1])
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
 
 
 if __name__ == "__main__":

@@ -3,13 +3,16 @@
 Options: ``--sizes=10000,100000``, ``--kinds=metal,fabric,fabric_reduced``,
 ``--threads=1,2``, ``--steps=N``, ``--json`` (prints {"cases": [{"name", "elements", "threads", "ns_per_element_cycle",
 "shares"}], "machine", "threading_layer"}), ``--no-machine-line`` (``make bench`` prints
-it first). Same as ``wovenimpact bench``.
+it first), ``--save=PATH`` (also writes the ``--json`` object to PATH). Same as
+``wovenimpact bench``.
 """
 
 from __future__ import annotations
 
 import json
+import os
 import sys
+from pathlib import Path
 
 import numba
 
@@ -37,11 +40,23 @@ def main() -> None:
         print(machine_line(), flush=True)
     cases = run_cases(kinds, sizes, thread_counts, steps,
                       report=None if quiet else (lambda c: print(case_line(c), flush=True)))
+    doc = {"cases": cases, "machine": machine(), "threading_layer": numba.threading_layer(),
+           "load_average": list(os.getloadavg())}  # how busy the machine was (page)
+    save_json(doc, sys.argv[1:])
     if quiet:
-        print(json.dumps({"cases": cases, "machine": machine(),
-                          "threading_layer": numba.threading_layer()}))
+        print(json.dumps(doc))
     else:
         print(f"threading layer: {numba.threading_layer()}")
+
+
+def save_json(doc: dict, argv: list[str]) -> None:
+    """``--save=PATH``: write ``doc`` (what ``--json`` prints) to PATH as well, for
+    benchmarks/performance_page.py (``make bench`` renders docs/performance.md from it)."""
+    for arg in argv:
+        if arg.startswith("--save="):
+            path = Path(arg.split("=", 1)[1])
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
 
 
 if __name__ == "__main__":

@@ -4,7 +4,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: venv run test bench bench-containment bench-flagship corpus clean
+.PHONY: venv run test docs bench bench-containment bench-flagship corpus clean
 
 venv: $(STAMP)
 
@@ -27,6 +27,11 @@ run: venv
 
 test: venv
 	$(BIN)/python -m pytest -q
+
+# docs/case_keys.md, the key reference generated from the input schemas (a test checks it is
+# current).
+docs: venv
+	$(BIN)/python -m wovenimpact.spec.reference --write docs/case_keys.md
 
 # The machine line first; then the fabric kernel alone, the explicit step (the same as
 # `wovenimpact bench`) and the ply-on-ply contact; their figures (out/bench/*.json) rewrite

@@ -1,4 +1,4 @@
-"""Input layer: files with units → validated SI parameter sets (MODEL.md preamble)."""
+"""Input layer: files with units → validated SI parameter sets (docs/model.md, units)."""
 
 from wovenimpact.spec.fields import InputWarning
 from wovenimpact.spec.material import load_material, material_from_dict

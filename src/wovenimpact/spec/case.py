@@ -210,7 +210,7 @@ Angle = quantity("angle", example="90 deg")
 
 
 class CasingSpec(BaseModel):
-    """``[mesh.casing]``: coaxial cylindrical layers about the z axis (MODEL.md §6).
+    """``[mesh.casing]``: coaxial cylindrical layers about the z axis (docs/model.md §6).
 
     The inner metal shell (``inner_section``; omit it for an all-metal casing of
     layers) has its inner surface at ``inner_radius``; ``layers`` layers of
@@ -251,7 +251,7 @@ DEFAULT_TWIST = math.radians(30.0)  # and its tip's 30° more: 60° from the axi
 class BladeSpec(BaseModel):
     """``[mesh.blade]``: a tapered, twisted blade about the z axis (model.casing).
 
-    Defaults (MODEL.md §7: the thesis's blade is not in its text; theory §8.1): root 40
+    Defaults (docs/model.md §7: the thesis's blade is not in its text; theory §8.1): root 40
     mm, split at 60 mm, tip 245 mm (5 mm inside a 250 mm casing), chords 80 mm at the
     root and 40 mm at the tip, radial along ``angle`` (from +x); a fan blade's twist —
     the chord turned 30° from the axial direction at the root and 60° at the tip — and
@@ -429,7 +429,7 @@ class RunSpec(BaseModel):
 
 
 class ImpactorSpec(BaseModel):
-    """``[impactor]``: a rigid body of revolution launched at the structure (MODEL §4).
+    """``[impactor]``: a rigid body of revolution launched at the structure (docs/model.md §4).
 
     ``position`` is the nose tip at t = 0, ``direction`` the direction of travel (the
     nose leads), ``velocity`` the speed along it. Mass from ``density`` (steel by

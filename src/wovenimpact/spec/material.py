@@ -1,8 +1,8 @@
 """Material files (TOML) → validated SI parameter sets.
 
 ``[material] kind = "woven_fabric"`` gives :class:`~wovenimpact.materials.fabric.FabricParameters`
-(MODEL.md §1, thesis Tables 5-1 and 7-2); ``kind = "j2_plastic"`` or ``"elastic"`` gives
-:class:`~wovenimpact.materials.metal.MetalParameters` (MODEL.md §5, thesis Tables 7-1,
+(docs/model.md §1, thesis Tables 5-1 and 7-2); ``kind = "j2_plastic"`` or ``"elastic"`` gives
+:class:`~wovenimpact.materials.metal.MetalParameters` (docs/model.md §5, thesis Tables 7-1,
 8-1, 8-2). Every dimensioned value carries its unit (``"96 GPa"``) and is converted
 to SI once, here. Unknown keys, missing units, wrong dimensions and unphysical
 values are errors; all problems of a file are reported together in one
@@ -107,7 +107,7 @@ class ShearSpec(BaseModel):
 
 
 class OptionsSpec(BaseModel):
-    """``[material.options]``: model variants (MODEL.md §1.4–1.7)."""
+    """``[material.options]``: model variants (docs/model.md §1.4–1.7)."""
 
     model_config = STRICT
     homogenisation: Literal["virial", "thesis"] = "virial"
@@ -345,7 +345,7 @@ def _fabric_parameters(
             notes.append(
                 f"{source}: material.{fam}.area: {y.area * 1e6:.6g} mm^2 differs by more than "
                 f"{LENTICULAR_TOLERANCE:.0%} from the lenticular section (2/π)·width·thickness = "
-                f"{lenticular * 1e6:.6g} mm^2 (MODEL.md §1): check area, width and thickness"
+                f"{lenticular * 1e6:.6g} mm^2 (docs/model.md §1.1): check area, width and thickness"
             )
         families[fam] = YarnFamily(
             half_length=half[fam],

@@ -39,16 +39,18 @@ def test_the_table_has_a_row_per_mesh_with_the_ratio_to_the_reference():
 
 def test_the_early_loss_is_the_impactors_kinetic_energy_lost_by_20_us(tmp_path):
     """From the run's history: E(0) − E(t nearest 20 µs); 100 → 70 J at 20 µs is 30 J (the
-    row at 30 µs, 60 J, is not the nearest), and a run without history gives a dash."""
+    row at 30 µs, 60 J, is not the nearest) of a quarter model, 120 J of the whole (the
+    summary's 400 J at the start); a run without history gives a dash."""
     run = tmp_path / "runs" / "abc"
     run.mkdir(parents=True)
     (run / "history.csv").write_text(
         "time_s,impactor_kinetic_energy_part_J\n0,100\n1e-05,90\n2.1e-05,70\n3e-05,60\n")
-    assert early_loss(run) == pytest.approx(30.0)
+    (run / "summary.json").write_text('{"initial_impactor_kinetic_energy_J": 400.0}')
+    assert early_loss(run) == pytest.approx(120.0)
     r = rows({"0.94 mm": 50.0, "2 mm": 100.0})
     r[0]["id"], r[1]["id"] = "abc", "missing"
     lines = table_lines(r, tmp_path)
-    assert "| 1.00 | 30.0 |" in lines[2] and "| 2.00 | — |" in lines[3]
+    assert "| 1.00 | 120.0 |" in lines[2] and "| 2.00 | — |" in lines[3]
 
 
 def test_the_study_sweeps_the_five_meshes_of_issue_36_on_the_strip_example():

@@ -56,20 +56,24 @@ def spread(rows: list[dict], key: str = "absorbed_energy_J",
 
 
 def early_loss(run_dir: Path, t: float = EARLY) -> float | None:
-    """The impactor's kinetic energy lost by time ``t`` (J), from the run's history.csv
-    (the row nearest ``t``); None when the history is missing."""
+    """The impactor's kinetic energy lost by time ``t`` (J, whole model), from the run's
+    history.csv (the row nearest ``t``; its ``_part`` columns are the modelled part's, so
+    scaled by the summary's whole-model initial energy over the history's first row);
+    None when the history or the summary is missing."""
     import csv
+    import json
 
-    path = run_dir / "history.csv"
-    if not path.exists():
+    path, summary = run_dir / "history.csv", run_dir / "summary.json"
+    if not (path.exists() and summary.exists()):
         return None
     with open(path, newline="") as fh:
         rows = list(csv.DictReader(fh))
     if not rows:
         return None
     e0 = float(rows[0]["impactor_kinetic_energy_part_J"])
+    full = float(json.loads(summary.read_text())["initial_impactor_kinetic_energy_J"])
     row = min(rows, key=lambda r: abs(float(r["time_s"]) - t))
-    return e0 - float(row["impactor_kinetic_energy_part_J"])
+    return (e0 - float(row["impactor_kinetic_energy_part_J"])) * full / e0
 
 
 def table_lines(rows: list[dict], out: Path | None = None) -> list[str]:

@@ -20,3 +20,17 @@ def test_jones_lines_tabulate_the_meshes_and_extrapolate(tmp_path):
     assert "| 16 | 3.125 | 10.000 | 11.000 | 1.0e-04 | 1600 |" in text
     assert "ratio 4.00" in text and "converged value 10.33 H" in text
     assert f"{10.3333333 / 11.0 - 1:+.1%}" in text and f"{10.3333333 / 4.0:.2f} ×" in text
+
+
+def test_the_v50_mesh_line_judges_the_spread_against_five_percent():
+    """Issue 36, V3: (max − min)/min of the ladders' V50; 75 / 73 / 72 m/s is 4.2 %, met;
+    75 / 65 m/s is 15.4 %, not met; a ladder without a V50 gives no verdict."""
+    from wovenimpact.studies.metal_validation import v50_mesh_line
+
+    ok = v50_mesh_line({"1 mm": 75.0, "0.5 mm": 73.0, "0.25 mm": 72.0}, "0.5 mm")
+    assert "75.0 / 73.0 / 72.0 m/s on 1 mm / 0.5 mm / 0.25 mm" in ok
+    assert "spread 4.2% of the smallest" in ok and ": met" in ok and "(0.5 mm)" in ok
+    bad = v50_mesh_line({"1 mm": 75.0, "0.5 mm": 65.0}, "0 mm")
+    assert "spread 15.4%" in bad and "not met" in bad
+    none = v50_mesh_line({"1 mm": 75.0, "0.5 mm": None}, "0.5 mm")
+    assert "75.0 / —" in none and "not every ladder brackets" in none

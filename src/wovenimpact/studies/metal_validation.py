@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 import shutil
 import sys
+import tomllib
 from pathlib import Path
 
 from wovenimpact.errors import InputError
@@ -22,6 +23,8 @@ ROOT = Path(__file__).resolve().parents[3]
 METAL_CASES = ("aluminium_fsp", "hybrid_coupon", "perforation_blunt")
 LADDER = "metal_perforation_v50"
 JONES_MESHES = (8, 16, 32)
+LADDER_MESHES = ("1 mm", "0.5 mm", "0.25 mm")  # issue 36, V3: the ladder on three meshes
+V50_TOLERANCE = 0.05  # issue 36, V3: V50 within 5 % across the meshes
 
 
 def _quiet(message: str) -> None:
@@ -97,9 +100,10 @@ def case_lines(work: Path, figures: Path, log=_quiet) -> list[str]:
 
 
 def ladder_lines(work: Path, workers: int = 1, log=_quiet, element_size: str = "1 mm"
-                 ) -> list[str]:
+                 ) -> tuple[list[str], float | None]:
     """The perforation ladder with ``element_size`` elements and its Lambert–Jonas V50
-    (runs kept in ``work/studies``; the case's own mesh is 1 mm)."""
+    (runs kept in ``work/studies``; the case's own mesh is 1 mm): the section's lines and
+    the V50 (m/s, None when the ladder does not bracket it)."""
     from wovenimpact.studies.ballistics import lambert_jonas_fit, require_decided
     from wovenimpact.studies.sweep import run_study
     from wovenimpact.units import to_si
@@ -124,18 +128,36 @@ def ladder_lines(work: Path, workers: int = 1, log=_quiet, element_size: str = "
                      f"{float(r['plastic_work_J']):.2f} | "
                      f"{float(r['energy_error_fraction']):.1e} |")
     done = [r for r in rows if r["status"] == "done"]
+    v50 = None
     try:
         require_decided(done, "impactor.velocity", f"study {LADDER}")
         fit = lambert_jonas_fit([to_si(r["impactor.velocity"], "velocity", "velocity")
                                  for r in done],
                                 [float(r["residual_velocity_m_per_s"]) for r in done])
+        v50 = fit.v_bl
         lines += ["", f"Lambert–Jonas: V50 = {fit.v_bl:.1f} m/s (a = {fit.a:.3f}, p = "
                   f"{fit.p:.2f}, rms {fit.rms:.2f} m/s). **Not compared with a published "
                   "ballistic limit**: no test with a stated plate, projectile and result "
                   "could be read in the reference library (docs/theory.md §7.9)."]
     except InputError as err:
         lines += ["", f"Lambert–Jonas fit not possible: {err}"]
-    return lines + [""]
+    return lines + [""], v50
+
+
+def v50_mesh_line(v50s: dict[str, float | None], fillet: str) -> str:
+    """Issue 36's V3 acceptance on the ladders' V50 by element size: the spread
+    (largest − smallest) / smallest within ``V50_TOLERANCE``; ``fillet`` is the case's
+    stated edge radius of the projectile's rim (as its file gives it)."""
+    got = {h: v for h, v in v50s.items() if v is not None}
+    listed = " / ".join(f"{v:.1f}" if v is not None else "—" for v in v50s.values())
+    head = (f"Mesh convergence (V3): V50 = {listed} m/s on {' / '.join(v50s)} elements, the "
+            f"projectile's rim rounded to the case's stated fillet ({fillet})")
+    if len(got) != len(v50s):
+        return head + "; not every ladder brackets its V50."
+    spread = (max(got.values()) - min(got.values())) / min(got.values())
+    ok = "met" if spread <= V50_TOLERANCE else "not met"
+    return head + (f": spread {spread:.1%} of the smallest (acceptance {V50_TOLERANCE:.0%}: "
+                   f"{ok}).")
 
 
 def metal_section(work: str | Path, figures: str | Path, log=_quiet, workers: int = 1
@@ -145,9 +167,15 @@ def metal_section(work: str | Path, figures: str | Path, log=_quiet, workers: in
     work = Path(work) / "metal"
     figures = Path(figures)
     figures.mkdir(parents=True, exist_ok=True)
-    return ["## Metal shells (issue 10)", "", *jones_lines(work, figures, log),
-            *case_lines(work, figures, log), *ladder_lines(work, workers, log),
-            *ladder_lines(work, workers, log, element_size="0.5 mm")]
+    lines = ["## Metal shells (issue 10)", "", *jones_lines(work, figures, log),
+             *case_lines(work, figures, log)]
+    v50s = {}
+    for size in LADDER_MESHES:
+        ladder, v50s[size] = ladder_lines(work, workers, log, element_size=size)
+        lines += ladder
+    case = tomllib.loads((ROOT / "examples" / "metal_impact" / "perforation_blunt.toml"
+                          ).read_text())
+    return lines + [v50_mesh_line(v50s, case["impactor"].get("fillet", "0 mm")), ""]
 
 
 def main(argv: list[str]) -> None:

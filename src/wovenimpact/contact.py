@@ -2,7 +2,7 @@
 
 :class:`ShellContact` owns the buffers and parameters; :mod:`wovenimpact.kernels.
 contact_broad` finds candidate (node, segment) pairs, :mod:`wovenimpact.kernels.
-contact_narrow` turns them into penalty (and friction) forces. MODEL.md §4.
+contact_narrow` turns them into penalty (and friction) forces. docs/model.md §4.
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 """Rigid impactors: bodies of revolution described by their meridian profile.
 
 An impactor is the solid swept by its profile ρ = R(ζ) about its axis, ζ measured
-from the nose tip (ζ = 0) back to the tail (ζ = L). Shapes (MODEL.md §4, issue 4):
+from the nose tip (ζ = 0) back to the tail (ζ = L). Shapes (docs/model.md §4, issue 4):
 
 - ``sphere``: R(ζ) = √(r² − (ζ − r)²), L = 2r;
 - ``cylinder`` with a ``flat``, ``hemispherical``, ``conical`` or ``ogive`` (tangent
@@ -162,7 +162,7 @@ class Impactor:
 
 def fragment_simulating_projectile() -> Impactor:
     """The .22-calibre 17-grain fragment-simulating projectile of fabric-armour testing
-    (MODEL.md §6): steel, 5.56 mm diameter, 1.1 g. Its chisel nose is not axisymmetric;
+    (docs/model.md §6): steel, 5.56 mm diameter, 1.1 g. Its chisel nose is not axisymmetric;
     here a flat-faced cylinder whose length gives 1.1 g at ρ = 7922 kg/m³ (5.72 mm)."""
     r = 0.5 * 5.56e-3
     length = 1.1e-3 / (STEEL_DENSITY * math.pi * r * r)

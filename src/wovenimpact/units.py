@@ -1,4 +1,4 @@
-"""Quantities with units in input files, converted once to SI (MODEL.md, preamble).
+"""Quantities with units in input files, converted once to SI (docs/model.md, units).
 
 Every dimensioned number a user writes carries its unit as a string: ``"96 GPa"``,
 ``"27 1/in"``, ``"1.44 g/cm^3"``, ``"0.98432 N"``. :func:`to_si` checks the string

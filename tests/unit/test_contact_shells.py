@@ -1,4 +1,4 @@
-"""Shell–shell penalty contact: bucket search, node-to-segment forces, driver (MODEL.md §4)."""
+"""Shell–shell penalty contact: bucket search, node-to-segment forces, driver (docs/model.md §4)."""
 
 from __future__ import annotations
 

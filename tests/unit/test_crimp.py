@@ -21,7 +21,7 @@ from wovenimpact.calibration.crimp import (
 INCH = 0.0254
 N_27_TPI = 27 / INCH  # threads per metre
 H0_TABLE_5_1 = 0.12495e-3  # m, thesis Table 5-1 (Maple)
-H0_EXACT = 0.12480e-3  # m, the integral solved to machine precision (MODEL.md §1)
+H0_EXACT = 0.12480e-3  # m, the integral solved to machine precision (docs/model.md §1)
 THESIS_REL = 5e-3  # the thesis's printed h0 and ours agree to 0.5 %
 
 

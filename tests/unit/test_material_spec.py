@@ -26,7 +26,7 @@ INCH = 0.0254
 H0_TABLE_5_1 = 0.12495e-3  # m, thesis Table 5-1
 H0_EXACT = 0.12480e-3  # m, eq. (5.5) solved exactly
 ELL0 = 0.47037e-3  # m, 1/(2 × 27/in); Table 7-2 prints 0.47035
-AREAL_MASS = 0.477  # kg/m², MODEL.md §1.8
+AREAL_MASS = 0.477  # kg/m², docs/model.md §1.8
 
 
 def kevlar_doc() -> dict:

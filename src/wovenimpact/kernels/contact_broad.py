@@ -1,4 +1,4 @@
-"""Broad phase of the shell–shell contact: hashed-grid search with per-node skins (MODEL.md §4).
+"""Broad phase of the shell–shell contact: hashed-grid search with per-node skins (docs/model.md §4).
 
 Candidates are (node, segment) pairs, a segment being the quad of a live element that
 takes part in contact. The narrow phase (:mod:`contact_narrow`) can only make a pair

@@ -1,4 +1,4 @@
-"""Narrow phase of the shell–shell contact: node-to-segment penalty (MODEL.md §4).
+"""Narrow phase of the shell–shell contact: node-to-segment penalty (docs/model.md §4).
 
 Input: the node-major candidate list of :mod:`contact_broad` (``pair_ptr``,
 ``pair_seg``). Every node of every ply is tested against the segments of the other

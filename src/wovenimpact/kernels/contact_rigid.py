@@ -1,4 +1,4 @@
-"""Penalty contact of shell nodes against a rigid body of revolution (MODEL.md §4).
+"""Penalty contact of shell nodes against a rigid body of revolution (docs/model.md §4).
 
 The body is its meridian profile (a polyline (ζ_i, ρ_i) from the tip on the axis to
 the tail on the axis, ζ along the unit axis a from the tip at c). A node at p has

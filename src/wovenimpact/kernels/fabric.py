@@ -1,7 +1,7 @@
 """Yarn-crossover model of a dry plain-weave fabric: one material-point update.
 
 docs/theory.md §1 states the model; thesis ch. 3.5–3.6 and 6.2 are its source,
-MODEL.md §1 the corrections. Per point, given the in-plane deformation gradient
+docs/model.md §1 the corrections. Per point, given the in-plane deformation gradient
 F (2×2, mapping the reference yarn frame — warp along x, fill along y — to the
 current corotational frame), the kernel
 

@@ -1,7 +1,7 @@
 """Plane-stress J2 plasticity of a metal shell point: one material-point update.
 
 docs/theory.md "Metal shells (kernels/j2.py)" states the model and numbers the
-equations (J1)–(J14) cited below; MODEL.md §5 and thesis 8.2.3 / 8.3.1 are its
+equations (J1)–(J14) cited below; docs/model.md §5 and thesis 8.2.3 / 8.3.1 are its
 source. Per point, given the in-plane deformation gradients F_old, F_new (2×2,
 reference material frame → current corotational frame) and the step Δt, the kernel
 

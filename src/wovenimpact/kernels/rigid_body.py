@@ -1,4 +1,4 @@
-"""Rigid-body dynamics of impactors, central differences like the nodes (MODEL.md §4).
+"""Rigid-body dynamics of impactors, central differences like the nodes (docs/model.md §4).
 
 State row of a body (``State.bodies``, layout below): centre-of-mass position x^n,
 velocity v^{n−1/2}, rotation matrix R^n (body → global, row-major) and body-frame

@@ -1,6 +1,6 @@
 """Four-node corotational shell, one in-plane point (Belytschko–Lin–Tsay family).
 
-docs/theory.md §2; thesis ch. 4.4; MODEL.md §2. Per element and step, given the
+docs/theory.md §2; thesis ch. 4.4; docs/model.md §2. Per element and step, given the
 positions x^n and the half-step velocities v^{n−1/2}, ω^{n−1/2}:
 
 1. corotational frame: e3 along d13 × d24 (diagonals), e1 along side 1→2

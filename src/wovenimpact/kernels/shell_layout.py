@@ -7,7 +7,7 @@ Sections (``Model.sections``, one row per section, SI):
 - ``C_AREAL_MASS``: mass per unit reference area μ (kg/m²).
 - ``C_BEND_E``, ``C_BEND_NU``: modulus and Poisson ratio of the bending resultant
   M = D κ, D = E t³/(12 (1 − ν²)) (the metal's own, or the small elastic bending
-  stiffness of a fabric, MODEL.md §1.8).
+  stiffness of a fabric, docs/model.md §1.8).
 - ``C_SHEAR_G``: transverse shear modulus G of Q = k G t γ (Pa); ``C_SHEAR_K`` its
   factor k (5/6).
 - ``C_HOURGLASS``: hourglass stiffness coefficient r (—).

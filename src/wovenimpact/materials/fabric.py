@@ -51,7 +51,7 @@ class YarnFamily:
 
 @dataclass(frozen=True)
 class FabricOptions:
-    """Model variants (MODEL.md §1.4–1.7; docs/theory.md §1.8)."""
+    """Model variants (docs/model.md §1.4–1.7; docs/theory.md §1.8)."""
 
     homogenisation: Literal["virial", "thesis"] = "virial"
     shear: Literal["true", "thesis"] = "true"

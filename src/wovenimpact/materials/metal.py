@@ -1,6 +1,6 @@
 """SI parameter set of the metals: J2 plasticity (blade, casing) and elastic (impactor).
 
-MODEL.md §5; thesis 7.1.2 (Table 7-1, steel impactor), 8.2.3 (Table 8-1, titanium
+docs/model.md §5; thesis 7.1.2 (Table 7-1, steel impactor), 8.2.3 (Table 8-1, titanium
 blade), 8.3.1 (Table 8-2, aluminium casing). Plane-stress J2 with a piecewise-linear
 isotropic hardening table; a point fails when its equivalent plastic strain reaches
 ``fracture_strain``, or, with a Johnson–Cook damage set, when its damage reaches 1.

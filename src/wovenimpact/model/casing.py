@@ -1,4 +1,4 @@
-"""Containment geometry (thesis ch. 8, MODEL.md §6): coaxial casing layers and a fan blade.
+"""Containment geometry (thesis ch. 8, docs/model.md §6): coaxial casing layers and a fan blade.
 
 ``casing_mesh`` builds N coaxial cylindrical layers about the z axis (an inner metal
 shell and fabric plies, or metal layers), each on its own nodes; ``blade_mesh`` a flat

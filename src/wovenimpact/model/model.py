@@ -57,7 +57,7 @@ class Section:
         material: fabric (crossover kernel) or an elastic metal.
         thickness: t (m); default for a fabric: 4 h0 (its shell thickness).
         bending_modulus: E_b of M = E_b t³/(12(1 − ν_b²)) κ (Pa); default the
-            metal's E; for a fabric it must be given (MODEL.md §1.8).
+            metal's E; for a fabric it must be given (docs/model.md §1.8).
         bending_poisson: ν_b (—); default the metal's ν, 0 for a fabric.
         transverse_shear_modulus: G of Q = k G t γ (Pa); default the metal's G; for
             a fabric it must be given (thesis: 3.28 GPa).
@@ -86,7 +86,7 @@ class Section:
     membrane: str | None = None
 
     def points_for(self, m) -> int:
-        """Through-thickness points: as given, else 5 for a plastic metal (MODEL.md §2)
+        """Through-thickness points: as given, else 5 for a plastic metal (docs/model.md §2)
         and 1 (resultant section) otherwise."""
         if self.points is not None:
             return self.points
@@ -106,7 +106,7 @@ class Section:
                     f"section {name!r}: a fabric section needs transverse_shear_modulus "
                     "(e.g. '3.28 GPa') and, unless it is integrated through the thickness "
                     "(points ≥ 3), bending_modulus (the small elastic bending stiffness of "
-                    "MODEL.md §1.8, e.g. '1 GPa')"
+                    "docs/model.md §1.8, e.g. '1 GPa')"
                 )
             e_b = 1.0 if self.bending_modulus is None else self.bending_modulus  # unused if points > 1
             nu_b = self.bending_poisson or 0.0

@@ -1,4 +1,4 @@
-"""Contact stage of the step: impactors on shells, and shells on shells (MODEL.md §4).
+"""Contact stage of the step: impactors on shells, and shells on shells (docs/model.md §4).
 
 Called between the element stage and the node update. It fills ``ws.f_con`` (the
 contact forces on the nodes at x^n, external loads of the shells) and the resultant

@@ -34,7 +34,7 @@ from wovenimpact.studies.ballistics import SETTLED, unsettled
 
 ROOT = Path(__file__).resolve().parents[3]
 KEY = "mesh.casing.layers"
-# thesis ch. 8 (MODEL.md §6): exit speed (m/s) of the fragment from 149 m/s
+# thesis ch. 8 (docs/model.md §6): exit speed (m/s) of the fragment from 149 m/s
 THESIS_HYBRID = {4: 133.0, 6: 131.0, 8: 129.0, 10: 124.0}
 THESIS_METAL = {4: 123.3, 8: 111.0, 12: 95.5, 18: 81.9, 20: 35.9, 24: 0.6}
 LADDERS = (

@@ -3,7 +3,7 @@
 Runs the chapter-7 plate-impact cases and studies of ``examples/`` (resuming whatever
 is already in the work directory), then writes a Markdown report with our numbers next
 to the thesis's, the ballistic fits and the comparison figures. The thesis's own units
-were inconsistent (MODEL.md §7): its numbers are trends to compare with, not targets,
+were inconsistent (docs/model.md §7): its numbers are trends to compare with, not targets,
 and nothing here is tuned to them. Only decided runs (perforated or stopped) enter a fit
 or a convergence verdict; the others are named as not decided.
 """

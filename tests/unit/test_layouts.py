@@ -23,6 +23,7 @@ LAYOUT_MODULES = (
     "wovenimpact.kernels.shell_layout",  # sections, element state, material kinds, EL_*
     "wovenimpact.kernels.fabric_layout",  # crossover parameter and point-state vectors
     "wovenimpact.kernels.j2_layout",  # J2 parameter and point-state vectors
+    "wovenimpact.kernels.solid_layout",  # hexahedron state H_*, transversely isotropic TI_*
     "wovenimpact.kernels.rigid_body",  # body state B_* and parameters BP_*
     "wovenimpact.kernels.contact_narrow",  # pair table GEO_*, segment table SG_*
     "wovenimpact.kernels.integrate",  # boundary-condition codes

@@ -137,3 +137,30 @@ class BlockScratch(NamedTuple):
     out_el: np.ndarray  # the element state and the isotropic step
     out_blk: np.ndarray  # corner forces
     pending: np.ndarray  # (n_blocks · LANES,) int8: 1 where shell_force takes the lane
+
+
+class HexMesh(NamedTuple):
+    """What the hexahedron kernel reads of a Model (never written; kernels.hex8)."""
+
+    hexes: np.ndarray  # (n_elems, 8) corner nodes, solid_layout node order
+    elem_mat: np.ndarray  # (n_elems,) row of ``mat_params``
+    mat_params: np.ndarray  # (n_materials, n_par) parameter rows (solid_layout TI_*)
+    frame: np.ndarray  # (n_elems, 3, 3) material axes a1, a2, a3 (rows, global components)
+    ref_grad: np.ndarray  # (n_elems, 3, 8) b⁰_I = (1/V0) ∫ ∇N_I dV in the reference
+    vol0: np.ndarray  # (n_elems,) reference volumes V0
+    hg_stiffness: np.ndarray  # (n_elems,) hourglass stiffness k (N/m)
+
+
+class HexTables(NamedTuple):
+    """Hexahedron state at the start (``el_in``) and end (``el_out``, written) of the
+    step, (n_elems, N_HEX_STATE) each (solid_layout H_*)."""
+
+    el_in: np.ndarray
+    el_out: np.ndarray
+
+
+class HexResults(NamedTuple):
+    """What the hexahedron stage writes beside the state tables."""
+
+    blocks: np.ndarray  # (n_elems, 8, 3) internal corner forces (global)
+    status: np.ndarray  # (n_elems,) int32 EL_* codes

@@ -93,6 +93,16 @@ class Impactor:
             return self.radius
         return {"flat": self.fillet, "hemispherical": self.radius}.get(self.nose, self.nose_length)
 
+    def edge_radius(self, sideways: bool = False) -> float:
+        """The smallest radius of curvature of the surface that strikes (m): a sphere's
+        radius; a body flying sideways strikes with its side, the shank radius; nose
+        first, a flat nose's fillet (0: a sharp rim), a hemispherical nose's radius, a
+        conical or ogive nose's tip (0: pointed). A mesh resolves the contact only with
+        elements well below it (:mod:`wovenimpact.mesh_verdict`)."""
+        if self.shape == "sphere" or sideways or self.nose == "hemispherical":
+            return self.radius
+        return self.fillet if self.nose == "flat" else 0.0
+
     def radius_at(self, zeta):
         """R(ζ) of the profile (0 outside [0, L])."""
         z = np.asarray(zeta, dtype=float)

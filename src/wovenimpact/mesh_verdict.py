@@ -8,6 +8,15 @@ the lengths its table was calibrated on (the table's first and last rows). The l
 judged are those of the material's elements that failed (eroded) in the run — not a
 blade's release row, which is let go — or all of its elements if none did: a contained or
 stopped run is judged by where it could have failed.
+
+A failure law calibrated on elements of one size cannot make up for a contact the mesh
+does not resolve: a striker's edge of radius R (a blade's edge, half its thickness; a
+projectile's rim fillet; Impactor.edge_radius) is felt as a blunter one by elements much
+larger than R, which then take more energy before they fail (docs/theory.md §8.8:
+the blade-edge strip and the blunt projectile's ladder). Each struck material's verdict
+therefore also says whether its judged elements are at most ``RESOLVED_FRACTION`` × R —
+a necessary condition for an answer that holds when the mesh is refined, not a
+sufficient one.
 """
 
 from __future__ import annotations
@@ -19,6 +28,7 @@ from wovenimpact.kernels import j2_layout as JL
 from wovenimpact.kernels import shell_layout as SL
 
 REFERENCE_TOLERANCE = 0.1  # an unregularised law: elements within 10 % of its reference length
+RESOLVED_FRACTION = 0.5  # elements up to half the striker's edge radius resolve its contact
 SUMMARY_KEY = "mesh_verdict"
 
 
@@ -66,6 +76,9 @@ def mesh_verdict(model, state) -> dict:
         return out
     eroded = state.elem[:, SL.E_ALIVE] == 0.0
     eroded[model.release_elems] = False  # a blade's release row is let go, not failed
+    radius = float(getattr(model, "striking_radius", np.inf))
+    striker_mats = {int(model.sections[model.elem_section[e], SL.C_MAT])
+                    for e in model.release_elems[:1]}  # a blade is not struck by itself
     for m in range(len(model.mat_kind)):
         if not fails(model, m):
             continue
@@ -92,12 +105,18 @@ def mesh_verdict(model, state) -> dict:
                 and np.all(np.abs(ratio_hi - 1.0) <= REFERENCE_TOLERANCE)
             verdict, ok = ("at the reference size", True) if near else ("not regularised", False)
         name = model.material_names[m] or f"material {m}"
+        resolved = None  # no striker, or the striker's own material
+        if np.isfinite(radius) and m not in striker_mats:
+            resolved = bool(hi <= RESOLVED_FRACTION * radius * (1.0 + 1e-9))
+            ok = ok and resolved
         out[name] = {
             "element_length_mm": [lo * 1e3, hi * 1e3],
             "reference_length_mm": float(ref.max() * 1e3) if np.any(ref > 0.0) else None,
             "calibrated_range_mm": span,
             "judged_on": "eroded elements" if failed.any() else "all its elements",
             "verdict": verdict,
+            "striking_radius_mm": radius * 1e3 if np.isfinite(radius) else None,
+            "striker_resolved": resolved,
             "ok": bool(ok),
         }
     return out
@@ -117,5 +136,11 @@ def verdict_text(verdicts: dict) -> tuple[str, bool | None]:
         against = "" if ref is None else (
             f" (calibrated {ref[0]:.3g}–{ref[1]:.3g} mm)" if v["calibrated_range_mm"]
             else f" (reference {ref[0]:.3g} mm)")
-        parts.append(f"{name}: {size}, {v['verdict']}{against}")
+        edge = ""
+        if v.get("striker_resolved") is not None:
+            r = v["striking_radius_mm"]
+            edge = (f"; the striker's edge (radius {r:.3g} mm) resolved" if v["striker_resolved"]
+                    else f"; coarser than half the striker's edge radius ({r:.3g} mm): its "
+                    "contact is not resolved")
+        parts.append(f"{name}: {size}, {v['verdict']}{against}{edge}")
     return "; ".join(parts), all(v["ok"] for v in verdicts.values())

@@ -72,3 +72,55 @@ def test_a_metal_without_a_reference_length_is_not_regularised_and_an_elastic_on
     model = build_model(mesh.nodes, mesh.quads, {"s": Section(steel, thickness=1e-3)},
                         ["s"] * mesh.n_elems)
     assert mesh_verdict(model, initial_state(model)) == {}
+
+
+def test_the_edge_radius_is_what_strikes_first():
+    """Sphere: its radius; a flat nose: its fillet (0, sharp); hemispherical: the radius;
+    conical: a point; any cylinder flying sideways: its shank radius."""
+    from wovenimpact.impactor import Impactor
+
+    assert Impactor("sphere", 3e-3).edge_radius() == 3e-3
+    flat = Impactor("cylinder", 5e-3, length=20e-3, fillet=0.5e-3)
+    assert flat.edge_radius() == 0.5e-3 and flat.edge_radius(sideways=True) == 5e-3
+    assert Impactor("cylinder", 5e-3, length=20e-3).edge_radius() == 0.0
+    assert Impactor("cylinder", 5e-3, length=20e-3, nose="hemispherical").edge_radius() == 5e-3
+    cone = Impactor("cylinder", 5e-3, length=20e-3, nose="conical", nose_length=8e-3)
+    assert cone.edge_radius() == 0.0
+
+
+def struck(size, radius, sideways=False):
+    """An at-reference-size fabric plate (one crossover cell, so its own law passes)
+    struck by a sphere of ``radius``, or a cylinder of that radius flying sideways."""
+    from wovenimpact.impactor import Impactor
+    from wovenimpact.model.model import RigidBody
+
+    imp = (Impactor("cylinder", radius, length=10 * radius) if sideways
+           else Impactor("sphere", radius))
+    body = RigidBody(imp, tip=(0.0, 0.0, 2 * radius), axis=(0.0, 1.0, 0.0) if sideways else None)
+    mesh = plate_mesh(16 * size, size)
+    model = build_model(mesh.nodes, mesh.quads, {"s": Section(fabric(), **FABRIC_SECTION)},
+                        ["s"] * mesh.n_elems, bodies=[body])
+    found = mesh_verdict(model, initial_state(model))
+    return found["kevlar_thesis"], {"mesh_verdict": found}
+
+
+def test_a_struck_material_passes_only_on_elements_up_to_half_the_strikers_edge_radius():
+    """Elements of one crossover cell (0.94 mm) under a 2 mm sphere (0.94 ≤ 0.5 × 2 mm)
+    resolve it; under a 1.5 mm sphere (0.94 > 0.75 mm) they do not, and the
+    box goes red even though the fabric is at its reference size. A cylinder flying sideways
+    is judged by its shank radius."""
+    ok, summary = struck(CELL, 2.0e-3)
+    assert ok["striker_resolved"] is True and ok["ok"] and ok["striking_radius_mm"] == 2.0
+    assert mesh_box(summary).status == "pass" and "(radius 2 mm) resolved" in mesh_box(summary).value
+    bad, summary = struck(CELL, 1.5e-3)
+    assert bad["verdict"] == "at the reference size" and bad["striker_resolved"] is False
+    assert not bad["ok"] and mesh_box(summary).status == "fail"
+    assert "its contact is not resolved" in mesh_box(summary).value
+    side, _ = struck(CELL, 2.0e-3, sideways=True)
+    assert side["striking_radius_mm"] == 2.0 and side["striker_resolved"] is True
+
+
+def test_without_a_striker_nothing_is_said_of_one():
+    alone, summary = verdict(fabric(), CELL, **FABRIC_SECTION)
+    assert alone["striker_resolved"] is None and alone["striking_radius_mm"] is None
+    assert "striker" not in mesh_box(summary).value

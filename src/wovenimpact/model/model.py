@@ -426,6 +426,10 @@ class Model:
     elem_failure: np.ndarray = field(default_factory=lambda: np.zeros((0, 6)))
     eroded_nodes: str = "remove"
     body_travel: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    # the smallest edge radius of what strikes the structure (m; inf: nothing does): the
+    # rigid bodies' (Impactor.edge_radius) and a released blade's half thickness — read by
+    # the mesh verdict only, so not in the digest
+    striking_radius: float = math.inf
 
     @property
     def n_nodes(self) -> int:
@@ -859,6 +863,10 @@ def build_model(
         body_params[i] = bp
         body_profiles[i, : len(prof)] = prof
         body_state0[i] = st0
+    striking = [b.impactor.edge_radius(sideways=b.axis is not None) for b in bodies or ()]
+    rel = release_array(release_elems, len(q))
+    if rel.size:  # a blade strikes with its edge: half its shell's thickness
+        striking.append(0.5 * float(sec_table[es[rel[0]], SL.C_THICK]))
     return Model(
         x0=x0, quads=q, elem_section=es, sections=sec_table,
         mat_kind=np.array(kinds, dtype=np.int64), mat_params=mat_params,
@@ -873,7 +881,8 @@ def build_model(
         body_state0=body_state0, body_travel=body_travel,
         node_sets=dict(node_sets or {}), elem_sets=dict(elem_sets or {}),
         shell_contact=shell_contact or ShellContactParams(),
-        release_elems=release_array(release_elems, len(q)), release_time=float(release_time),
+        release_elems=rel, release_time=float(release_time),
+        striking_radius=min(striking, default=math.inf),
         erode_inverted=bool(erode_inverted),
         section_names=tuple(names), material_names=tuple(getattr(m, "name", "") for m in mats),
         mass_scaling_fraction=float(mass_scaling_fraction),

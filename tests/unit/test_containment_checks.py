@@ -50,7 +50,8 @@ def ring():
 
 
 def checked(ring, spec_changes=None, *, x_shift=None, layers=None, blade_scale=None):
-    """Run check_containment on a copy of ``ring`` with its geometry changed."""
+    """Run check_containment on a copy of ``ring`` with its geometry changed; the warnings
+    it gave, as text (an error propagates)."""
     from wovenimpact.model.containment_checks import check_containment
     from wovenimpact.spec.case import case_from_dict
     from wovenimpact.spec.fields import read_toml, set_dotted
@@ -69,11 +70,30 @@ def checked(ring, spec_changes=None, *, x_shift=None, layers=None, blade_scale=N
     doc = read_toml(CASE, "case")
     for key, value in {**COARSE, **(spec_changes or {})}.items():
         set_dotted(doc, key, value)
-    check_containment(case_from_dict(doc, str(CASE)), model, state, mesh)
+    spec = case_from_dict(doc, str(CASE))
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        check_containment(spec, model, state, mesh)
+    return [str(w.message) for w in caught if issubclass(w.category, InputWarning)]
 
 
 def test_the_example_passes_every_check(ring):
-    checked(ring)
+    """Neither an error nor a warning for the example as it is; the same call with the
+    blade 1 % larger, its tip through the casing, is refused (so the check does look)."""
+    assert checked(ring) == []
+    with pytest.raises(InputError, match="would start in contact with, or through"):
+        checked(ring, blade_scale=1.01)
+
+
+def test_free_cut_edges_of_a_sector_are_warned_of(ring):
+    """The ring has no cut edges; a sector whose cut edges no boundary clamps is warned of
+    (and is the only warning of the otherwise sound example)."""
+    ring_sector = copy.deepcopy(ring)
+    layer0 = ring.mesh.node_sets["casing.layer0"]
+    free = layer0[np.all(ring.model.bc_code[layer0] == 0, axis=1)]
+    ring_sector.mesh.node_sets["casing.cut_edges"] = free[:3]
+    warned = checked(ring_sector)
+    assert len(warned) == 1 and "cut edges (node set casing.cut_edges) are free" in warned[0]
 
 
 def test_a_layer_listed_twice_is_refused(ring):
@@ -92,7 +112,7 @@ def test_a_casing_off_the_spin_axis_is_refused(ring):
     m/s for a 160 m/s fragment."""
     with pytest.raises(InputError, match="surface about the z axis"):
         checked(ring, x_shift=0.1)
-    checked(ring, x_shift=1e-4)  # a tenth of a millimetre is no reason to refuse
+    assert checked(ring, x_shift=1e-4) == []  # a tenth of a millimetre: no error, no warning
 
 
 def test_a_blade_reaching_the_casing_is_refused(ring):

@@ -99,7 +99,7 @@ def test_any_case_value_gives_a_clean_error_or_a_sane_run(doc):
             event("refused")
             lines = str(err).splitlines()
             assert lines, "an InputError without a message"
-            for line in lines:  # one line per problem, naming the file and the key
+            for line in lines:  # one line per problem, naming the key
                 m = PROBLEM_LINE.match(line)
                 assert m, f"names no key of the case: {line!r}"
                 for key in m["key"].split(" / "):

@@ -29,7 +29,7 @@ def validate(
 ) -> None:
     """Run (or resume) the example cases and thesis studies; write the validation report."""
     from wovenimpact.io.outdir import check_output_file, prepare_output_dir, write_failure
-    from wovenimpact.studies.validation import ROOT, STUDIES, run_validation
+    from wovenimpact.studies.validation import ON_REQUEST, ROOT, STUDIES, run_validation
 
     if containment:
         _containment(work, report or ROOT / "docs" / "validation_containment.md", workers,
@@ -41,10 +41,10 @@ def validate(
     if report is None:
         report = work / "validation.md" if study else ROOT / "docs" / "validation.md"
     try:
-        unknown = [s for s in study or () if s not in STUDIES]
+        unknown = [s for s in study or () if s not in STUDIES + ON_REQUEST]
         if unknown:
             raise InputError(f"--study {unknown[0]!r}: no such study (valid: one of "
-                             f"{', '.join(STUDIES)})")
+                             f"{', '.join(STUDIES + ON_REQUEST)})")
         prepare_output_dir(work, "--work")
         check_output_file(report, "--report")
         path = run_validation(work, report,

@@ -25,6 +25,7 @@ from wovenimpact.io.report import write_index
 from wovenimpact.studies.ballistics import DECIDED
 from wovenimpact.studies.metal_validation import metal_section
 from wovenimpact.studies.strip_validation import STUDY as STRIP_STUDY
+from wovenimpact.studies.mesh_validation import RING_STUDIES, ring_section
 from wovenimpact.studies.strip_validation import strip_section
 from wovenimpact.spec.fields import read_toml, set_dotted
 
@@ -34,7 +35,10 @@ THESIS_RESIDUAL = {"plies1_100": "82–85", "plies2_100": "58", "plies4_100": "1
                    "plies6_100": "0 (stopped)", "plies4_120": "— (ELVS data, not in text)"}
 STUDIES = ("thesis_velocity", "thesis_plies", "thesis_plate_size", "thesis_crimp",
            "thesis_compaction", "thesis_element_size", "thesis_velocity_v50",
-           "thesis_velocity_v50_2plies", "hourglass", "design_175", STRIP_STUDY)
+           "thesis_velocity_v50_2plies", "hourglass", "design_175", STRIP_STUDY,
+           "mesh_ring_v0")
+# studies run only when asked for (`wovenimpact validate --study NAME`): hours of ring runs
+ON_REQUEST = ("mesh_ring_hybrid4",)
 # the design search of the README: fewest plies that stop the FSP at 175 m/s, by runs
 DESIGN = {"design_175": ("plies1_100", ("impactor.velocity=175 m/s",), 2)}
 THESIS_STUDY_NOTE = {
@@ -394,6 +398,9 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
             continue
         if study == STRIP_STUDY:  # issue 36, V1: its own section (two variants, acceptance)
             lines += strip_section(work, figures, workers=workers, log=log)
+            continue
+        if study in RING_STUDIES:  # issue 36, V0 and V2: the ring's mesh studies
+            lines += ring_section(study, work, workers=workers, log=log)
             continue
         path = ROOT / "examples" / "studies" / f"{study}.toml"
         if not path.exists():

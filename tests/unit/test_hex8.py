@@ -291,15 +291,28 @@ def full_integration_energy(x, u, c_voigt):
     return energy
 
 
-def test_hourglass_coefficient_8_3_is_the_full_integration_bending_energy():
-    """Scale of r: on a cube of an isotropic ν = 0 material, r = 8/3 gives the ξη mode
-    (displacement in its plane) the energy the fully integrated element gives it."""
+def physical_coefficient(mode, direction):
+    """r at which a cube's hourglass energy equals the fully integrated element's, for an
+    isotropic ν = 0 material (G_hg = G): ½ k q² = ½ ∫ ε:C:ε dV with k = 3/2 r G h gives
+    r = 8/3 for a displacement in the plane of a two-index mode (ηζ, ξζ, ξη), 16/9 across
+    it, and 32/27 for ξηζ (docs/solid.md, "Scale of r")."""
+    if mode == 3:
+        return 32.0 / 27.0
+    across = (0, 1, 2)[mode]  # ηζ: x, ξζ: y, ξη: z
+    return 16.0 / 9.0 if direction == across else 8.0 / 3.0
+
+
+@pytest.mark.parametrize("mode", range(4))
+@pytest.mark.parametrize("direction", range(3))
+def test_scale_of_r_against_the_fully_integrated_element(mode, direction):
     g = 10e9
     iso = TransverseIsotropicParameters(e11=2 * g, e22=2 * g, g12=g, g23=g, nu12=0.0,
                                         nu23=0.0, density=1000.0)
-    model = one_element(cube_nodes(), params=iso, hourglass=8.0 / 3.0)
+    model = one_element(cube_nodes(), params=iso, hourglass=physical_coefficient(mode,
+                                                                                 direction))
+    h_alpha = np.array([L.HEX_H1, L.HEX_H2, L.HEX_H3, L.HEX_H4][mode])
     u = np.zeros((8, 3))
-    u[:, 0] = HG_AMPLITUDE * PARENT[:, 0] * PARENT[:, 1]
+    u[:, direction] = HG_AMPLITUDE * h_alpha
     _, out = jump(model, cube_nodes() + u)
     reference = full_integration_energy(cube_nodes(), u, iso.stiffness())
     assert out[0, L.H_W_HG] == pytest.approx(reference, rel=FIRST_ORDER)

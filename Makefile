@@ -25,8 +25,10 @@ run: venv
 	@echo "Flagship: out/plies4_120/ (summary.json, history.csv, plots/, fields/fields.pvd for ParaView)"
 	@echo "Report: out/plies4_120/report.html"
 
+# One pytest worker per core (pytest-xdist): on a fresh clone most of the suite's time is Numba
+# compiling the kernels into the cache, which two workers share; the slowest tests are listed.
 test: venv
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n auto --durations=15
 
 # docs/case_keys.md, the key reference generated from the input schemas (a test checks it is
 # current).

@@ -65,6 +65,25 @@ def _jsonable(v):
     return v
 
 
+def cell(v) -> str:
+    """A value as a table cell: numbers to 6 significant digits (NumPy scalars too, inside
+    lists and mappings), markup escaped — rich reads "[np.float64(…)]" as a tag and drops it."""
+    def text(x) -> str:
+        if isinstance(x, (bool, str)) or x is None:
+            return str(x)
+        if hasattr(x, "item") and getattr(x, "ndim", 0) == 0:
+            x = x.item()
+        if isinstance(x, float):
+            return f"{x:.6g}"
+        if isinstance(x, Mapping):
+            return "{" + ", ".join(f"{k}: {text(y)}" for k, y in x.items()) + "}"
+        if isinstance(x, (list, tuple)) or hasattr(x, "tolist"):
+            return "[" + ", ".join(text(y) for y in (x.tolist() if hasattr(x, "tolist") else x)) + "]"
+        return str(x)
+
+    return escape(text(v))
+
+
 def emit(result: Mapping, as_json: bool, title: str) -> None:
     """Print ``result`` as one JSON object on stdout, or as a table for a person."""
     if as_json:
@@ -74,7 +93,7 @@ def emit(result: Mapping, as_json: bool, title: str) -> None:
     table.add_column("quantity")
     table.add_column("value", justify="right")
     for k, v in result.items():
-        table.add_row(k, f"{v:.6g}" if isinstance(v, float) else str(v))
+        table.add_row(escape(str(k)), cell(v))
     console.print(table)
 
 

@@ -9,7 +9,7 @@ import typer
 from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
-from wovenimpact.cli.app import app, console, err_console, fail
+from wovenimpact.cli.app import app, cell, console, err_console, fail
 from wovenimpact.errors import InputError
 
 
@@ -66,7 +66,7 @@ def sweep(
         for col in rows[0]:
             table.add_column(col)
         for r in rows:
-            table.add_row(*(f"{v:.6g}" if isinstance(v, float) else str(v) for v in r.values()))
+            table.add_row(*(cell(v) for v in r.values()))
         console.print(table)
         console.print(f"report: {out_dir / 'report.html'}")
     if failed:

@@ -89,3 +89,21 @@ def test_study_page_links_each_run_page_and_inlines_the_plots(tmp_path):
     index = read_page(write_index(tmp_path, "all"))
     assert "study/report.html" in index.links and "study/runs/aaa/report.html" in index.links
     assert all((tmp_path / link).exists() for link in index.links)
+
+
+def test_the_page_shows_the_summarys_case_digest_not_a_second_one(tmp_path):
+    """One case digest per run: the provenance table repeats summary.json's (the resolved
+    case) and its run digest; the digest of the case text is shown only when the summary
+    has no provenance."""
+    from wovenimpact.io.report import digest
+
+    text = '[case]\nname = "x"\n'
+    out = fake_run(tmp_path / "run", energy_error_fraction=0.0,
+                   provenance={"case_digest": "7f24bebc00000000", "digest": "d1d2d3d4d5d6d7d8"})
+    html = write_run_report(out, case_text=text, overrides=["a=1"]).read_text()
+    provenance = html[html.index('id="provenance"'):]
+    assert "7f24bebc00000000" in provenance and "d1d2d3d4d5d6d7d8" in provenance
+    assert digest(text + "\n--set a=1") not in html
+    bare = fake_run(tmp_path / "bare", energy_error_fraction=0.0)
+    assert digest(text + "\n--set a=1") in write_run_report(bare, case_text=text,
+                                                            overrides=["a=1"]).read_text()

@@ -212,11 +212,18 @@ def write_run_report(out_dir: str | Path, *, spec=None, case_text: str | None = 
     body.append("<p>Overrides (--set / study parameters): "
                 + (", ".join(f"<code>{escape(o)}</code>" for o in overrides) or "none")
                 + "</p>")
-    case_digest = digest(shown + "".join(f"\n--set {o}" for o in overrides)) if shown else "n/a"
+    prov = summary.get("provenance") if isinstance(summary.get("provenance"), dict) else {}
+    if "case_digest" in prov:  # one digest on the page: the summary's (provenance.py)
+        case_row = {"item": "case digest (SHA-256 of the case as resolved, overrides applied)",
+                    "value": prov["case_digest"]}
+    else:  # a summary without provenance (an element test): the text and overrides
+        case_row = {"item": "case digest (SHA-256 of the text and overrides)",
+                    "value": digest(shown + "".join(f"\n--set {o}" for o in overrides))
+                    if shown else "n/a"}
     body += ['<h2 id="provenance">Provenance</h2>',
-             *_table([{"item": "wovenimpact version", "value": __version__},
-                      {"item": "case digest (SHA-256 of the text and overrides)",
-                       "value": case_digest},
+             *_table([{"item": "wovenimpact version", "value": __version__}, case_row,
+                      *([{"item": "run digest (case, files read and code)",
+                          "value": prov["digest"]}] if "digest" in prov else []),
                       {"item": "model digest", "value": model_digest or "n/a"},
                       {"item": "page written (UTC)",
                        "value": datetime.now(timezone.utc).strftime("%Y-%m-%d %H:%M:%S")}],

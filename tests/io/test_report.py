@@ -107,3 +107,20 @@ def test_the_page_shows_the_summarys_case_digest_not_a_second_one(tmp_path):
     bare = fake_run(tmp_path / "bare", energy_error_fraction=0.0)
     assert digest(text + "\n--set a=1") in write_run_report(bare, case_text=text,
                                                             overrides=["a=1"]).read_text()
+
+
+def test_a_containment_run_shows_its_fragments_exit_speed_and_thresholds_in_the_values_unit():
+    """The second box of a containment run names the fragment's exit speed (not a residual
+    velocity with a 0 m/s threshold); the energy error's threshold is in % like its value."""
+    from wovenimpact.io.report import verdicts
+
+    boxes = {v.key: v for v in verdicts({"outcome": "escaped", "energy_error_fraction": 4e-4,
+                                         "fragment_exit_speed_m_per_s": 125.4})}
+    speed = boxes["residual_velocity_m_per_s"]
+    assert speed.name == "fragment exit speed" and speed.value == "125.40 m/s"
+    assert speed.threshold == "none: contained" and speed.status == "fail"
+    energy = boxes["energy_error_fraction"]
+    assert energy.value == "0.04 %" and energy.threshold == "≤ 1 %" and energy.status == "pass"
+    plate = {v.key: v for v in verdicts({"outcome": "perforated", "residual_velocity_m_per_s": 84.0})}
+    assert plate["residual_velocity_m_per_s"].name == "residual velocity"
+    assert plate["residual_velocity_m_per_s"].threshold == "0 m/s"

@@ -86,19 +86,27 @@ def verdicts(summary: dict) -> list[Verdict]:
     residual_text = "n/a" if residual is None else f"{residual:.2f} m/s"
     if rebound is not None:
         residual_text += f" (rebound {rebound:.2f} m/s)"
+    # a containment run's second box is its fragment's exit speed (none when contained)
+    fragment = "residual_velocity_m_per_s" not in summary and (
+        "fragment_exit_speed_m_per_s" in summary)
+    speed_name, speed_limit = (("fragment exit speed", "none: contained") if fragment
+                               else ("residual velocity", "0 m/s"))
     return [
         Verdict("outcome", "outcome", "n/a" if outcome is None else str(outcome),
                 " or ".join(HELD), _status(None if outcome is None else outcome in HELD)),
-        Verdict("residual_velocity_m_per_s", "residual velocity", residual_text, "0 m/s",
+        Verdict("residual_velocity_m_per_s", speed_name, residual_text, speed_limit,
                 _status(None if residual is None else residual == 0.0)),
         Verdict("energy_error_fraction", "energy error",
-                "n/a" if error is None else f"{error * 100:.2g} %", f"≤ {limit:.2g}",
+                "n/a" if error is None else f"{error * 100:.2g} %", f"≤ {limit * 100:.2g} %",
                 _status(None if error is None else error <= limit)),
         Verdict("hourglass_fraction", "hourglass share of internal work",
                 "n/a" if hourglass is None else f"{hourglass:.1%}", f"≤ {HOURGLASS_LIMIT:.0%}",
                 _status(None if hourglass is None else hourglass <= HOURGLASS_LIMIT)),
         mesh_box(summary),
     ]
+
+
+MESH_THRESHOLD = "failure calibrated for these elements; the striker's edge resolved"
 
 
 def mesh_box(summary: dict) -> Verdict:
@@ -108,11 +116,9 @@ def mesh_box(summary: dict) -> Verdict:
 
     found = summary.get(SUMMARY_KEY)
     if found is None:
-        return Verdict(SUMMARY_KEY, "mesh", "n/a", "failure calibrated for these elements",
-                       "na")
+        return Verdict(SUMMARY_KEY, "mesh", "n/a", MESH_THRESHOLD, "na")
     text, ok = verdict_text(found)
-    return Verdict(SUMMARY_KEY, "mesh", text, "failure calibrated for these elements",
-                   _status(ok))
+    return Verdict(SUMMARY_KEY, "mesh", text, MESH_THRESHOLD, _status(ok))
 
 
 def _value_text(v) -> str:

@@ -23,7 +23,6 @@ from __future__ import annotations
 import json
 import sys
 import time
-from pathlib import Path
 
 import numba
 import numpy as np
@@ -34,6 +33,7 @@ from wovenimpact.jit import set_threads
 from wovenimpact.materials.metal import MetalParameters
 from wovenimpact.model import Section, build_model
 from wovenimpact.model.mesh import plate_mesh
+from performance_page import save_json  # benchmarks/ is the script's folder
 
 SIDE, SIZE, SPACING, THICK = 97e-3, 0.94e-3, 0.5e-3, 0.4998e-3
 
@@ -127,15 +127,6 @@ def main(argv: list[str]) -> None:
               f"{c['book_ns_per_node']:>7.1f} "
               f"{c['ns_per_node'] / c['reused_ns_per_node']:>6.2f}")
 
-
-def save_json(doc: dict, argv: list[str]) -> None:
-    """``--save=PATH``: write ``doc`` (what ``--json`` prints) to PATH as well, for
-    benchmarks/performance_page.py (``make bench`` renders docs/performance.md from it)."""
-    for arg in argv:
-        if arg.startswith("--save="):
-            path = Path(arg.split("=", 1)[1])
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
 
 
 if __name__ == "__main__":

@@ -16,7 +16,6 @@ import json
 import math
 import sys
 import time
-from pathlib import Path
 
 import numba
 import numpy as np
@@ -26,6 +25,7 @@ from wovenimpact.kernels import fabric_layout as L
 from wovenimpact.kernels.fabric import fabric_update_for_points
 from wovenimpact.spec import load_material
 from wovenimpact.materials.fabric import initial_state
+from performance_page import save_json  # benchmarks/ is the script's folder
 
 
 def stretch_shear(lam_w, lam_f, gamma):
@@ -84,15 +84,6 @@ def main(n: int = 200_000, repeats: int = 7) -> None:
         print(f"{results[i]['threads']} thread(s): exact / table = "
               f"{results[i]['ns_per_point_update'] / results[i + 1]['ns_per_point_update']:.2f}×")
 
-
-def save_json(doc: dict, argv: list[str]) -> None:
-    """``--save=PATH``: write ``doc`` (what ``--json`` prints) to PATH as well, for
-    benchmarks/performance_page.py (``make bench`` renders docs/performance.md from it)."""
-    for arg in argv:
-        if arg.startswith("--save="):
-            path = Path(arg.split("=", 1)[1])
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
 
 
 if __name__ == "__main__":

@@ -12,12 +12,12 @@ from __future__ import annotations
 import json
 import os
 import sys
-from pathlib import Path
 
 import numba
 
 from wovenimpact.benchmark import DEFAULT_SIZES, case_line, machine, machine_line, run_cases
 from wovenimpact.jit import configure_threading
+from performance_page import save_json  # benchmarks/ is the script's folder
 
 
 def main() -> None:
@@ -48,15 +48,6 @@ def main() -> None:
     else:
         print(f"threading layer: {numba.threading_layer()}")
 
-
-def save_json(doc: dict, argv: list[str]) -> None:
-    """``--save=PATH``: write ``doc`` (what ``--json`` prints) to PATH as well, for
-    benchmarks/performance_page.py (``make bench`` renders docs/performance.md from it)."""
-    for arg in argv:
-        if arg.startswith("--save="):
-            path = Path(arg.split("=", 1)[1])
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
 
 
 if __name__ == "__main__":

@@ -28,6 +28,16 @@ SECTION = re.compile(r"<!-- section: (?P<name>[\w-]+) -->\n(?P<body>.*?)<!-- end
                      re.S)
 
 
+def save_json(doc: dict, argv: list[str]) -> None:
+    """``--save=PATH`` among a benchmark's ``argv``: write ``doc`` (what its ``--json``
+    prints) to PATH as well, for this page (``make bench`` renders docs/performance.md)."""
+    for arg in argv:
+        if arg.startswith("--save="):
+            path = Path(arg.split("=", 1)[1])
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(json.dumps(doc, indent=1) + "\n", encoding="utf-8")
+
+
 def replace_sections(page: str, sections: dict[str, str]) -> str:
     """``page`` with the body of each section named in ``sections`` replaced; sections not
     named, and the text around the markers, are kept as they are."""

@@ -140,6 +140,8 @@ def verdict_text(verdicts: dict) -> tuple[str, bool | None]:
         if v.get("striker_resolved") is not None:
             r = v["striking_radius_mm"]
             edge = (f"; the striker's edge (radius {r:.3g} mm) resolved" if v["striker_resolved"]
+                    else "; struck by a sharp edge (radius 0), which no mesh resolves: give "
+                    "the impactor a fillet" if r == 0.0
                     else f"; coarser than half the striker's edge radius ({r:.3g} mm): its "
                     "contact is not resolved")
         parts.append(f"{name}: {size}, {v['verdict']}{against}{edge}")

@@ -124,3 +124,19 @@ def test_without_a_striker_nothing_is_said_of_one():
     alone, summary = verdict(fabric(), CELL, **FABRIC_SECTION)
     assert alone["striker_resolved"] is None and alone["striking_radius_mm"] is None
     assert "striker" not in mesh_box(summary).value
+
+
+def test_a_sharp_striker_is_never_resolved_and_the_box_says_so():
+    """A flat nose without a fillet strikes with a radius-0 rim: red on any mesh, and the
+    box says what to do."""
+    from wovenimpact.impactor import Impactor
+    from wovenimpact.model.model import RigidBody
+
+    body = RigidBody(Impactor("cylinder", 2.78e-3, length=5e-3), tip=(0.0, 0.0, 1e-3))
+    mesh = plate_mesh(16 * CELL, CELL)
+    model = build_model(mesh.nodes, mesh.quads, {"s": Section(fabric(), **FABRIC_SECTION)},
+                        ["s"] * mesh.n_elems, bodies=[body])
+    found = mesh_verdict(model, initial_state(model))
+    assert found["kevlar_thesis"]["striker_resolved"] is False
+    box = mesh_box({"mesh_verdict": found})
+    assert box.status == "fail" and "sharp edge (radius 0)" in box.value and "fillet" in box.value

@@ -22,7 +22,7 @@ from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels.contact_rigid import rigid_contact_forces
 from wovenimpact.model.compile import compile_case
 from wovenimpact.model.mesh import plate_mesh
-from wovenimpact.model.model import RigidBody, travel_of_row
+from wovenimpact.model.model import RigidBody, flies_sideways, travel_of_row
 from wovenimpact.quantities import impactor_row, intact_material_ahead, travel_direction
 from wovenimpact.spec.case import case_from_dict
 from wovenimpact.spec.fields import read_toml, set_dotted
@@ -47,7 +47,7 @@ def compiled(doc: dict, base: Path = STRIP.parent):
         return spec, compile_case(spec, base)
 
 
-def refused(doc: dict, *fragments: str) -> str:
+def check_refused(doc: dict, *fragments: str) -> str:
     with pytest.raises(InputError) as err:
         compiled(doc)
     text = str(err.value)
@@ -104,7 +104,7 @@ def test_a_square_given_its_width_is_the_square_of_before(quarter):
     ("impactor.axis", [0, 0, 0], ("impactor.axis", "non-zero")),
 ])
 def test_bad_widths_and_axes_are_refused_naming_the_key(key, value, fragments):
-    refused(strip_doc(**{key.replace(".", "__"): value}), *fragments)
+    check_refused(strip_doc(**{key.replace(".", "__"): value}), *fragments)
 
 
 # --- the body's frame ----------------------------------------------------------------
@@ -202,12 +202,14 @@ def test_a_sideways_body_in_a_quarter_model_must_be_symmetric_about_both_planes(
     """Its middle (tip + length/2 along the axis) on the z axis and its axis along x or
     y; the example (middle at y = 0) compiles, its cylinder moved 5 mm along y does not;
     an axis along x through the origin's middle compiles too."""
-    refused(strip_doc(impactor__position=["0 mm", "-20 mm", "5.4871 mm"]), "quarter model",
+    check_refused(strip_doc(impactor__position=["0 mm", "-20 mm", "5.4871 mm"]), "quarter model",
             "symmetric")
-    refused(strip_doc(impactor__axis=[0, 1, 1e-3]), "impactor.axis")
-    refused(strip_doc(impactor__axis=[1, 1, 0], impactor__position=["0 mm", "0 mm", "5.4871 mm"]),
+    check_refused(strip_doc(impactor__axis=[0, 1, 1e-3]), "impactor.axis")
+    check_refused(strip_doc(impactor__axis=[1, 1, 0], impactor__position=["0 mm", "0 mm", "5.4871 mm"]),
             "quarter model")
-    compiled(strip_doc(impactor__axis=[1, 0, 0], impactor__position=["-25 mm", "0 mm", "5.4871 mm"]))
+    _, along_x = compiled(strip_doc(impactor__axis=[1, 0, 0],
+                                    impactor__position=["-25 mm", "0 mm", "5.4871 mm"]))
+    assert along_x.model.body_params.shape[0] == 1 and flies_sideways(along_x.model)
 
 
 def full_strip(**changes) -> dict:
@@ -220,10 +222,11 @@ def test_a_sideways_path_that_misses_the_strip_is_refused():
     """The full strip (y within ±20 mm): a 50 mm edge from y = 30 mm passes beside it;
     travelling away (+z) the strip is behind it; the example's path (y from −25 mm)
     meets it."""
-    compiled(full_strip())
-    refused(full_strip(impactor__position=["0 mm", "30 mm", "5.4871 mm"]), "misses",
+    _, example = compiled(full_strip())
+    assert example.model.body_params.shape[0] == 1 and flies_sideways(example.model)
+    check_refused(full_strip(impactor__position=["0 mm", "30 mm", "5.4871 mm"]), "misses",
             "no node lies within")
-    refused(full_strip(impactor__direction=[0, 0, 1]), "misses", "behind the nose")
+    check_refused(full_strip(impactor__direction=[0, 0, 1]), "misses", "behind the nose")
 
 
 def test_intact_material_ahead_is_read_in_the_edge_s_shadow():

@@ -43,6 +43,20 @@ SPRING, DAMPING, FRICTION = 0, 1, 2  # kinds of the books: books[kind, a, b]
 N_KINDS = 3
 
 
+@kernel
+def relative_velocity(v, quads, pair_w, geo, p, k, s):
+    """(v_x, v_y, v_z, v_n) of node p relative to the point of segment s it touches in pair
+    k (the segment's node velocities weighted by pair_w[k]), v_n along the pair's normal —
+    the expressions of ``penalty_forces``."""
+    q0, q1, q2, q3 = quads[s, 0], quads[s, 1], quads[s, 2], quads[s, 3]
+    w0, w1, w2, w3 = pair_w[k, 0], pair_w[k, 1], pair_w[k, 2], pair_w[k, 3]
+    vx = v[p, 0] - (w0 * v[q0, 0] + w1 * v[q1, 0] + w2 * v[q2, 0] + w3 * v[q3, 0])
+    vy = v[p, 1] - (w0 * v[q0, 1] + w1 * v[q1, 1] + w2 * v[q2, 1] + w3 * v[q3, 1])
+    vz = v[p, 2] - (w0 * v[q0, 2] + w1 * v[q1, 2] + w2 * v[q2, 2] + w3 * v[q3, 2])
+    vn = vx * geo[k, GEO_N] + vy * geo[k, GEO_N + 1] + vz * geo[k, GEO_N + 2]
+    return vx, vy, vz, vn
+
+
 @loop_kernel
 def shell_pair_powers(v, quads, pair_seg, pair_w, geo, pair_f, pair_sd, pair_pw, active,
                       n_active, friction, node_part, seg_part, n_parts, act_if, act_pw):
@@ -59,12 +73,7 @@ def shell_pair_powers(v, quads, pair_seg, pair_w, geo, pair_f, pair_sd, pair_pw,
         p = active[j, 0]
         k = active[j, 1]
         s = pair_seg[k]
-        q0, q1, q2, q3 = quads[s, 0], quads[s, 1], quads[s, 2], quads[s, 3]
-        w0, w1, w2, w3 = pair_w[k, 0], pair_w[k, 1], pair_w[k, 2], pair_w[k, 3]
-        vx = v[p, 0] - (w0 * v[q0, 0] + w1 * v[q1, 0] + w2 * v[q2, 0] + w3 * v[q3, 0])
-        vy = v[p, 1] - (w0 * v[q0, 1] + w1 * v[q1, 1] + w2 * v[q2, 1] + w3 * v[q3, 1])
-        vz = v[p, 2] - (w0 * v[q0, 2] + w1 * v[q1, 2] + w2 * v[q2, 2] + w3 * v[q3, 2])
-        vn = vx * geo[k, GEO_N] + vy * geo[k, GEO_N + 1] + vz * geo[k, GEO_N + 2]
+        vx, vy, vz, vn = relative_velocity(v, quads, pair_w, geo, p, k, s)
         sp, dp = pair_sd[k, 0], pair_sd[k, 1]
         act_if[j] = node_part[p] * n_parts + seg_part[s]
         act_pw[j, 0] = pair_pw[k, SPRING]
@@ -117,12 +126,7 @@ def book_shell_pairs(v, quads, pair_seg, pair_w, geo, pair_f, pair_sd, pair_pw, 
         p = active[j, 0]
         k = active[j, 1]
         s = pair_seg[k]
-        q0, q1, q2, q3 = quads[s, 0], quads[s, 1], quads[s, 2], quads[s, 3]
-        w0, w1, w2, w3 = pair_w[k, 0], pair_w[k, 1], pair_w[k, 2], pair_w[k, 3]
-        vx = v[p, 0] - (w0 * v[q0, 0] + w1 * v[q1, 0] + w2 * v[q2, 0] + w3 * v[q3, 0])
-        vy = v[p, 1] - (w0 * v[q0, 1] + w1 * v[q1, 1] + w2 * v[q2, 1] + w3 * v[q3, 1])
-        vz = v[p, 2] - (w0 * v[q0, 2] + w1 * v[q1, 2] + w2 * v[q2, 2] + w3 * v[q3, 2])
-        vn = vx * geo[k, GEO_N] + vy * geo[k, GEO_N + 1] + vz * geo[k, GEO_N + 2]
+        vx, vy, vz, vn = relative_velocity(v, quads, pair_w, geo, p, k, s)
         sp, dp = pair_sd[k, 0], pair_sd[k, 1]
         pf = 0.0
         if friction:

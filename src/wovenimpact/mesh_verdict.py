@@ -76,7 +76,7 @@ def mesh_verdict(model, state) -> dict:
         return out
     eroded = state.elem[:, SL.E_ALIVE] == 0.0
     eroded[model.release_elems] = False  # a blade's release row is let go, not failed
-    radius = float(getattr(model, "striking_radius", np.inf))
+    radius = model.striking_radius
     striker_mats = {int(model.sections[model.elem_section[e], SL.C_MAT])
                     for e in model.release_elems[:1]}  # a blade is not struck by itself
     for m in range(len(model.mat_kind)):

@@ -56,11 +56,10 @@ def distorted(rng, amount=0.15, h=H):
     return cube_nodes(h) + amount * h * rng.uniform(-1.0, 1.0, (8, 3))
 
 
-def gauss_oracle(x):
-    """V = ∫ det J and B_I = ∫ ∇N_I dV of the trilinear element, 2×2×2 Gauss (exact for
-    both: det J and cof J ∂N/∂ξ are at most cubic in each parent coordinate)."""
+def gauss_points(x):
+    """The trilinear element at nodes x at its 2×2×2 Gauss points: (∂N/∂ξ (8, 3), the
+    Jacobian ∂x/∂ξ) at each, weights 1."""
     g = 1.0 / math.sqrt(3.0)
-    vol, big_b = 0.0, np.zeros((8, 3))
     xi, eta, zeta = PARENT.T
     for a in (-g, g):
         for b in (-g, g):
@@ -68,10 +67,17 @@ def gauss_oracle(x):
                 dn = np.stack([xi * (1 + eta * b) * (1 + zeta * c),
                                eta * (1 + xi * a) * (1 + zeta * c),
                                zeta * (1 + xi * a) * (1 + eta * b)], axis=1) / 8.0
-                jac = x.T @ dn  # ∂x/∂ξ
-                det = np.linalg.det(jac)
-                big_b += dn @ np.linalg.inv(jac) * det
-                vol += det
+                yield dn, x.T @ dn
+
+
+def gauss_oracle(x):
+    """V = ∫ det J and B_I = ∫ ∇N_I dV of the trilinear element, 2×2×2 Gauss (exact for
+    both: det J and cof J ∂N/∂ξ are at most cubic in each parent coordinate)."""
+    vol, big_b = 0.0, np.zeros((8, 3))
+    for dn, jac in gauss_points(x):
+        det = np.linalg.det(jac)
+        big_b += dn @ np.linalg.inv(jac) * det
+        vol += det
     return vol, big_b
 
 
@@ -273,21 +279,13 @@ def test_hourglass_mode_of_a_cube_is_resisted_and_its_energy_booked(mode, direct
 
 def full_integration_energy(x, u, c_voigt):
     """½ ∫ ε : C : ε dV of the trilinear element, 2×2×2 Gauss (small strain)."""
-    g = 1.0 / math.sqrt(3.0)
-    xi, eta, zeta = PARENT.T
     energy = 0.0
-    for a in (-g, g):
-        for b in (-g, g):
-            for c in (-g, g):
-                dn = np.stack([xi * (1 + eta * b) * (1 + zeta * c),
-                               eta * (1 + xi * a) * (1 + zeta * c),
-                               zeta * (1 + xi * a) * (1 + eta * b)], axis=1) / 8.0
-                jac = x.T @ dn
-                grad = u.T @ (dn @ np.linalg.inv(jac))
-                eps = 0.5 * (grad + grad.T)
-                ev = np.array([eps[0, 0], eps[1, 1], eps[2, 2],
-                               2 * eps[1, 2], 2 * eps[0, 2], 2 * eps[0, 1]])
-                energy += 0.5 * ev @ c_voigt @ ev * np.linalg.det(jac)
+    for dn, jac in gauss_points(x):
+        grad = u.T @ (dn @ np.linalg.inv(jac))
+        eps = 0.5 * (grad + grad.T)
+        ev = np.array([eps[0, 0], eps[1, 1], eps[2, 2],
+                       2 * eps[1, 2], 2 * eps[0, 2], 2 * eps[0, 1]])
+        energy += 0.5 * ev @ c_voigt @ ev * np.linalg.det(jac)
     return energy
 
 

@@ -104,6 +104,10 @@ def acceptance_lines(rows: list[dict], sizes: list[str], checks) -> list[str]:
     return lines
 
 
+def num(v: float | None, fmt: str) -> str:
+    return "—" if v is None else format(v, fmt)
+
+
 def table_lines(rows: list[dict]) -> list[str]:
     """One row per run."""
     lines = ["| element size | release angle | outcome | fragment speed at exit or end (m/s) | "
@@ -117,10 +121,6 @@ def table_lines(rows: list[dict]) -> list[str]:
             continue
         speed = _float(r.get("fragment_exit_speed_m_per_s"))
         speed = _float(r.get("fragment_speed_at_end_m_per_s")) if speed is None else speed
-
-        def num(v, fmt):
-            return "—" if v is None else format(v, fmt)
-
         lines.append(
             f"| {r[MESH_KEY]} | {r.get(ANGLE_KEY, '')} | {r.get('outcome', '')} | "
             f"{num(speed, '.2f')} | {num(energy_loss(r), '.1f')} | "

@@ -12,6 +12,8 @@ the acceptance of issue 36 (the strip's absorbed energy within 10 % from 2 to 7 
 
 from __future__ import annotations
 
+import csv
+import json
 import shutil
 from pathlib import Path
 
@@ -60,9 +62,6 @@ def early_loss(run_dir: Path, t: float = EARLY) -> float | None:
     history.csv (the row nearest ``t``; its ``_part`` columns are the modelled part's, so
     scaled by the summary's whole-model initial energy over the history's first row);
     None when the history or the summary is missing."""
-    import csv
-    import json
-
     path, summary = run_dir / "history.csv", run_dir / "summary.json"
     if not (path.exists() and summary.exists()):
         return None

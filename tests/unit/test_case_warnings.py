@@ -122,3 +122,18 @@ def test_a_material_given_as_a_path_takes_set_overrides_and_a_value_is_no_table(
     for key in ("run.end_time.unit", "run.end_time.unit.name"):
         with pytest.raises(InputError, match=r"'run.end_time' is a value \('1 ms'\), not a table"):
             set_dotted(doc, key, "s", label="--set")
+
+
+def test_an_override_of_an_optional_table_the_case_omits_sets_it_and_a_typo_is_named():
+    """``--set contact.damping=0.1`` on a case without ``[contact]`` (a default table)
+    sets the value; a misspelt table is an InputError that names it and lists the
+    case's tables, not a silently ignored key."""
+    from wovenimpact.errors import InputError
+
+    spec, _ = load_case(TOUR)
+    assert spec.contact.damping == pytest.approx(0.3)  # the default
+    spec, _ = load_case(TOUR, ["contact.damping=0.1", 'contact.damping_mode="approach"'])
+    assert spec.contact.damping == pytest.approx(0.1)
+    assert spec.contact.damping_mode == "approach"
+    with pytest.raises(InputError, match=r"unknown key 'contatc'.*valid: one of the keys.*contact"):
+        load_case(TOUR, ["contatc.damping=0.1"])

@@ -138,16 +138,15 @@ def read_toml(path, what: str) -> dict:
 
 
 def set_dotted(doc: dict, key: str, value: Any, label: str = "parameters") -> None:
-    """doc["a"]["b"][0]["c"] = value for key "a.b.0.c" (list items by index). Missing
-    tables under a ``set`` table (material overrides) are created; elsewhere the key must
-    exist in the base case except for its last part (a new optional key). ``label``
-    names where the key came from in error messages (a study's ``parameters``,
-    ``--set``)."""
+    """doc["a"]["b"][0]["c"] = value for key "a.b.0.c" (list items by index). A missing
+    table is created (``contact.damping`` on a case without ``[contact]``): the case's
+    validation then names a key that is not one of the schema's, with the valid ones.
+    A list item must exist. ``label`` names where the key came from in error messages
+    (a study's ``parameters``, ``--set``)."""
     parts = key.split(".")
     node: Any = doc
     for i, part in enumerate(parts[:-1]):
-        overrides = "set" in parts[:i] or (part == "set" and parts[0] == "materials")
-        if isinstance(node, dict) and part not in node and overrides:
+        if isinstance(node, dict) and part not in node and not parts[i + 1].isdigit():
             node[part] = {}
         if (i == 1 and parts[0] == "materials" and parts[2:3] == ["set"]
                 and isinstance(node, dict) and isinstance(node.get(part), str)):

@@ -111,13 +111,21 @@ def restart_parts(spec, base: str | Path) -> dict:
     }
 
 
-def stale_reason(summary: dict, expected: dict) -> str | None:
+CODE_PARTS = ("code_version", "source_digest")
+
+
+def stale_reason(summary: dict, expected: dict, older_code: bool = False) -> str | None:
     """Why a finished run's ``summary`` cannot stand for the case of ``expected``
-    (:func:`provenance`), or None if its digest matches."""
+    (:func:`provenance`), or None if its digest matches. With ``older_code`` a run made
+    by other code stands if its case and files are the same (``sweep
+    --keep-older-code``)."""
     old = summary.get("provenance")
     if not isinstance(old, dict) or "digest" not in old:
         return "its summary has no provenance digest (written by an older wovenimpact)"
     if old["digest"] == expected["digest"]:
+        return None
+    if older_code and all(old.get(k) == v for k, v in expected.items()
+                          if k not in CODE_PARTS and k != "digest"):
         return None
     return "changed since it ran: " + changed_parts(old, expected)
 

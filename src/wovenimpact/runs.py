@@ -620,10 +620,11 @@ def reused_or_run(case_path: str | Path, out: str | Path, log=None, label: str =
     return s
 
 
-def reusable_summary(out: str | Path, spec, base: str | Path) -> tuple[dict | None, str]:
+def reusable_summary(out: str | Path, spec, base: str | Path,
+                     older_code: bool = False) -> tuple[dict | None, str]:
     """The summary.json in ``out`` if it is a finished run of exactly this case, its
-    files and this code (provenance digest, current ``summary_version``), else None with
-    the reason ("" when there is no summary at all)."""
+    files and this code (provenance digest, current ``summary_version``; any code with
+    ``older_code``), else None with the reason ("" when there is no summary at all)."""
     from wovenimpact.provenance import stale_reason
 
     try:
@@ -632,5 +633,5 @@ def reusable_summary(out: str | Path, spec, base: str | Path) -> tuple[dict | No
         return None, ""
     if not isinstance(summary, dict) or summary.get("summary_version", 1) < SUMMARY_VERSION:
         return None, "its summary was written by an older wovenimpact (summary_version)"
-    reason = stale_reason(summary, provenance(spec, base))
+    reason = stale_reason(summary, provenance(spec, base), older_code)
     return (None, reason) if reason else (summary, "")

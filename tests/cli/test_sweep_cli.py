@@ -317,3 +317,33 @@ def test_a_metric_with_a_value_per_ply_is_plotted_one_line_per_ply(tmp_path: Pat
     names = {p.name for p in written}
     assert {"absorbed_energy_J.png", "absorbed_energy_per_ply_J.png"} <= names
     assert all(p.stat().st_size > 0 for p in written)
+
+
+def test_keep_older_code_keeps_runs_of_other_code_and_names_their_code(tmp_path: Path):
+    """``--keep-older-code``: variants finished by other code (same case) are kept, a
+    warning counts them and results.csv's code column names each run's source digest."""
+    import csv
+
+    import pytest
+
+    from wovenimpact.errors import InputWarning
+    from wovenimpact.provenance import digest_of
+    from wovenimpact.studies.sweep import run_study
+
+    write_case(tmp_path, end="8 us")
+    study = tmp_path / "study.toml"
+    study.write_text(STUDY.replace(', ["0 m/s", "0 m/s", "-60"]', ""))
+    out = tmp_path / "out"
+    for v in fake_finished_runs(study, out, ("stopped", "perforated")):
+        path = out / "runs" / v.id / "summary.json"
+        summary = json.loads(path.read_text())
+        parts = {k: val for k, val in summary["provenance"].items() if k != "digest"}
+        parts["source_digest"] = "0123456789abcdef"
+        summary["provenance"] = {**parts, "digest": digest_of(parts)}
+        path.write_text(json.dumps(summary))
+    with pytest.warns(InputWarning, match="2 of 2 variants kept from runs made by other code"):
+        run_study(study, out, keep_older_code=True)
+    with (out / "results.csv").open() as fh:
+        rows = list(csv.DictReader(fh))
+    assert [(r["outcome"], r["code"]) for r in rows] == [("stopped", "0123456789abcdef"),
+                                                        ("perforated", "0123456789abcdef")]

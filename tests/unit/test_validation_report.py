@@ -123,6 +123,38 @@ def test_a_summary_of_an_older_rule_is_not_taken_as_finished(tmp_path):
     assert finished(tmp_path, {"a": 1}, doc, case.parent)[0]["outcome"] == "perforated"
 
 
+def test_a_run_of_other_code_is_kept_only_when_asked_and_only_for_the_same_case(tmp_path):
+    """A finished variant whose summary names other code is run again by default
+    ("the code" changed); with older_code (``sweep --keep-older-code``) it is kept, but
+    not if its case changed too."""
+    import json
+
+    from wovenimpact.provenance import digest_of, provenance
+    from wovenimpact.runs import SUMMARY_VERSION
+    from wovenimpact.spec.case import case_from_dict
+    from wovenimpact.spec.fields import read_toml
+    from wovenimpact.studies.sweep import finished
+
+    case = ROOT / "examples" / "plate_impact" / "plies1_100.toml"
+    doc = read_toml(case, "case file")
+    prov = provenance(case_from_dict(doc), case.parent)
+    (tmp_path / "parameters.json").write_text(json.dumps({"a": 1}))
+
+    def write(**changes):
+        parts = {k: v for k, v in prov.items() if k != "digest"} | changes
+        summary = {"outcome": "stopped", "summary_version": SUMMARY_VERSION,
+                   "provenance": {**parts, "digest": digest_of(parts)}}
+        (tmp_path / "summary.json").write_text(json.dumps(summary))
+
+    write(source_digest="0123456789abcdef")
+    done, why = finished(tmp_path, {"a": 1}, doc, case.parent)
+    assert done is None and why == "changed since it ran: the code"
+    assert finished(tmp_path, {"a": 1}, doc, case.parent, older_code=True)[0]["outcome"] == "stopped"
+    write(source_digest="0123456789abcdef", case_digest="fedcba9876543210")
+    done, why = finished(tmp_path, {"a": 1}, doc, case.parent, older_code=True)
+    assert done is None and why == "changed since it ran: the case, the code"
+
+
 def test_a_failed_design_search_is_reported_not_fatal(tmp_path, monkeypatch):
     """A pack whose run fails (e.g. its energy check) stops the design search; validate
     writes that into the report instead of losing the whole report."""

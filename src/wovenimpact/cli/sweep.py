@@ -23,6 +23,9 @@ def sweep(
     overrides: list[str] = typer.Option(
         None, "--set", help="Change a value of the study's case for every variant: KEY=VALUE "
         "with a dotted key, e.g. --set 'run.end_time=20 us' (repeatable)."),
+    keep_older_code: bool = typer.Option(
+        False, "--keep-older-code", help="Keep finished variants made by other code when their "
+        "case and files are unchanged (results.csv's code column names each run's code)."),
 ) -> None:
     """Run every variant of STUDY (finished ones are kept), write results.csv, plots/ and
     report.html (linking each variant's page)."""
@@ -53,7 +56,8 @@ def sweep(
     try:
         with bar:
             rows = run_study(study, out_dir, scheduler=scheduler, workers=workers,
-                             progress=report, overrides=overrides or ())
+                             progress=report, overrides=overrides or (),
+                             keep_older_code=keep_older_code)
     except InputError as err:
         fail(str(err))
     except OSError as err:

@@ -20,7 +20,9 @@ key named, and the others still run), run in ``OUT/runs/<id>/`` and summarised i
 whose ``summary.json`` exists with the same parameters and the provenance digest its
 case would have now (case, material and mesh files, code: wovenimpact.provenance) is
 not run again (the study resumes); one whose digest differs runs again, with a warning
-saying what changed. Variants with the same values are run once (a warning says so);
+saying what changed (``sweep --keep-older-code`` keeps a run whose case and files are
+the same but whose code differs: after a change known not to touch the results, a long
+study need not start over; results.csv then names each run's code). Variants with the same values are run once (a warning says so);
 ``metrics`` that no summary has are an error before anything runs. A variant whose
 energy balance fails ``run.energy_tolerance`` is reported as failed (with its figures).
 For impact runs results.csv always records the ``outcome`` (perforated,
@@ -54,6 +56,7 @@ from pydantic import BaseModel, Field, ValidationError
 
 from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.jit import process_pool
+from wovenimpact.provenance import code_version
 from wovenimpact.io.atomic import atomic_write_text
 from wovenimpact.io.report import write_study_report
 from wovenimpact.spec.fields import (
@@ -259,11 +262,12 @@ def outcome_of(summary: dict) -> dict:
     return {"status": "done", **summary}
 
 
-def finished(out: Path, values: dict, document: dict, base: str | Path) -> tuple[dict | None, str]:
+def finished(out: Path, values: dict, document: dict, base: str | Path,
+             older_code: bool = False) -> tuple[dict | None, str]:
     """The result of a variant already run in ``out`` with these ``values`` whose summary's
     provenance digest is the one ``document`` (its paths relative to ``base``) would have
-    now (runs.reusable_summary), else None and why it cannot be reused ("" if it never
-    finished)."""
+    now (runs.reusable_summary; the code's part ignored with ``older_code``), else None
+    and why it cannot be reused ("" if it never finished)."""
     from wovenimpact.runs import reusable_summary
 
     try:
@@ -276,7 +280,7 @@ def finished(out: Path, values: dict, document: dict, base: str | Path) -> tuple
     spec = quiet_spec(document, str(out))
     if spec is None:
         return None, ""
-    summary, why = reusable_summary(out, spec, base)
+    summary, why = reusable_summary(out, spec, base, older_code)
     return (outcome_of(summary), "") if summary is not None else (None, why)
 
 
@@ -289,13 +293,16 @@ def run_study(
     threads_per_run: int = 1,
     progress=None,
     overrides=(),
+    keep_older_code: bool = False,
 ) -> list[dict]:
     """Run every variant of a study (resuming), write results.csv and plots; returns the rows.
 
     ``progress(done, total, variant_id, result)`` is called as each variant finishes
     (resumed ones count as done from the start). ``overrides`` (``--set KEY=VALUE``)
     change the base case of every variant; a variant is resumed only if it was run with
-    the same ones."""
+    the same ones. With ``keep_older_code`` a finished variant made by other code is kept
+    if its case and files are the same (a warning counts them; results.csv then has a
+    ``code`` column: each run's source digest)."""
     progress = progress or (lambda done, total, vid, result: None)
     info, variants, base = load_study(study_path, overrides)
     extra = {"--set": list(overrides)} if overrides else {}
@@ -305,7 +312,8 @@ def run_study(
     todo = []
     stale: dict[str, int] = {}
     for v in variants:
-        done, why = finished(out / "runs" / v.id, {**v.values, **extra}, v.document, base)
+        done, why = finished(out / "runs" / v.id, {**v.values, **extra}, v.document, base,
+                             keep_older_code)
         if done is not None:
             results[v.id] = {**done, "resumed": True}
         else:
@@ -315,6 +323,12 @@ def run_study(
     for why, count in stale.items():
         warnings.warn(f"{count} of {len(variants)} variants run again: {why}", InputWarning,
                       stacklevel=2)
+    current = code_version()["source_digest"]
+    older = sum(bool(r.get("resumed")) and _source_digest(r) != current for r in results.values())
+    if older:
+        warnings.warn(f"{older} of {len(variants)} variants kept from runs made by other code "
+                      "(--keep-older-code; results.csv's code column names each run's)",
+                      InputWarning, stacklevel=2)
     if results:
         progress(len(results), len(variants), "", {"status": "finished earlier"})
     args = [(v.document, str(base), str(out / "runs" / v.id), {**v.values, **extra},
@@ -347,6 +361,8 @@ def run_study(
                "status": r.get("status"), "error": r.get("error", "")}
         if impact:  # the outcome of an impact run, always recorded (the fits need it)
             row["outcome"] = r.get("outcome", "")
+        if keep_older_code:
+            row["code"] = _source_digest(r) or current
         for m in info.metrics:
             row[m] = r.get(m, "")
         rows.append(row)
@@ -387,6 +403,12 @@ def _connect(client_class, address: str):
         raise InputError(f"--scheduler {address!r}: no scheduler answers ({type(err).__name__}: "
                          f"{err}; valid: the address of a running Dask scheduler, e.g. "
                          "tcp://host:8786)") from None
+
+
+def _source_digest(result: dict) -> str:
+    """The source digest of the code that made a finished run ("" if it has none)."""
+    prov = result.get("provenance")
+    return prov.get("source_digest", "") if isinstance(prov, dict) else ""
 
 
 def _short(value: Any) -> str:

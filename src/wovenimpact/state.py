@@ -143,6 +143,7 @@ def initial_material_rows(model) -> np.ndarray:
         j2 = np.flatnonzero(kind == SL.MAT_J2)
         if j2.size:
             rows[j2, JL.S_FRAC_SCALE:JL.S_FRAC_SCALE + 2] = model.elem_failure[elem[j2], :2]
+            rows[j2, JL.S_HINGE] = model.elem_failure[elem[j2], 2]
     return rows
 
 

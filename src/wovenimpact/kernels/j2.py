@@ -28,7 +28,8 @@ reference material frame → current corotational frame) and the step Δt, the k
    step (to round-off);
 5. failure (J12–J13): ε̄p ≥ ε_f (the thesis's constant fracture strain) or the
    Johnson–Cook damage D = Σ Δε̄p / ε_f(η, ε̇*) ≥ 1; a failed point carries no
-   stress from then on and its alive flag is 0 for good.
+   stress from then on and its alive flag is 0 for good. With a hinge length
+   (J17, :func:`fold_amplification`) each step's Δε̄p counts amp ≥ 1 times.
 
 What the caller (the shell section) must do
 -------------------------------------------
@@ -90,6 +91,7 @@ from wovenimpact.kernels.j2_layout import (
     S_EVOLUTION,
     S_FAIL_ENERGY,
     S_FRAC_SCALE,
+    S_HINGE,
     S_JC_DAMAGE,
     S_KIRCHHOFF,
     S_PLASTIC_WORK,
@@ -313,7 +315,8 @@ def clear_failed_point(s_out, i):
 
 # --- one material point ------------------------------------------------------------
 @kernel
-def j2_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, dt, thick, s_in, s_out, i):
+def j2_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, dt, thick, s_in, s_out, i,
+             amp=1.0):
     """Update J2 material point i from F_old to F_new over Δt (the module's steps 1–5).
 
     Args:
@@ -325,6 +328,9 @@ def j2_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, dt, thick, s_in, 
         s_in, s_out: state tables (n, N_STATE): row i at the start of the step, and
             row i at the end (written; the tables may not alias). Pass m and i as
             unsigned integers (np.uint64) in loops.
+        amp: the factor ≥ 1 on the step's Δε̄p when fracture is judged (J17: the
+            section's fold amplification, :func:`fold_amplification`); 1 for a point
+            with no hinge length (S_HINGE = 1), which is then judged as before.
 
     Returns:
         (status, stiffness, N_xx, N_yy, N_xy): a STATUS_* code, an upper bound
@@ -415,18 +421,28 @@ def j2_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, dt, thick, s_in, 
     after = 0.0  # the part of Δε̄p past the onset of failure
     if deps > 0.0:
         s_frac = s_in[i, S_FRAC_SCALE]
+        counted = deps * amp  # (J17): Δε̄p as fracture counts it
         if p[m, P_DAMAGE] != 0.0:
             seq = math.sqrt(t11 * t11 - t11 * t22 + t22 * t22 + 3.0 * t12 * t12)
             eta = (t11 + t22) / (3.0 * seq) if seq > 0.0 else 0.0
             ef = s_frac * fracture_strain_jc(p, m, eta, rate)
             d_old = s_in[i, S_JC_DAMAGE]
-            dmg = d_old + deps / ef if ef > 0.0 else 1.0
+            dmg = d_old + counted / ef if ef > 0.0 else 1.0
             s_out[i, S_JC_DAMAGE] = dmg
             if dmg >= 1.0:
                 onset = True
                 after = deps if d_old >= 1.0 else deps * (dmg - 1.0) / (dmg - d_old)
         ef_const = s_frac * p[m, P_FRACTURE]
-        if ef_const > 0.0 and eps_p_new >= ef_const:
+        if ef_const > 0.0 and s_in[i, S_HINGE] > 1.0:
+            # (J17) with a constant ε_f (no Johnson–Cook damage: the material file refuses
+            # both with a hinge length): D = Σ amp Δε̄p / (s ε_f) in the damage column
+            d_old = s_in[i, S_JC_DAMAGE]
+            dmg = d_old + counted / ef_const
+            s_out[i, S_JC_DAMAGE] = dmg
+            if dmg >= 1.0:
+                onset = True
+                after = deps if d_old >= 1.0 else deps * (dmg - 1.0) / (dmg - d_old)
+        elif ef_const > 0.0 and eps_p_new >= ef_const:
             onset = True
             after = max(after, eps_p_new - max(eps_p, ef_const))
     d_e_old = s_in[i, S_SOFT_DAMAGE]
@@ -469,6 +485,36 @@ def j2_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, dt, thick, s_in, 
     scale = thick / det_n
     n_xx, n_yy, n_xy = rotate_to_corotational(t11 * scale, t22 * scale, t12 * scale, cn, sn)
     return STATUS_OK, stiff * max(1.0, jac), n_xx, n_yy, n_xy
+
+
+@kernel
+def fold_amplification(x_b, ko11, ko12, ko21, ko22, kn11, kn12, kn21, kn22,
+                       fo11, fo12, fo21, fo22, f11, f12, f21, f22):
+    """(J17) The factor on a section point's Δε̄p when fracture is judged: 1 + (x_b − 1) r.
+
+    x_b = max(1, l_e/l_h) (S_HINGE): an element of length l_e bends over its whole length
+    what a fold of the sheet bends over l_h, so the bending part of its surface strain
+    is x_b times too small. r ∈ [0, 1] is the bending share of the point's strain
+    increment, measured rotation-free by the Green–Lagrange increments ΔE = ½ΔC:
+
+        r = |ΔE_k − ΔE_0| / (|ΔE_0| + |ΔE_k − ΔE_0|),
+
+    ΔE_k the point's (F_k = (I + z κ̂) F, old ko.., new kn..), ΔE_0 the mid-surface's
+    (fo.., f..), |·| the Frobenius norm. A membrane step (r = 0) counts as it is, a pure
+    bending step x_b times; x_b = 1 gives exactly 1."""
+    if x_b <= 1.0:
+        return 1.0
+    dk11 = 0.5 * ((kn11 * kn11 + kn21 * kn21) - (ko11 * ko11 + ko21 * ko21))
+    dk22 = 0.5 * ((kn12 * kn12 + kn22 * kn22) - (ko12 * ko12 + ko22 * ko22))
+    dk12 = 0.5 * ((kn11 * kn12 + kn21 * kn22) - (ko11 * ko12 + ko21 * ko22))
+    d011 = 0.5 * ((f11 * f11 + f21 * f21) - (fo11 * fo11 + fo21 * fo21))
+    d022 = 0.5 * ((f12 * f12 + f22 * f22) - (fo12 * fo12 + fo22 * fo22))
+    d012 = 0.5 * ((f11 * f12 + f21 * f22) - (fo11 * fo12 + fo21 * fo22))
+    bend = math.sqrt((dk11 - d011) ** 2 + (dk22 - d022) ** 2 + 2.0 * (dk12 - d012) ** 2)
+    memb = math.sqrt(d011 * d011 + d022 * d022 + 2.0 * d012 * d012)
+    if bend + memb <= 0.0:
+        return 1.0
+    return 1.0 + (x_b - 1.0) * bend / (bend + memb)
 
 
 # --- many points ----------------------------------------------------------------

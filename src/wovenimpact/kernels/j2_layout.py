@@ -39,7 +39,8 @@ P_FAIL_DISP = P_FRAC_LENGTH + 1  # ū_f, plastic displacement from onset to fail
 P_FRAC_ROWS = P_FRAC_LENGTH + 2  # rows of the fracture-strain scale table (0: s = 1)
 P_FRAC_TABLE = P_FRAC_LENGTH + 3  # row k: l_e/l_ref at P_FRAC_TABLE + 2k, scale s at + 2k + 1
 FRAC_ROWS_MAX = 16
-N_PARAM = P_FRAC_TABLE + 2 * FRAC_ROWS_MAX
+P_HINGE_RATIO = P_FRAC_TABLE + 2 * FRAC_ROWS_MAX  # l_h/t, a fold's width in thicknesses; 0: none
+N_PARAM = P_HINGE_RATIO + 1
 
 # --- state (history variables and outputs of one material point) -------------
 # S_ALIVE and S_ENERGY sit at the same columns as in fabric_layout, so a section
@@ -61,7 +62,11 @@ S_RETURN_ITER = 15  # iterations of the last return
 S_FRAC_SCALE = 16  # s, the scale of the fracture strain (constant and Johnson–Cook) (—)
 S_EVOLUTION = 17  # l_e/ū_f: damage D_e grows by l_e Δε̄p/ū_f after onset (1/—); 0: fail at onset
 S_SOFT_DAMAGE = 18  # D_e ∈ [0, 1], damage after the onset of failure; the stress is (1 − D_e) τ̃
-N_STATE = 19
+# per point, set at the start of a run (theory §7.3, "Folds"): x_b = max(1, l_e/l_h), l_h
+# the hinge ratio times the section's thickness t0, the
+# factor on the bending part of the plastic strain when fracture is judged; 1: none
+S_HINGE = 19
+N_STATE = 20
 
 # --- status codes returned per point -----------------------------------------
 STATUS_OK = 0

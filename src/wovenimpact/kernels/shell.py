@@ -49,9 +49,10 @@ from numba import prange
 
 from wovenimpact.jit import inline_kernel, kernel, loop_kernel
 from wovenimpact.kernels import fabric_layout as FL
+from wovenimpact.kernels import j2_layout as JL
 from wovenimpact.kernels.bundles import ElementTables
 from wovenimpact.kernels.fabric import fabric_point
-from wovenimpact.kernels.j2 import j2_point
+from wovenimpact.kernels.j2 import fold_amplification, j2_point
 from wovenimpact.kernels.vecmath import sqrt as vsqrt
 from wovenimpact.kernels.shell_layout import (
     C_AREAL_MASS,
@@ -237,7 +238,7 @@ def through_thickness_f(z, kx, ky, kxy2, f11, f12, f21, f22):
 
 @inline_kernel
 def point_response(kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, dt, thick,
-                   rows_in, rows_out, row):
+                   rows_in, rows_out, row, amp=1.0):
     """The material at one point: F_old → F_new (o.., g..) over Δt, dispatched on its kind.
 
     Fabric and J2 points keep their state in row ``row`` of the material rows (the
@@ -251,7 +252,7 @@ def point_response(kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, 
         length of the whole section); the stable step's stiffnesses (theory §4,
         "Stable step"): C_s the isotropic part (C_m itself, or a fabric's trellis shear
         alone) and k_w, k_f a fabric's yarn families per reference width and length
-        (zero for other materials).
+        (zero for other materials). ``amp``: a J2 point's fold amplification (J17).
     """
     if kind == MAT_FABRIC:
         st, c, a, b, c12, c_s, k_w, k_f = fabric_point(
@@ -264,7 +265,7 @@ def point_response(kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, 
     if kind == MAT_J2:
         st, c, a, b, c12 = j2_point(
             mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, dt, thick, rows_in,
-            rows_out, row,
+            rows_out, row, amp,
         )
         if st != 0:
             return st, False, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
@@ -315,9 +316,14 @@ def section_response(
         if g11 * g22 - g12 * g21 <= 0.0:
             return EL_INVERTED, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
         o11, o12, o21, o22 = through_thickness_f(z, ko_x, ko_y, ko_xy2, fo11, fo12, fo21, fo22)
+        amp = 1.0
+        if kind == MAT_J2 and n_pts > 1:  # (J17): a fold's strain, judged at its width
+            amp = fold_amplification(rows_in[row0 + np.uint64(k), JL.S_HINGE],
+                                     o11, o12, o21, o22, g11, g12, g21, g22,
+                                     fo11, fo12, fo21, fo22, f11, f12, f21, f22)
         st, live, c, energy, a, b, c12, c_s, k_w, k_f = point_response(
             kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, dt, thick,
-            rows_in, rows_out, row0 + np.uint64(k),
+            rows_in, rows_out, row0 + np.uint64(k), amp,
         )
         if st != 0:
             return EL_MATERIAL, 0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0

@@ -72,11 +72,17 @@ class FractureRegularisation:
             l_e Δε̄p/ū_f and the stress is (1 − D_e) times the undamaged one, so that the
             work of the softening per unit crack area does not depend on l_e; the point
             fails at D_e = 1. 0: it fails at onset.
+        hinge_ratio: l_h/t, the width over which a fold of the sheet bends, in the
+            section's thicknesses t: an element longer than l_h bends over its whole
+            length what the sheet bends over l_h, so the bending part of a point's
+            plastic strain counts x_b = l_e/l_h times when fracture is judged (theory
+            §7.3, "Folds"). 0: none.
     """
 
     reference_length: float = 0.0
     fracture_scale: tuple[tuple[float, float], ...] = ()
     failure_displacement: float = 0.0
+    hinge_ratio: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -170,29 +176,36 @@ def j2_parameter_row(params: MetalParameters) -> np.ndarray:
         for k, (x, sc) in enumerate(r.fracture_scale):
             p[L.P_FRAC_TABLE + 2 * k] = x
             p[L.P_FRAC_TABLE + 2 * k + 1] = sc
+        p[L.P_HINGE_RATIO] = r.hinge_ratio
     return p
 
 
 # --- running the kernel on points ------------------------------------------------
-def regularised_columns(p: np.ndarray, lengths: np.ndarray) -> np.ndarray:
-    """Each point's S_FRAC_SCALE and S_EVOLUTION from its element's length l_e = √A0
-    (theory §7.3).
+def regularised_columns(p: np.ndarray, lengths: np.ndarray, thickness=0.0) -> np.ndarray:
+    """Each point's S_FRAC_SCALE, S_EVOLUTION and S_HINGE from its element's length l_e
+    = √A0 and its section's thickness t0 (theory §7.3).
 
     Args:
         p: the material's J2 parameter row (:func:`j2_parameter_row`).
         lengths: (n,) l_e (m); a length ≤ 0 stands for the reference length (a point
             without an element: the single-point drivers).
+        thickness: t0 (m), scalar or (n,); ≤ 0: no fold law (x_b = 1).
 
     Returns:
-        (n, 2): s (scale of the fracture strain) and l_e/ū_f (0: failure at onset).
+        (n, 3): s (scale of the fracture strain), l_e/ū_f (0: failure at onset) and
+        x_b = max(1, l_e/l_h) (1: no hinge length).
     """
     lengths = np.asarray(lengths, dtype=float).reshape(-1)
     l_ref = p[L.P_FRAC_LENGTH]
-    out = np.zeros((len(lengths), 2))
+    out = np.zeros((len(lengths), 3))
     out[:, 0] = 1.0
+    out[:, 2] = 1.0
     if l_ref <= 0.0:
         return out
     le = np.where(lengths > 0.0, lengths, l_ref)
+    hinge = p[L.P_HINGE_RATIO] * np.broadcast_to(np.asarray(thickness, dtype=float), le.shape)
+    folds = hinge > 0.0
+    out[folds, 2] = np.maximum(1.0, le[folds] / hinge[folds])
     n_rows = int(p[L.P_FRAC_ROWS])
     if n_rows:
         table = p[L.P_FRAC_TABLE:L.P_FRAC_TABLE + 2 * n_rows].reshape(n_rows, 2)
@@ -202,24 +215,27 @@ def regularised_columns(p: np.ndarray, lengths: np.ndarray) -> np.ndarray:
     return out
 
 
-def set_regularised_columns(state: np.ndarray, p: np.ndarray, lengths: np.ndarray) -> None:
+def set_regularised_columns(state: np.ndarray, p: np.ndarray, lengths: np.ndarray,
+                            thickness=0.0) -> None:
     """Write :func:`regularised_columns` into the state rows (n, N_STATE), in place."""
-    cols = regularised_columns(p, lengths)
+    cols = regularised_columns(p, lengths, thickness)
     state[:, L.S_FRAC_SCALE] = cols[:, 0]
     state[:, L.S_EVOLUTION] = cols[:, 1]
+    state[:, L.S_HINGE] = cols[:, 2]
 
 
 def initial_state(params: MetalParameters, n_points: int = 1,
-                  lengths: np.ndarray | None = None) -> np.ndarray:
+                  lengths: np.ndarray | None = None, thickness: float = 0.0) -> np.ndarray:
     """States of ``n_points`` virgin points: no stress, λ3 = 1, alive, σ_y = σ_h(0); their
     fracture columns for elements of the given lengths l_e (None: the reference length,
-    i.e. the fracture strain as given; theory §7.3)."""
+    i.e. the fracture strain as given) and a section of thickness t0 (0: no fold law;
+    theory §7.3)."""
     s = np.zeros((n_points, L.N_STATE))
     s[:, L.S_THICK] = 1.0
     s[:, L.S_ALIVE] = 1.0
     s[:, L.S_YIELD] = params.hardening[0][1]
     set_regularised_columns(s, j2_parameter_row(params),
-                            np.zeros(n_points) if lengths is None else lengths)
+                            np.zeros(n_points) if lengths is None else lengths, thickness)
     return s
 
 

@@ -368,7 +368,7 @@ class Model:
             (:func:`characteristic_lengths`).
         elem_failure: (n_elems, 6) the failure columns of each element's points, from
             its lengths (:func:`failure_columns`): fabric S_TU_SCALE … S_ERODE_LIMIT + 1,
-            J2 S_FRAC_SCALE, S_EVOLUTION in the first two.
+            J2 S_FRAC_SCALE, S_EVOLUTION, S_HINGE in the first three.
         eroded_nodes: "remove" (default): a node left without a live element leaves the
             model with its kinetic energy; "keep" (LS-DYNA's ENMASS = 2): it flies on
             as a free node with its mass and momentum, contact-active (theory §5,
@@ -587,18 +587,20 @@ def characteristic_lengths(x0, quads, warp_direction, kinds) -> np.ndarray:
     return out
 
 
-def failure_columns(kinds, params, elem_mat, elem_length) -> np.ndarray:
+def failure_columns(kinds, params, elem_mat, elem_length, elem_thickness=None) -> np.ndarray:
     """(n_elems, 6): the failure columns of each element's material points (theory §1.4,
     §7.3) from its lengths — a fabric's :func:`materials.fabric.regularised_columns`, a
-    J2 metal's :func:`materials.metal.regularised_columns` in the first two, zeros for an
-    elastic element. kinds, params: per material; elem_mat: each element's material."""
+    J2 metal's :func:`materials.metal.regularised_columns` in the first three, zeros for
+    an elastic element. kinds, params: per material; elem_mat: each element's material;
+    elem_thickness: each element's section thickness t0 (the metal's fold law; None: none)."""
     out = np.zeros((len(elem_mat), 6))
     for m, (kind, p) in enumerate(zip(kinds, params)):
         sel = np.flatnonzero(elem_mat == m)
         if kind == SL.MAT_FABRIC:
             out[sel] = fabric_regularised_columns(p, elem_length[sel])
         elif kind == SL.MAT_J2:
-            out[sel, :2] = j2_regularised_columns(p, elem_length[sel, 0])
+            t0 = 0.0 if elem_thickness is None else elem_thickness[sel]
+            out[sel, :3] = j2_regularised_columns(p, elem_length[sel, 0], t0)
     return out
 
 
@@ -822,7 +824,8 @@ def build_model(
     ref_grad, area0, gauss_grad, gauss_weight = material_frame_gradients(x0, q, warp_direction)
     elem_mat = sec_table[es, SL.C_MAT].astype(np.int64)
     elem_length = characteristic_lengths(x0, q, warp_direction, np.array(kinds)[elem_mat])
-    elem_failure = failure_columns(kinds, params, elem_mat, elem_length)
+    elem_failure = failure_columns(kinds, params, elem_mat, elem_length,
+                                   sec_table[es, SL.C_THICK])
     for m, kind in enumerate(kinds):  # the vector stage's failure threshold (P_TU_FLOOR)
         sel = elem_mat == m
         if kind == SL.MAT_FABRIC and sel.any():

@@ -11,7 +11,9 @@ values are errors; all problems of a file are reported together in one
     kevlar.toml: material.warp.crimp: must be ≥ 0 (got -0.01; valid: a dimensionless number ≥ 0 ...)
 
 Suspicious but admissible inputs (a yarn area far from the lenticular section,
-h0 inconsistent with the crimp) are reported as :class:`InputWarning`.
+h0 inconsistent with the crimp) are reported as :class:`InputWarning`. A fabric without
+crimp (a family's h0 = 0) and a compaction limit ``a`` at or above the crossover's height
+h_w0 + h_f0 are errors (:func:`_check_weave_geometry`).
 
 Geometry (thesis eq. 5.2, 5.5): the in-plane half-length of a family-i yarn
 between crossings is ℓ_i0 = 1/(2 n_j), n_j the thread count of the CROSSING
@@ -215,6 +217,8 @@ class MetalRegularisationSpec(BaseModel):
     # [[l_e/l_ref, scale of the fracture strain], ...], l_e/l_ref increasing, 1 at 1
     fracture_scale: ScaleTable = Field(default_factory=list, max_length=FRAC_ROWS_MAX)
     failure_displacement: quantity("length", gt=0, example="0.05 mm") | None = None
+    # l_h/t, the width of a fold in the section's thicknesses: theory §7.3, "Folds"
+    hinge_ratio: quantity("dimensionless", gt=0, example="1") | None = None
 
 
 class J2Spec(BaseModel):
@@ -479,12 +483,14 @@ def _check_scale_table(table: list[tuple[float, float]], raw: dict, key: str) ->
 def _check_weave_geometry(spec: FabricSpec, raw: dict) -> list[Problem]:
     """A weave the crossover cell can hold (theory: material geometry, docs/inputs.md):
     each yarn fits in its width × thickness box and is no thicker than wide, yarns lie
-    at most MAX_PITCH_WIDTHS widths apart, the two crimp heights (eq. 5.5, or h0 given)
-    add up to at most the two yarn thicknesses (Peirce: about half of them), and the
-    compaction limit a is at most the two thicknesses."""
+    at most MAX_PITCH_WIDTHS widths apart, each family is crimped (h0 > 0), the two crimp
+    heights (eq. 5.5, or h0 given) add up to at most the two yarn thicknesses (Peirce:
+    about half of them), and the compaction limit a is below the crossover's height
+    h_w0 + h_f0 (theory §1.3: H_w + H_f = h_w0 + h_f0 − δ with δ < a)."""
     problems = []
     t_sum = spec.warp.thickness + spec.fill.thickness
     heights = 0.0
+    straight = False
     for fam, other in (("warp", "fill"), ("fill", "warp")):
         y: YarnSpec = getattr(spec, fam)
         pitch = 1.0 / y.thread_count
@@ -506,7 +512,19 @@ def _check_weave_geometry(spec: FabricSpec, raw: dict) -> list[Problem]:
                 "fabric", _raw(raw, fam, "thread_count"),
                 f"a thread count ≥ {1.0 / (MAX_PITCH_WIDTHS * y.width) * 0.0254:.4g} 1/in"))
         half = half_length_from_thread_count(getattr(spec, other).thread_count)
-        heights += crimp_amplitude(half, y.crimp) if y.h0 is None else y.h0
+        h0 = crimp_amplitude(half, y.crimp) if y.h0 is None else y.h0
+        heights += h0
+        if h0 == 0.0:
+            straight = True
+            key = "crimp" if y.h0 is None else "h0"
+            problems.append(Problem(
+                f"material.{fam}.{key}", f"is 0: a straight {fam} yarn (h0 = 0), outside the "
+                "crossover model, whose yarns undulate round each other (eq. 5.5): its table "
+                "measures heights against h0 (docs/theory.md §1.9) and the compaction limit "
+                "a must lie below h_w0 + h_f0", _raw(raw, fam, key),
+                f"a crimp > 0 and ≤ {MAX_CRIMP:g} such as 0.0421; woven fabrics have a few %, "
+                "a nearly straight family e.g. 0.001" if key == "crimp" else
+                "a length > 0 such as '0.12495 mm', or no h0 (eq. 5.5 from the crimp)"))
     if heights > t_sum:
         problems.append(Problem(
             "material.warp.crimp / material.fill.crimp (or h0)",
@@ -516,11 +534,16 @@ def _check_weave_geometry(spec: FabricSpec, raw: dict) -> list[Problem]:
                                   "fill": _raw(raw, "fill", "crimp")},
             f"crimps whose heights add up to at most {t_sum * 1e3:.4g} mm (Peirce's geometry: "
             f"about half, {t_sum * 0.5e3:.4g} mm; woven fabrics have crimps of a few %)"))
-    if spec.compaction.a > t_sum:
+    if not straight and spec.compaction.a >= heights:
+        # δ(F) = a F/(b + F) → a: with a ≥ h_w0 + h_f0 a finite push would flatten the
+        # crossover to nothing (H_w + H_f = 0) and the law beyond it means nothing
         problems.append(Problem(
-            "material.compaction.a", f"is larger than the two yarn thicknesses "
-            f"({t_sum * 1e3:.4g} mm) it compacts", _raw(raw, "compaction", "a"),
-            f"a length < {t_sum * 1e3:.4g} mm"))
+            "material.compaction.a", f"is not below the crossover's height h_w0 + h_f0 = "
+            f"{heights * 1e3:.5g} mm (eq. 5.5, or h0 given): the law F = b δ/(a − δ) presses "
+            "the yarns into each other by δ < a, and H_w + H_f = h_w0 + h_f0 − δ must stay "
+            "above 0 (docs/theory.md §1.3)", _raw(raw, "compaction", "a"),
+            f"a length < {heights * 1e3:.5g} mm; the thesis's Kevlar has a = 0.12389 mm, "
+            "about half its h_w0 + h_f0"))
     return problems
 
 
@@ -539,6 +562,13 @@ def _metal_parameters(spec: J2Spec | ElasticSpec, raw: dict, source: str) -> Met
                     "material.regularisation", "regularises a fracture strain the material "
                     "does not have", valid="material.plasticity.fracture_strain or a "
                     "[material.damage] table, or no [material.regularisation]"))
+            if (spec.regularisation.hinge_ratio is not None
+                    and spec.plasticity.fracture_strain is not None and spec.damage is not None):
+                reg_problems.append(Problem(
+                    "material.regularisation.hinge_ratio", "needs one fracture criterion, "
+                    "the material has two (plasticity.fracture_strain and [material.damage])",
+                    _raw(raw, "regularisation", "hinge_ratio"),
+                    "a hinge ratio with either fracture_strain or [material.damage]"))
         raise_problems(_check_hardening(table, raw) + _check_damage(spec, raw)
                        + _check_yield_strain(spec, raw) + reg_problems, source)
         hardening = tuple((float(e), float(s)) for e, s in table)
@@ -558,6 +588,7 @@ def _metal_parameters(spec: J2Spec | ElasticSpec, raw: dict, source: str) -> Met
             reference_length=r.reference_length,
             fracture_scale=tuple((float(x), float(v)) for x, v in r.fracture_scale),
             failure_displacement=r.failure_displacement or 0.0,
+            hinge_ratio=r.hinge_ratio or 0.0,
         )
     return MetalParameters(
         name=spec.name,

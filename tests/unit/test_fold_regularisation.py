@@ -136,3 +136,15 @@ def test_a_hinge_ratio_with_two_fracture_criteria_is_refused(tmp_path):
     path.write_text(text)
     with pytest.raises(InputError, match="hinge_ratio.*two"):
         load_material(path)
+
+
+def test_a_hinge_ratio_needs_no_reference_length_but_a_scale_table_does(tmp_path):
+    from wovenimpact.errors import InputError
+
+    path = tmp_path / "al.toml"
+    path.write_text(ALUMINIUM.read_text() + "\n[material.regularisation]\nhinge_ratio = 1\n")
+    assert load_material(path).regularisation.hinge_ratio == 1.0
+    path.write_text(ALUMINIUM.read_text()
+                    + "\n[material.regularisation]\nfracture_scale = [[1, 1], [2, 0.9]]\n")
+    with pytest.raises(InputError, match="reference_length: is missing"):
+        load_material(path)

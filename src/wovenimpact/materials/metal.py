@@ -64,7 +64,8 @@ class FractureRegularisation:
 
     Attributes:
         reference_length: l_ref (m), the element length at which the fracture strain
-            (constant or Johnson–Cook) holds as given.
+            (constant or Johnson–Cook) holds as given (0: none; the scale table and
+            the softening need one).
         fracture_scale: rows (l_e/l_ref, s): the point's fracture strain is s ε_f, s
             piecewise linear in l_e/l_ref, flat beyond the first and last rows, s = 1 at
             l_ref; empty: s = 1.
@@ -200,12 +201,14 @@ def regularised_columns(p: np.ndarray, lengths: np.ndarray, thickness=0.0) -> np
     out = np.zeros((len(lengths), 3))
     out[:, 0] = 1.0
     out[:, 2] = 1.0
+    # the fold law needs no reference length; a point without an element is no fold
+    hinge = p[L.P_HINGE_RATIO] * np.broadcast_to(np.asarray(thickness, dtype=float),
+                                                 lengths.shape)
+    folds = (hinge > 0.0) & (lengths > 0.0)
+    out[folds, 2] = np.maximum(1.0, lengths[folds] / hinge[folds])
     if l_ref <= 0.0:
         return out
     le = np.where(lengths > 0.0, lengths, l_ref)
-    hinge = p[L.P_HINGE_RATIO] * np.broadcast_to(np.asarray(thickness, dtype=float), le.shape)
-    folds = hinge > 0.0
-    out[folds, 2] = np.maximum(1.0, le[folds] / hinge[folds])
     n_rows = int(p[L.P_FRAC_ROWS])
     if n_rows:
         table = p[L.P_FRAC_TABLE:L.P_FRAC_TABLE + 2 * n_rows].reshape(n_rows, 2)

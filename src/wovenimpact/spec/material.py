@@ -213,7 +213,8 @@ class MetalRegularisationSpec(BaseModel):
     (docs/theory.md §7.3; :class:`~wovenimpact.materials.metal.FractureRegularisation`)."""
 
     model_config = STRICT
-    reference_length: quantity("length", gt=0, example="0.5 mm")
+    # needed by fracture_scale and failure_displacement (not by hinge_ratio)
+    reference_length: quantity("length", gt=0, example="0.5 mm") | None = None
     # [[l_e/l_ref, scale of the fracture strain], ...], l_e/l_ref increasing, 1 at 1
     fracture_scale: ScaleTable = Field(default_factory=list, max_length=FRAC_ROWS_MAX)
     failure_displacement: quantity("length", gt=0, example="0.05 mm") | None = None
@@ -562,6 +563,12 @@ def _metal_parameters(spec: J2Spec | ElasticSpec, raw: dict, source: str) -> Met
                     "material.regularisation", "regularises a fracture strain the material "
                     "does not have", valid="material.plasticity.fracture_strain or a "
                     "[material.damage] table, or no [material.regularisation]"))
+            r = spec.regularisation
+            if r.reference_length is None and (r.fracture_scale or r.failure_displacement):
+                reg_problems.append(Problem(
+                    "material.regularisation.reference_length", "is missing",
+                    valid="the element length at which the fracture strain holds as given "
+                    "(fracture_scale and failure_displacement are relative to it)"))
             if (spec.regularisation.hinge_ratio is not None
                     and spec.plasticity.fracture_strain is not None and spec.damage is not None):
                 reg_problems.append(Problem(
@@ -585,7 +592,7 @@ def _metal_parameters(spec: J2Spec | ElasticSpec, raw: dict, source: str) -> Met
     r = getattr(spec, "regularisation", None)
     if r is not None:
         regularisation = FractureRegularisation(
-            reference_length=r.reference_length,
+            reference_length=r.reference_length or 0.0,
             fracture_scale=tuple((float(x), float(v)) for x, v in r.fracture_scale),
             failure_displacement=r.failure_displacement or 0.0,
             hinge_ratio=r.hinge_ratio or 0.0,

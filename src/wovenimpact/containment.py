@@ -103,6 +103,11 @@ class CasingWatch:
         in_casing = np.zeros(model.n_nodes, dtype=bool)
         in_casing[self.casing] = True
         self.casing_elems = np.flatnonzero(in_casing[model.quads].all(axis=1))
+        # the layers' elements and their nodes, as the summary's absorbed energies count
+        # them (layer_elements, layer_absorbed_energies): the history's casing energies
+        self.layer_elems = np.concatenate(layer_elements(model))
+        self.layer_nodes = np.unique(model.quads[self.layer_elems])
+        self.layer_node_mass = model.node_mass[self.layer_nodes]
         self._live = -1
         self._anchored = np.zeros(model.n_nodes, dtype=bool)
 
@@ -169,6 +174,41 @@ CONTAINMENT_COLUMNS = ("fragment_speed_m_per_s", "fragment_radial_velocity_m_per
                        "intact_casing_outside",
                        "fragment_beyond_casing",
                        "outer_layer_bulge_m")
+
+
+CASING_ENERGY_COLUMNS = ("fragment_kinetic_energy_part_J", "casing_kinetic_energy_part_J",
+                         "casing_element_energy_part_J", "casing_absorbed_energy_part_J")
+
+
+def casing_energy_row(model, state, watch: CasingWatch | None = None) -> dict:
+    """The energies of a containment run's two parties (J, modelled part), the history
+    columns :data:`CASING_ENERGY_COLUMNS` that the energy plot draws on their own axes
+    (the fragment's kinetic energy, kilojoules, would flatten the casing's):
+
+    - ``fragment_kinetic_energy_part_J``: Σ ½ m v² over the fragment's nodes;
+    - ``casing_kinetic_energy_part_J``: the same over the casing layers' nodes;
+    - ``casing_element_energy_part_J``: the stored and hourglass energy the casing
+      layers' elements hold (an eroded element's as it held it at erosion), as
+      :func:`layer_energies` counts them — not what broken yarns or plastic flow
+      dissipated, which no element holds;
+    - ``casing_absorbed_energy_part_J``: the contact work the casing layers' nodes
+      received so far, the summary's ``casing_absorbed_energy_J`` at the end
+      (:func:`layer_absorbed_energies`).
+    """
+    w = CasingWatch(model) if watch is None else watch
+    v_f = state.v[w.nodes]
+    v_c = state.v[w.layer_nodes]
+    e = w.layer_elems
+    return {
+        "fragment_kinetic_energy_part_J": 0.5 * float(np.sum(w.m * np.sum(v_f * v_f, axis=1))),
+        "casing_kinetic_energy_part_J": 0.5 * float(np.sum(w.layer_node_mass
+                                                           * np.sum(v_c * v_c, axis=1))),
+        # three columns gathered, not the elements' whole rows
+        "casing_element_energy_part_J": float(np.sum(state.elem[e, SL.E_U_MEMB])
+                                              + np.sum(state.elem[e, SL.E_U_BEND])
+                                              + np.sum(state.elem[e, SL.E_U_HG])),
+        "casing_absorbed_energy_part_J": float(np.sum(state.contact_work[w.layer_nodes])),
+    }
 
 
 def outer_layer_bulge(model, state, anchored: np.ndarray | None = None) -> float:

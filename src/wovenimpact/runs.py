@@ -14,8 +14,9 @@ case with ``run.stop_when_decided``: until its outcome has held that long) and w
   consistent files); ``restart=True`` resumes from the newest one and the run ends
   bitwise identical to an uninterrupted one (the output schedule is a function of
   the State alone);
-- ``OUT/plots/energy.png``, ``OUT/summary.json`` and ``OUT/report.html`` (one page:
-  verdicts, summary, plots, case, provenance; :mod:`wovenimpact.io.report`) at the end.
+- ``OUT/plots/energy.png``, ``OUT/summary.json`` and ``OUT/report.html`` (one page: the
+  answer, how far to trust it, the summary grouped in engineering units, plots, case,
+  provenance; :mod:`wovenimpact.io.report`) at the end.
 
 summary.json carries the ``provenance`` digests (:mod:`wovenimpact.provenance`) by which
 studies reuse a finished run, and ``energy_check``: a run whose energy balance fails
@@ -63,14 +64,17 @@ from wovenimpact.quantities import (
     symmetry_factor,
 )
 from wovenimpact.containment import (
+    CASING_ENERGY_COLUMNS,
     CONTAINMENT_COLUMNS,
     CasingWatch,
+    casing_energy_row,
     casing_inner_radius,
     casing_outer_radius,
     casing_summary,
     decided_since,
     fragment_row,
     is_containment,
+    layer_elements,
     speed_settled,
 )
 from wovenimpact.provenance import changed_parts, digest_of, provenance, restart_parts
@@ -122,11 +126,13 @@ def history_columns(model) -> tuple[str, ...]:
     points (metal_state.plastic_work), a part of the internal work. With mass scaling
     (``run.mass_scaling_fraction``): ``added_mass_part_kg``, ``mass_scaling_energy_part_J``
     (the kinetic energy the added mass brought, an input of the balance) and
-    ``mass_scaled_elements``."""
+    ``mass_scaled_elements``. A containment model's rows add the fragment's and the
+    casing's columns (containment.fragment_row, containment.casing_energy_row: the
+    fragment's kinetic energy and the casing's kinetic, element and absorbed energies)."""
     return (HISTORY_COLUMNS + (IMPACT_COLUMNS if model.body_params.shape[0] else ())
             + (METAL_COLUMNS if has_metal(model) else ())
             + (MASS_SCALING_COLUMNS if model.mass_scaling_fraction > 0.0 else ())
-            + (CONTAINMENT_COLUMNS if is_containment(model) else ()))
+            + (CONTAINMENT_COLUMNS + CASING_ENERGY_COLUMNS if is_containment(model) else ()))
 
 
 def history_row(model, state: State, normaliser: float = 0.0,
@@ -144,7 +150,9 @@ def history_row(model, state: State, normaliser: float = 0.0,
         impact = {**impactor_row(model, state), **intact_material_ahead(model, state),
                   "impactor_kinetic_energy_part_J": eb["impactor_kinetic_J"]}
     if is_containment(model):
+        watch = CasingWatch(model) if watch is None else watch
         impact.update(fragment_row(model, state, watch))
+        impact.update(casing_energy_row(model, state, watch))
     if has_metal(model):
         impact["plastic_work_part_J"] = plastic_work(model, state)
     if model.mass_scaling_fraction > 0.0:
@@ -534,8 +542,33 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
         "symmetry_factor": factor,
         # each failing material's element lengths against its calibrated range (theory §1.4)
         MESH_VERDICT_KEY: mesh_verdict(model, state),
+        **element_sizes(spec, model),
         "max_displacement_m": float(np.sqrt(np.max(np.sum((state.x - model.x0) ** 2, axis=1)))),
     }
+
+
+def element_sizes(spec, model) -> dict:
+    """summary.json's element sizes (m), the first thing a reader of a result asks:
+    ``element_size_m``, the case's ``mesh.element_size`` (a containment casing's: the fine
+    sector's in a graded ring) and, for a containment case, ``blade_element_size_m``, the
+    blade's (``mesh.blade.element_size``, else the casing's). An imported mesh has no
+    such key: there each is the median √(element area) of the elements it stands for
+    (the casing layers' and the rest, the blade, in an imported containment mesh)."""
+    mesh = spec.mesh
+    if mesh.kind == "plate":
+        return {"element_size_m": float(mesh.element_size)}
+    if mesh.kind == "containment":
+        return {"element_size_m": float(mesh.element_size),
+                "blade_element_size_m": float(mesh.blade_element_size)}
+
+    def median_size(elems) -> float | None:
+        return float(np.sqrt(np.median(model.area0[elems]))) if len(elems) else None
+
+    if not is_containment(model):
+        return {"element_size_m": median_size(np.arange(model.n_elems))}
+    casing = np.concatenate(layer_elements(model))
+    blade = np.setdiff1d(np.arange(model.n_elems), casing)
+    return {"element_size_m": median_size(casing), "blade_element_size_m": median_size(blade)}
 
 
 def contact_damping_summary(model, state: State, factor: float) -> dict:
@@ -575,7 +608,8 @@ CONTAINMENT_SUMMARY_KEYS = ("outcome", "contained", "fragment_exit_speed_m_per_s
                             "casing_mass_kg", "casing_mass_per_area_kg_per_m2", "casing_layers",
                             "absorbed_energy_per_layer_J", "casing_absorbed_energy_J",
                             "held_energy_per_layer_J",
-                            "absorbed_energy_per_material_J", "stopped_when_decided")
+                            "absorbed_energy_per_material_J", "stopped_when_decided",
+                            "blade_element_size_m")
 COMMON_SUMMARY_KEYS = (
     "summary_version", "case", "end_time_s", "steps", "elements", "nodes", "first_time_step_s",
     "last_time_step_s", "wall_time_s", "element_cycles", "ns_per_element_cycle",
@@ -588,7 +622,7 @@ COMMON_SUMMARY_KEYS = (
     "contact_friction_energy_J", "contact_damping_energy_by_interface_J",
     "contact_friction_energy_by_interface_J", "eroded_elements", "energy_error_fraction",
     "energy_tolerance", "energy_check", "symmetry_factor", "max_displacement_m",
-    "restarted_from_step", "provenance", "finished_utc", "mesh_verdict",
+    "restarted_from_step", "provenance", "finished_utc", "mesh_verdict", "element_size_m",
     "plastic_work_J",  # runs with a metal section only
     # runs with mass scaling only
     "added_mass_kg", "added_mass_fraction", "mass_scaling_energy_J", "mass_scaled_elements",

@@ -24,3 +24,27 @@ def test_cell_formats_nested_values():
     assert cell([np.float64(1.0) / 3.0, (2, np.float32(0.5))]) == "[0.333333, [2, 0.5]]"
     assert cell(np.array([1.0, 2.0])) == "[1, 2]"
     assert cell(None) == "None" and cell(True) == "True"
+
+
+def test_the_run_summary_is_grouped_in_engineering_units_as_on_the_report(capsys):
+    """``wovenimpact run``'s table: the report's groups and units (io/summary_keys.py),
+    NumPy scalars printed, an unknown key under "other", the provenance left out."""
+    from wovenimpact.cli.app import emit_summary
+
+    summary = {"outcome": "escaped", "fragment_exit_speed_m_per_s": np.float64(125.4),
+               "max_bulge_m": np.float64(0.0412),
+               "absorbed_energy_per_layer_J": [np.float64(300.0), np.float64(12.5)],
+               "end_time_s": 0.0025, "my_new_metric": 7, "summary_version": 4,
+               "provenance": {"digest": "d1d2d3d4"}}
+    with console.capture() as cap:
+        emit_summary(summary, False, "summary")
+    out = cap.get()
+    lines = out.splitlines()
+    bulge = next(line for line in lines if "largest bulge" in line)
+    assert "41.2" in bulge and " mm " in bulge and "max_bulge_m" in bulge
+    assert "300, 12.5" in out and "125.4" in out
+    ms = next(line for line in lines if "end time" in line)
+    assert "2.5" in ms and " ms " in ms
+    assert out.index("Answer") < out.index("Casing and fragment") < out.index("Run and checks")
+    assert out.index("Other keys") < out.index("my_new_metric")
+    assert "d1d2d3d4" not in out and "summary_version" not in out

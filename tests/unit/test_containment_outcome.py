@@ -161,6 +161,16 @@ def test_containment_outputs_bulge_layer_and_material_energies_and_fragment_plot
     assert per_material[names[1]] == pytest.approx(per_layer[1] + per_layer[2], rel=1e-12)
     assert sum(per_layer) > 0.0
     assert summary["casing_absorbed_energy_J"] == pytest.approx(sum(per_layer), rel=1e-12)
+    # the history's casing energies (the energy plot's casing panel) end at the summary's
+    # absorbed energy; the casing holds less than it absorbed, the fragment lost more
+    assert h["casing_absorbed_energy_part_J"][-1] == pytest.approx(
+        summary["casing_absorbed_energy_J"], rel=1e-12)
+    held = h["casing_kinetic_energy_part_J"][-1] + h["casing_element_energy_part_J"][-1]
+    assert 0.0 < held <= h["casing_absorbed_energy_part_J"][-1] * (1.0 + 1e-9)
+    lost = h["fragment_kinetic_energy_part_J"][0] - h["fragment_kinetic_energy_part_J"][-1]
+    assert lost > h["casing_absorbed_energy_part_J"][-1] > 0.0
+    # the element sizes as run (the override, and the blade's: the casing's by default)
+    assert summary["element_size_m"] == summary["blade_element_size_m"] == pytest.approx(0.01)
     # absorbed = the contact work the layer's nodes received: the run's per-node sums
     # (final checkpoint) add up to the whole contact work, the blade gave what the layers
     # took plus what the contact dashpots dissipated and the penalty springs hold

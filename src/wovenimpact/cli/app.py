@@ -97,6 +97,30 @@ def emit(result: Mapping, as_json: bool, title: str) -> None:
     console.print(table)
 
 
+def emit_summary(summary: Mapping, as_json: bool, title: str) -> None:
+    """A run's summary: one JSON object as :func:`emit`, or for a person the grouping of
+    its report.html (:mod:`wovenimpact.io.summary_keys`): a section per group, each row
+    its label, its value in the unit shown beside it (mm, m/s, J, %, …) and its
+    summary.json key; the provenance digests are left to summary.json and report.html."""
+    if as_json:
+        emit(summary, True, title)
+        return
+    from wovenimpact.io.summary_keys import grouped
+
+    table = Table(title=title)
+    table.add_column("quantity")
+    table.add_column("value", justify="right")
+    table.add_column("unit")
+    table.add_column("summary.json key", style="dim", overflow="fold")  # whole, not cut
+    for i, (_, heading, rows) in enumerate(grouped(summary)):
+        if i:
+            table.add_section()
+        table.add_row(f"[bold]{escape(heading)}[/]", "", "", "")
+        for r in rows:
+            table.add_row(escape(r.label), escape(r.value), escape(r.unit), escape(r.key))
+    console.print(table)
+
+
 def fail(message: str, code: int = 2) -> None:
     """Print an input error for a person and exit with ``code``."""
     err_console.print(f"[bold red]error:[/] {escape(message)}", soft_wrap=True)

@@ -8,7 +8,7 @@ from pathlib import Path
 import typer
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-from wovenimpact.cli.app import app, console, emit, err_console, fail
+from wovenimpact.cli.app import app, console, emit_summary, err_console, fail
 from wovenimpact.errors import InputError, MaterialPointError, SimulationError
 
 LOG_EVERY_S = 60.0  # wall seconds between progress lines when stderr is not a terminal
@@ -93,7 +93,7 @@ def run(
         bar.stop()
         fail(write_failure(err, f"the outputs of {case}"))
     bar.stop()
-    emit(summary, as_json, f"{case.name}: summary (also in {out / 'summary.json'})")
+    emit_summary(summary, as_json, f"{case.name}: summary (also in {out / 'summary.json'})")
     if not as_json:
         console.print(f"report: {out / 'report.html'}")
     energy_verdict(summary)

@@ -62,9 +62,31 @@ def energy_plot(h: dict, path: str | Path, title: str = "", symmetry_factor: flo
     contact energy and what contact dashpots and friction dissipated of it (dashed; the
     dashpots' and friction's own shares dash-dotted),
     eroded, external work, and the balance error, with a line at 1 % of the initial
-    kinetic energy for scale."""
+    kinetic energy for scale.
+
+    A containment run's history (with the casing's columns,
+    ``containment.CASING_ENERGY_COLUMNS``) gets two panels instead
+    (:func:`containment_energy_plot`): the fragment's kilojoules would flatten the
+    casing's energies near zero on one axis."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
+    if all(c in h for c in CASING_CURVES.values()):
+        fig = containment_energy_figure(h, title, symmetry_factor)
+    else:
+        fig = single_energy_figure(h, title, symmetry_factor)
+    fig.tight_layout()
+    _save(fig, path)
+    return path
+
+
+def _initial_kinetic(h: dict, symmetry_factor: float) -> float:
+    return symmetry_factor * (h["structure_kinetic_energy_part_J"][0]
+                              + (h["impactor_kinetic_energy_part_J"][0]
+                                 if "impactor_kinetic_energy_part_J" in h else 0.0))
+
+
+def single_energy_figure(h: dict, title: str = "", symmetry_factor: float = 1.0):
+    """The one-panel figure of :func:`energy_plot` (every run but a containment one)."""
     t = h["time_s"] * 1e6
     curves = energy_curves(h, symmetry_factor)
     dashed = {"stored (live elements)", "hourglass (live elements)",
@@ -78,9 +100,7 @@ def energy_plot(h: dict, path: str | Path, title: str = "", symmetry_factor: flo
         else:
             ax.plot(t, y, "--" if label in dashed else "-." if label in dotted else "-",
                     label=label)
-    e0 = symmetry_factor * (h["structure_kinetic_energy_part_J"][0]
-                            + (h["impactor_kinetic_energy_part_J"][0]
-                               if "impactor_kinetic_energy_part_J" in h else 0.0))
+    e0 = _initial_kinetic(h, symmetry_factor)
     if e0 > 0.0:
         ax.axhline(0.01 * e0, color="0.6", lw=0.8, label="1 % of the initial kinetic energy")
     ax.set_xlabel("time (µs)")
@@ -88,9 +108,80 @@ def energy_plot(h: dict, path: str | Path, title: str = "", symmetry_factor: flo
     ax.set_title(title)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, ncol=2)
-    fig.tight_layout()
-    _save(fig, path)
-    return path
+    return fig
+
+
+# the casing panel's own curves: label → history column (containment.casing_energy_row)
+CASING_CURVES = {"casing absorbed (contact work received)": "casing_absorbed_energy_part_J",
+                 "casing kinetic": "casing_kinetic_energy_part_J",
+                 "casing elements' stored + hourglass": "casing_element_energy_part_J"}
+FRAGMENT_CURVE = "fragment_kinetic_energy_part_J"
+
+
+def containment_curves(h: dict, symmetry_factor: float = 1.0) -> tuple[dict, dict]:
+    """The two panels' curves of a containment run's energy plot (J, whole problem):
+
+    - the fragment and the whole model: ``fragment kinetic`` (Σ ½ m v² over its nodes),
+      ``structure kinetic`` (every node: the spinning hub part, the fragment and the
+      casing), ``internal work``, ``external work`` (the blade root's prescribed spin),
+      ``contact energy`` and the ``balance error``;
+    - the casing: the energy it absorbed (the contact work its layers' nodes received,
+      summary.json's ``casing_absorbed_energy_J`` at the end), its kinetic energy, the
+      stored and hourglass energy its elements hold, and what is left of the absorbed
+      energy, ``casing dissipated (absorbed − kinetic − held)``: broken yarns, plastic
+      flow, eroded pieces and the layers' contact with each other; beside them the
+      whole model's contact damping and friction, eroded kinetic and eroded internal
+      energy (all but the blade's release row are the casing's), and the balance error
+      again on this scale.
+    """
+    f = symmetry_factor
+    every = energy_curves(h, f)
+    whole = {"fragment kinetic": f * h[FRAGMENT_CURVE]}
+    for label in ("structure kinetic", "internal work", "external work", "contact energy",
+                  "balance error"):
+        whole[label] = every[label]
+    casing = {label: f * h[c] for label, c in CASING_CURVES.items()}
+    casing["casing dissipated (absorbed − kinetic − held)"] = (
+        casing["casing absorbed (contact work received)"] - casing["casing kinetic"]
+        - casing["casing elements' stored + hourglass"])
+    for label in ("contact damping", "contact friction", "eroded kinetic",
+                  "eroded internal (at erosion)", "balance error"):
+        if label in every:
+            casing[label] = every[label]
+    return whole, casing
+
+
+def containment_energy_figure(h: dict, title: str = "", symmetry_factor: float = 1.0):
+    """Two panels sharing the time axis (:func:`containment_curves`): the fragment's
+    kinetic energy with the whole model's books above, the casing's energies below on
+    their own scale."""
+    t = h["time_s"] * 1e6
+    whole, casing = containment_curves(h, symmetry_factor)
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(7.5, 7.2), sharex=True)
+    for ax, curves in ((top, whole), (bottom, casing)):
+        for label, y in curves.items():
+            if label == "balance error":
+                ax.plot(t, y, "k:", lw=1.6, label="balance error |drift| (whole model)")
+            elif label.startswith(("contact damping", "contact friction")):
+                ax.plot(t, y, "-.", label=f"{label} (whole model)")
+            elif label.startswith("eroded"):
+                ax.plot(t, y, ":", label=f"{label} (whole model)")
+            else:
+                ax.plot(t, y, "--" if "dissipated" in label else "-",
+                        lw=2.0 if label in ("fragment kinetic",
+                                            "casing absorbed (contact work received)") else 1.2,
+                        label=label)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, ncol=2)
+    e0 = _initial_kinetic(h, symmetry_factor)
+    if e0 > 0.0:
+        top.axhline(0.01 * e0, color="0.6", lw=0.8, label="1 % of the initial kinetic energy")
+        top.legend(fontsize=7, ncol=2)
+    top.set_ylabel("fragment and whole model (J)")
+    top.set_title(title)
+    bottom.set_ylabel("casing (J)")
+    bottom.set_xlabel("time (µs)")
+    return fig
 
 
 def impactor_plot(h: dict, path: str | Path, title: str = "") -> Path:

@@ -91,6 +91,24 @@ def test_a_failure_stretch_beyond_the_table_limit_is_an_input_error_naming_the_f
     FT.family_knots(dataclasses.replace(at, ultimate_tension=0.999 * limit), params.warp)
 
 
+def test_a_family_without_crimp_is_an_input_error_not_a_zero_over_zero():
+    """h0 = 0 (crimp 0) made the builder divide by h0 in its height norms (a RuntimeWarning
+    from 0/0) and run; the material files refuse it (test_strict_inputs), and so does the
+    table, naming the family, for parameters made in code."""
+    import warnings
+
+    params = reference_fabric()
+    straight = dataclasses.replace(params.warp, crimp=0.0, h0=0.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with pytest.raises(InputError, match=r"^warp\.h0 = 0 m \(crimp 0\): the crossover "
+                                             r"table needs crimped yarns"):
+            FT.family_knots(straight, params.fill, family="warp")
+        with pytest.raises(InputError, match=r"^fill\.h0 = 0 m"):
+            FT.with_table(dataclasses.replace(params, fill=dataclasses.replace(
+                params.fill, crimp=0.0, h0=0.0)), np.zeros(L.N_PARAM))
+
+
 def sample_errors(params, n, seed):
     rng = np.random.default_rng(seed)
     lu = max(FT.failure_stretch(params.warp), FT.failure_stretch(params.fill))

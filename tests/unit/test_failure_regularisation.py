@@ -137,13 +137,24 @@ def test_a_broken_family_erodes_once_its_element_has_opened_by_the_erosion_openi
 
 
 def test_without_regularisation_every_point_keeps_the_material_s_own_failure(kevlar):
-    """The default (no [material.regularisation]): s = 1, the material's softening strain
-    and stretch limit, whatever the element — the columns of the runs made before."""
+    """The default (no [material.regularisation]): s = 1 and the material's softening
+    strain whatever the element; a broken family erodes at the opening at which a
+    crossover-size element reaches the material's erode_broken_stretch λ_e (λ_lim = 1 +
+    (λ_e − 1) h_ref/h: λ_e itself at h_ref, 1.5 on an element twice as long); a stretch
+    limit of 0 still means never."""
     p = with_options(kevlar, failure="progressive", softening_strain=0.01).to_array(table=False)
-    cols = regularised_columns(p, np.array([[0.5e-3, 7e-3], [20e-3, 0.0]]))
+    h_ref = p[L.P_REG_LENGTH:L.P_REG_LENGTH + 2]
+    lengths = np.array([[0.5e-3, 7e-3], [2.0 * h_ref[0], 0.0]])
+    cols = regularised_columns(p, lengths)
     assert np.array_equal(cols[:, 0:2], np.ones((2, 2)))
     assert np.array_equal(cols[:, 2:4], np.full((2, 2), 0.01))
-    assert np.array_equal(cols[:, 4:6], np.full((2, 2), p[L.P_ERODE_STRETCH]))
+    lam_e = p[L.P_ERODE_STRETCH]
+    assert lam_e == 2.0
+    h = np.where(lengths > 0.0, lengths, h_ref)
+    assert cols[:, 4:6] == pytest.approx(1.0 + (lam_e - 1.0) * h_ref / h, rel=1e-15)
+    assert cols[1, 4] == pytest.approx(1.5) and cols[1, 5] == 2.0
+    never = with_options(kevlar, erode_broken_stretch=0.0).to_array(table=False)
+    assert np.array_equal(regularised_columns(never, lengths)[:, 4:6], np.zeros((2, 2)))
 
 
 def test_the_element_lengths_follow_the_yarns():

@@ -91,7 +91,8 @@ class FailureRegularisation:
             softening, ½ s T_u · δ_s / s = ½ T_u δ_s per yarn crossing the crack, does not
             depend on h_i; 0: the material's fixed ``softening_strain``.
         erosion_opening: δ_e (m): a point whose family i is broken erodes once λ_i exceeds
-            1 + δ_e/h_i (the crack opened by δ_e); 0: the fixed ``erode_broken_stretch``.
+            1 + δ_e/h_i (the crack opened by δ_e); 0: the opening at which an element of
+            the reference length reaches ``erode_broken_stretch``, δ_e = (λ_e − 1) h_ref.
     """
 
     reference_length: float | None = None
@@ -269,7 +270,10 @@ def regularised_columns(p: np.ndarray, lengths: np.ndarray) -> np.ndarray:
 
     Returns:
         (n, 6): s_w, s_f (T_u scales), Δε_s,w, Δε_s,f (softening strains), λ_lim,w,
-        λ_lim,f (stretch of a broken family at which the point erodes; 0: never).
+        λ_lim,f (stretch of a broken family at which the point erodes; 0: never): 1 +
+        δ_e/h_i, δ_e the erosion opening, by default (λ_e − 1) h_ref with λ_e the
+        ``erode_broken_stretch`` option — that stretch on an element of the reference
+        length, the same opening on any other.
     """
     lengths = np.atleast_2d(np.asarray(lengths, dtype=float))
     h_ref = p[L.P_REG_LENGTH:L.P_REG_LENGTH + 2]
@@ -285,7 +289,13 @@ def regularised_columns(p: np.ndarray, lengths: np.ndarray) -> np.ndarray:
     crimp = p[L.P_ELL0:L.P_ELL0 + 2] / p[L.P_LT0:L.P_LT0 + 2]
     out[:, 2:4] = crimp * opening / (scale * h) if opening > 0.0 else p[L.P_SOFT]
     erode = p[L.P_ERODE_OPENING]
-    out[:, 4:6] = 1.0 + erode / h if erode > 0.0 else p[L.P_ERODE_STRETCH]
+    stretch = p[L.P_ERODE_STRETCH]
+    if erode > 0.0:
+        out[:, 4:6] = 1.0 + erode / h
+    elif stretch > 0.0:  # the opening of an element of the reference length at λ_e
+        out[:, 4:6] = 1.0 + (stretch - 1.0) * h_ref / h
+    else:
+        out[:, 4:6] = 0.0  # never
     return out
 
 

@@ -142,8 +142,14 @@ def knots(lo: float, hi: float, fine: list[tuple[float, float]], coarse=COARSE, 
 def family_knots(own, other, coarse=COARSE, dense=FINE, family: str = "yarn") -> np.ndarray:
     """Knots along one family's stretch (module docstring: the grid choice).
 
-    Raises InputError when the family's failure stretch exceeds ``MAX_FAILURE_STRETCH``
-    (the grid would not fit in memory)."""
+    Raises InputError when the family is not crimped (h0 = 0: the table measures heights
+    against h0, and the material files refuse it, spec.material) or its failure stretch
+    exceeds ``MAX_FAILURE_STRETCH`` (the grid would not fit in memory)."""
+    if not own.h0 > 0.0:
+        raise InputError(
+            f"{family}.h0 = {own.h0:g} m (crimp {own.crimp:g}): the crossover table needs "
+            "crimped yarns, its heights measured against h0 (docs/theory.md §1.9); valid: "
+            "h0 > 0, e.g. from a crimp > 0 such as 0.0421 (eq. 5.5)")
     lam_u = failure_stretch(own)
     if lam_u > MAX_FAILURE_STRETCH:
         raise InputError(

@@ -10,13 +10,12 @@ from __future__ import annotations
 
 import copy
 import math
-import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from wovenimpact.errors import InputError, InputWarning
+from wovenimpact.errors import InputError
 from wovenimpact.model.abaqus import read_inp
 from wovenimpact.model.gmsh import gmsh_hint, read_msh
 from wovenimpact.model.mesh import Mesh, plate_mesh
@@ -35,6 +34,7 @@ from wovenimpact.model.model import (
 )
 from wovenimpact.spec.case import (
     DOFS,
+    LARGE_MESH,
     ImportedMeshSpec,
     CaseSpec,
     ContainmentMeshSpec,
@@ -126,12 +126,21 @@ def make_mesh(spec: CaseSpec, base: Path, sections: dict | None = None
     if not path.is_file():
         raise InputError(f"mesh.file: {m.file!r} not found (looked for {path})")
     mesh = read_inp(path) if m.kind == "abaqus" else read_msh(path)
+    if mesh.n_elems > LARGE_MESH and not spec.run.allow_large_mesh:  # spec.case.check_mesh_size
+        raise InputError(f"mesh.file: {m.file!r} holds {mesh.n_elems:,} elements, more than "
+                         f"{LARGE_MESH:,}: a model that takes minutes to build and run on two "
+                         "cores (valid: a coarser mesh, or run.allow_large_mesh = true "
+                         "(--set run.allow_large_mesh=true) to build it all the same)")
     mesh.nodes *= m.length_unit
     names: list[str | None] = [None] * mesh.n_elems
     for elset, section in m.sections.items():
         if elset not in mesh.elem_sets:
             raise InputError(f"mesh.sections: element set {elset!r} is not in {m.file}; "
                              f"sets there: {sorted(mesh.elem_sets)}{gmsh_hint(m.file)}")
+        if len(mesh.elem_sets[elset]) == 0:
+            raise InputError(f"mesh.sections: element set {elset!r} of {m.file} holds no "
+                             f"element, so section {section!r} would be given to nothing "
+                             "(valid: a set that holds elements)")
         for e in mesh.elem_sets[elset]:
             if names[e] is not None and names[e] != section:
                 raise InputError(f"mesh.sections: element {e} is in two sets with different "
@@ -473,10 +482,12 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     for i, b in enumerate(spec.boundary):
         nodes = node_set(mesh, b.nodes, f"boundary[{i}].nodes")
         if nodes.size == 0:
-            hint = (" (a full casing ring has no cut edges)" if b.nodes == "casing.cut_edges"
+            hint = ("; a full casing ring (mesh.casing.sector = 360 deg) has no cut edges: "
+                    "remove this boundary, or model a sector" if b.nodes == "casing.cut_edges"
                     else "")
-            warnings.warn(f"boundary[{i}].nodes = {b.nodes!r} holds no node{hint}: this "
-                          "boundary constrains nothing", InputWarning, stacklevel=2)
+            raise InputError(f"boundary[{i}].nodes: node set {b.nodes!r} holds no node, so "
+                             f"this boundary would constrain nothing (valid: a set that holds "
+                             f"nodes{hint})")
         if b.type == "clamped":
             bcs.fix(nodes)
         elif b.type == "pinned":
@@ -537,12 +548,17 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     w = np.zeros((mesh.n_nodes, 3))
     for i, iv in enumerate(spec.initial_velocity):
         nodes = node_set(mesh, iv.nodes, f"initial_velocity[{i}].nodes")
+        if nodes.size == 0:
+            raise InputError(f"initial_velocity[{i}].nodes: node set {iv.nodes!r} holds no "
+                             "node, so this velocity would move nothing (valid: a set that "
+                             "holds nodes)")
         centre = np.asarray(iv.centre)
         if iv.radius is not None:
             nodes = nodes[np.linalg.norm(mesh.nodes[nodes] - centre, axis=1) <= iv.radius]
             if nodes.size == 0:
                 raise InputError(f"initial_velocity[{i}].radius: no node of {iv.nodes!r} lies "
-                                 f"within {iv.radius:g} m of {centre.tolist()}")
+                                 f"within {iv.radius:g} m of {centre.tolist()} (valid: a radius "
+                                 "that reaches a node of the set)")
         if iv.velocity is not None:
             v[nodes] += np.asarray(iv.velocity)
         if iv.angular_velocity is not None:

@@ -8,6 +8,12 @@ together, one line each, naming the key::
 
     plate.toml: run.end_time: has no unit (got '200'; valid: a time > 0 such as '60 us')
 
+TOML's types are kept: a count, a switch or a direction takes an integer, ``true`` /
+``false`` or three numbers, and a string ``"4"``, a ``1`` for ``true`` or ``["1", "0",
+"0"]`` is an error naming the type given (``spec.fields.integer``, ``boolean``,
+``vector``). A generated mesh of more than LARGE_MESH elements needs
+``run.allow_large_mesh = true``.
+
 Two things are warnings (:class:`~wovenimpact.errors.InputWarning`), not errors: an
 output interval longer than ``run.end_time`` (clipped to it, so that a run shortened
 with ``--set run.end_time=…`` just runs) and a quarter plate whose ``symmetry_x`` /
@@ -60,7 +66,8 @@ Schema (see README and examples/cases/)::
                       keep), mass_scaling_fraction, max_added_mass_fraction, threads,
                       max_steps (the
                       predicted step count end_time/Δt₁ above which the run is refused;
-                      5e6; docs/inputs.md)
+                      5e6; docs/inputs.md), allow_large_mesh (a mesh above LARGE_MESH
+                      elements is refused without it)
 """
 
 from __future__ import annotations
@@ -71,18 +78,32 @@ import warnings
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-from pydantic import AfterValidator, BaseModel, Field, ValidationError, model_validator
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    Field,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from wovenimpact.errors import InputWarning
 from wovenimpact.impactor import BODY_PENALTY_SCALE, SIDEWAYS_COS
 from wovenimpact.spec.fields import (
+    DEFAULT_TABLES,
     STRICT,
     Problem,
     apply_overrides,
+    boolean,
+    check_numbers,
     input_error,
+    integer,
     problems_from_validation,
     quantity,
     read_toml,
+    toml_type,
+    type_error,
+    vector,
 )
 
 def _unit_direction(v: tuple[float, float, float]) -> tuple[float, float, float]:
@@ -94,7 +115,9 @@ def _unit_direction(v: tuple[float, float, float]) -> tuple[float, float, float]
     return v
 
 
-Direction = Annotated[tuple[float, float, float], AfterValidator(_unit_direction)]
+DIRECTION_VALID = "three numbers, not all zero, such as [0, 0, -1], not quoted"
+# an array of three TOML numbers: ["1", "0", "0"] or [true, 0, 0] is refused, not read
+Direction = Annotated[vector(DIRECTION_VALID), AfterValidator(_unit_direction)]
 Length = quantity("length", gt=0, example="0.94 mm")
 Time = quantity("time", gt=0, example="10 us")
 Velocity = quantity("velocity", example="-120 m/s")
@@ -108,6 +131,12 @@ DEFAULT_MAX_STEPS = 5_000_000
 # the largest mesh compiled: 5 million elements (the element and material state alone
 # are ~10 GB); a larger count is a unit slip (mesh.side = "1e30 mm"), not a model
 MAX_ELEMENTS = 5_000_000
+# the largest mesh built without run.allow_large_mesh = true: on two cores 941 000 fabric
+# elements (0.05 mm on examples/plate_impact/plies1_100.toml) took 21 s and 3.5 GB to
+# build, and a step costs ~1 µs per element (docs/performance.md): 500 000 elements are
+# ~10 s to build and ~0.5 s a step, minutes before the first output. The largest shipped
+# case or study variant has 237 000 (a 40-layer casing)
+LARGE_MESH = 500_000
 
 
 class CaseInfo(BaseModel):
@@ -131,7 +160,7 @@ class SectionSpec(BaseModel):
     hourglass: quantity("dimensionless", ge=0, lt=1, example="0.05") = 0.05
     areal_mass: quantity("areal_density", gt=0, example="0.477 kg/m^2") | None = None
     # 1: resultant section; odd ≥ 3: Simpson points (default 5 for plastic metals, else 1)
-    points: int | None = Field(default=None, ge=1)
+    points: integer(ge=1, example=5) | None = None
     # in-plane membrane integration: "full" 2×2 Gauss points (default for fabric) or
     # "reduced" one point + hourglass springs (default for metals); theory §4.5
     membrane: Literal["full", "reduced"] | None = None
@@ -147,9 +176,9 @@ class PlateMeshSpec(BaseModel):
     # the plate's extent along y; not given: side (a square, the mesh as before the key)
     width: Length | None = None
     element_size: Length
-    plies: int = Field(default=1, ge=1)
+    plies: integer(ge=1, example=4) = 1
     spacing: Length | None = None
-    quarter: bool = False
+    quarter: boolean() = False
     section: str = Field(min_length=1)
     # a section per ply from the lowest (z = 0) up, e.g. fabric plies behind a metal
     # plate; without spacing the plies then touch: mid-planes (t_k + t_k+1)/2 apart
@@ -195,6 +224,18 @@ class ImportedMeshSpec(BaseModel):
     axis: Direction = (0.0, 0.0, 1.0)
     containment: ContainmentSetsSpec | None = None
 
+    @field_validator("warp_direction", mode="before")
+    @classmethod
+    def _vector_or_circumferential(cls, value):
+        """One message for a value that is neither (not one per member of the union)."""
+        if value is None or value == "circumferential":
+            return value
+        if isinstance(value, (list, tuple)):
+            return check_numbers(value, 3, DIRECTION_VALID)
+        raise type_error(f"is {toml_type(value)}, not 'circumferential' or three numbers",
+                         "'circumferential' (the hoop direction about mesh.axis), or "
+                         + DIRECTION_VALID)
+
     @property
     def warp(self):
         """``warp_direction``, or its default (see the class docstring)."""
@@ -230,11 +271,11 @@ class CasingSpec(BaseModel):
     coarse_element_size: quantity("length", gt=0, example="14 mm") | None = None
     inner_section: str | None = None
     layer_section: str = Field(min_length=1)
-    layers: int = Field(ge=1, le=200)
+    layers: integer(ge=1, le=200, example=4)
     layer_spacing: Length | None = None
     # every second layer turned by half an element about the axis (full ring only): a
     # node faces an element edge of the next layer, not a corner of four (theory §8)
-    offset_layers: bool = False
+    offset_layers: boolean() = False
 
     @model_validator(mode="after")
     def _grading_needs_both(self):
@@ -384,7 +425,7 @@ class RunSpec(BaseModel):
     alpha: quantity("dimensionless", gt=0, le=1, example="0.9") = 0.9
     erode_dt_fraction: quantity("dimensionless", ge=0, lt=1, example="0.05") = 0.05
     # an element crushed through itself is eroded (true) or stops the run (false)
-    erode_inverted: bool = False
+    erode_inverted: boolean() = False
     # selective mass scaling (docs/theory.md §4): elements whose step falls below this
     # fraction of the first get mass so that it is that fraction again (0: off); under
     # stable_step = "yarn" only the wave bound gets mass, not the kinematic limit (which
@@ -399,19 +440,22 @@ class RunSpec(BaseModel):
     # default's up to 0.2 %); not yet the default
     stable_step: Literal["isotropic", "yarn"] = "isotropic"
     # what becomes of a node that loses its last live element (docs/theory.md §5, "Eroded
-    # nodes"): "remove" leaves the model with its kinetic energy (eroded_kinetic; the
-    # default), "keep" flies on as a free node with its mass and momentum, contact-active
-    # against impactors and other plies' segments (LS-DYNA's ENMASS = 2)
-    eroded_nodes: Literal["remove", "keep"] = "remove"
+    # nodes"): "keep" (the default) flies on as a free node with its mass and momentum,
+    # contact-active against impactors and other plies' segments (LS-DYNA's ENMASS = 2);
+    # "remove" leaves the model with its kinetic energy (eroded_kinetic)
+    eroded_nodes: Literal["remove", "keep"] = "keep"
     # the run stops once the added mass exceeds this fraction of the model's mass
     max_added_mass_fraction: quantity("dimensionless", gt=0, le=1, example="0.02") = 0.02
-    threads: int | None = Field(default=None, ge=1)
+    threads: integer(ge=1, example=2) | None = None
     # largest energy-balance error fraction of a run that ends with exit 0 (runs.summarise;
     # docs/theory.md §5): 1 %, the report's verdict line; the shipped examples and study
     # variants stay below 4e-3
     energy_tolerance: quantity("dimensionless", gt=0, le=1, example="0.01") = 0.01
     # the predicted step count end_time / Δt₁ above which a run is refused (model.sanity)
-    max_steps: int = Field(default=DEFAULT_MAX_STEPS, ge=1)
+    max_steps: integer(ge=1, example=DEFAULT_MAX_STEPS) = DEFAULT_MAX_STEPS
+    # a mesh of more than LARGE_MESH (500 000) elements is refused unless this is true: it
+    # takes minutes to build and run on two cores (docs/inputs.md, "Large meshes")
+    allow_large_mesh: boolean() = False
     # a containment run ends once its outcome (contained or escaped) has read the same
     # for this long, an escape also with the fragment's speed settled within 0.5 % over
     # it (runs.decision_watch; docs/theory.md §8.3); omitted: it runs to end_time
@@ -482,7 +526,7 @@ class ContactSpec(BaseModel):
 
     model_config = STRICT
     surfaces: Literal["plies", "parts", "element_sets", "none"] = "plies"
-    self_contact: bool = False
+    self_contact: boolean() = False
     penalty_scale: quantity("dimensionless", gt=0, le=0.5, example="0.1") = 0.1
     damping: quantity("dimensionless", ge=0, le=2, example="0.3") = 0.3
     friction: quantity("dimensionless", ge=0, le=10, example="0.2") = 0.0
@@ -499,7 +543,7 @@ class InitialErosionSpec(BaseModel):
     model_config = STRICT
     centre: tuple[Coordinate, Coordinate, Coordinate] = (0.0, 0.0, 0.0)
     radius: Length
-    plies: list[int] | None = None
+    plies: list[integer(ge=0, example=0)] | None = None
     cylinder_axis: Direction | None = (0.0, 0.0, 1.0)
 
 
@@ -530,6 +574,11 @@ class CaseSpec(BaseModel):
     contact: ContactSpec = ContactSpec()
     initial_erosion: list[InitialErosionSpec] = []
     run: RunSpec
+
+
+# an override may create these when the case omits them (spec.fields.set_dotted)
+DEFAULT_TABLES.update(name for name, f in CaseSpec.model_fields.items()
+                      if isinstance(f.default, BaseModel))
 
 
 def mesh_sections(mesh) -> list[tuple[str, str]]:
@@ -599,13 +648,14 @@ def check_references(spec: CaseSpec) -> list[Problem]:
         problems.append(Problem("mesh.spacing", "is missing", valid="the distance between ply "
                                 "mid-planes, e.g. '0.5 mm', needed when plies > 1 "
                                 "(or ply_sections: touching plies)"))
-    return problems + check_mesh_size(spec.mesh)
+    return problems + check_mesh_size(spec.mesh, spec.run.allow_large_mesh)
 
 
-def check_mesh_size(m) -> list[Problem]:
+def check_mesh_size(m, allow_large: bool = False) -> list[Problem]:
     """A generated mesh must have at least 2 elements along each modelled edge (a quarter
     plate's edge is half the side; a casing's length and the released fragment) and at
-    most MAX_ELEMENTS elements in all."""
+    most MAX_ELEMENTS elements in all; more than LARGE_MESH only with ``allow_large``
+    (``run.allow_large_mesh``)."""
     if isinstance(m, PlateMeshSpec):
         counts = []
         for name, length in (("side", m.side), ("width", m.width)):
@@ -654,17 +704,28 @@ def check_mesh_size(m) -> list[Problem]:
         count = in_casing + in_blade
         context = f"casing and blade, {c.layers} layers"
         if in_blade > in_casing and b.element_size is not None:
-            return _too_many(count, "mesh.blade.element_size", hb, context)
+            return _too_many(count, "mesh.blade.element_size", hb, context, allow_large)
     else:
         return []
-    return _too_many(count, "mesh.element_size", m.element_size, context)
+    return _too_many(count, "mesh.element_size", m.element_size, context, allow_large)
 
 
-def _too_many(count: float, key: str, size: float, context: str) -> list[Problem]:
-    """A count of elements above MAX_ELEMENTS, blamed on ``key`` (= ``size``)."""
+def _too_many(count: float, key: str, size: float, context: str,
+              allow_large: bool = False) -> list[Problem]:
+    """A count of elements above MAX_ELEMENTS, or above LARGE_MESH without
+    ``allow_large``, blamed on ``key`` (= ``size``)."""
     if count > MAX_ELEMENTS:
         return [Problem(key, f"gives about {count:.3g} elements ({context})", size,
                         f"at most {MAX_ELEMENTS:g} elements in the mesh")]
+    if count > LARGE_MESH and not allow_large:
+        # the count goes as 1/size²: the size that gives LARGE_MESH elements
+        fit = size * math.sqrt(count / LARGE_MESH) if math.isfinite(count) else math.inf
+        return [Problem(key, f"gives about {count:.3g} elements ({context}), more than "
+                        f"{LARGE_MESH:,}: a mesh that takes minutes to build and run on two "
+                        f"cores (~10 s to build and ~0.5 s a step per {LARGE_MESH:,} "
+                        "elements)", size, f"{key} ≥ about {fit * 1e3:.3g} mm, or "
+                        "run.allow_large_mesh = true (--set run.allow_large_mesh=true) to "
+                        "build it all the same")]
     return []
 
 

@@ -117,7 +117,8 @@ class OptionsSpec(BaseModel):
     frame: Literal["fibre", "green-naghdi"] = "fibre"
     failure: Literal["instant", "progressive"] = "instant"
     softening_strain: quantity("dimensionless", gt=0, example="0.01") | None = None
-    # erode a point once a broken yarn family is stretched past this (0: never)
+    # erode a point once a broken yarn family is stretched past this on an element of the
+    # reference length, i.e. opened by (this − 1) × reference length on any (0: never)
     erode_broken_stretch: quantity("dimensionless", ge=0, example="2.0") = 2.0
     # ... or, with a family broken, either family crushed below this (0: never; < 1)
     erode_broken_crush: quantity("dimensionless", ge=0, lt=1, example="0.5") = 0.5

@@ -41,8 +41,11 @@ fails when this page and the schemas part. Every quantity carries its unit in th
 stored in and the bounds it must meet (in that unit). A key without a default must be
 given; "—" means not given (the key's comment says what that means). A key on the command
 line (`--set KEY=VALUE`) is dotted: `run.end_time`, `mesh.casing.layers`,
-`initial_velocity.0.radius`. What a valid file may still not say, and what is only warned
-of: [inputs.md](inputs.md). The model behind the keys: [theory.md](theory.md).
+`initial_velocity.0.radius`. A whole number, a switch or a list of plain numbers is
+written as TOML writes it — `plies = 4`, `quarter = true`, `direction = [0, 0, -1]` — and
+`"4"`, `4.0`, `1` for true or `["1", "0", "0"]` are errors naming the key. What a valid
+file may still not say, and what is only warned of: [inputs.md](inputs.md). The model
+behind the keys: [theory.md](theory.md).
 """
 
 

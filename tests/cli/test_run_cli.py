@@ -508,8 +508,10 @@ def test_penalty_stiffness_does_not_follow_a_falling_step(tmp_path):
 
 
 def test_a_node_eroded_in_the_step_takes_no_contact_force(tmp_path):
-    """Momentum: a node whose last element erodes in this step leaves the model in the
-    node update, so the contact stage must neither push it nor let it push the body.
+    """Momentum, with ``run.eroded_nodes = "remove"``: a node whose last element erodes in
+    this step leaves the model in the node update, so the contact stage must neither push
+    it nor let it push the body (with "keep", the default, it stays contact-active:
+    tests/verification/test_eroded_nodes.py).
     With the elements under the face eroded this step, the body feels only the nodes
     that keep a live element; with nothing eroded it feels them all."""
     from wovenimpact.kernels import rigid_body as RB
@@ -517,7 +519,8 @@ def test_a_node_eroded_in_the_step_takes_no_contact_force(tmp_path):
 
     text = CASE.replace('[[initial_velocity]]\nvelocity = ["0 m/s", "0 m/s", "-60 m/s"]\n'
                         'radius = "1.5 mm"\n', "") + IMPACTOR.replace("{z}", "0.4 mm")
-    compiled = compile_case(*load_case(write_case(tmp_path, text=text)))
+    compiled = compile_case(*load_case(write_case(tmp_path, text=text),
+                                       ['run.eroded_nodes="remove"']))
     model, state = compiled.model, compiled.state
     state.bodies[0, RB.B_X + 2] -= 0.3e-3  # the flat nose 0.05 mm into the ply's surface
     state.dt_first = 1e-7

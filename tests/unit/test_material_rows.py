@@ -38,8 +38,9 @@ def test_each_element_owns_its_sections_points_and_starts_at_its_materials_state
     state = initial_state(model)
     width = model.point_width
     assert state.mat.shape == (sum(rows[s] for s in which), width)
-    start = {"fabric": fabric_point_state(fabric)[0], "metal": metal_point_state(metal)[0]}
-    for e, name in enumerate(which):
+    for e, name in enumerate(which):  # the initial state for the element's lengths (§1.4, §7.3)
+        start = {"fabric": fabric_point_state(fabric, lengths=model.elem_length[e:e + 1])[0],
+                 "metal": metal_point_state(metal, lengths=model.elem_length[e, :1])[0]}
         own = state.mat[model.mat_row[e]:model.mat_row[e + 1]]
         if name == "steel":
             assert not own.any()

@@ -369,10 +369,11 @@ class Model:
         elem_failure: (n_elems, 6) the failure columns of each element's points, from
             its lengths (:func:`failure_columns`): fabric S_TU_SCALE … S_ERODE_LIMIT + 1,
             J2 S_FRAC_SCALE, S_EVOLUTION, S_HINGE in the first three.
-        eroded_nodes: "remove" (default): a node left without a live element leaves the
-            model with its kinetic energy; "keep" (LS-DYNA's ENMASS = 2): it flies on
-            as a free node with its mass and momentum, contact-active (theory §5,
-            "Eroded nodes").
+        eroded_nodes: "remove" (this class's default, for models built in code): a node
+            left without a live element leaves the model with its kinetic energy; "keep"
+            (LS-DYNA's ENMASS = 2; a case's default, ``run.eroded_nodes``): it flies on as
+            a free node with its mass and momentum, contact-active (theory §5, "Eroded
+            nodes").
     """
 
     x0: np.ndarray
@@ -736,8 +737,9 @@ def build_model(
         max_added_mass_fraction: stop once the added mass exceeds this fraction of the
             model's mass, 0 < f ≤ 1; default 0.02.
         stable_step: "isotropic" (default) or "yarn" (theory §4, "Stable step").
-        eroded_nodes: "remove" (default) or "keep": what becomes of a node that loses
-            its last live element (theory §5, "Eroded nodes").
+        eroded_nodes: "remove" (default here; a case's ``run.eroded_nodes`` defaults to
+            "keep") or "keep": what becomes of a node that loses its last live element
+            (theory §5, "Eroded nodes").
     """
     x0 = np.ascontiguousarray(nodes, dtype=float)
     q = np.ascontiguousarray(quads, dtype=np.int64)

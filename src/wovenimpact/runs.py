@@ -369,15 +369,16 @@ OUTPUT_PATTERNS = ("checkpoints/checkpoint_*.npz", "fields/step_*.vtu", "fields/
 
 def clear_outputs(out: Path) -> None:
     """Remove what an earlier run wrote into ``out`` (:data:`OUTPUT_PATTERNS`, nothing
-    else), warning how many files went: a new run's outputs never mix with another's."""
+    else), saying how many files go before they go: a new run's outputs never mix with
+    another's."""
     old = [p for pattern in OUTPUT_PATTERNS for p in out.glob(pattern) if p.is_file()]
+    if old:
+        warnings.warn(f"{out}: removing {len(old)} output files of an earlier run "
+                      "(checkpoints, fields, plots, history, summary, report, error) before "
+                      "this one (to keep them, give another --out)",
+                      InputWarning, stacklevel=3)
     for p in old:
         p.unlink()
-    if old:
-        warnings.warn(f"{out}: removed {len(old)} output files of an earlier run "
-                      "(checkpoints, fields, plots, history, summary, report, error) before "
-                      "this one",
-                      InputWarning, stacklevel=3)
 
 
 def decision_watch(model, hold: float | None):

@@ -564,7 +564,7 @@ def test_a_reused_output_directory_is_cleared_of_an_earlier_runs_outputs(tmp_pat
         p.parent.mkdir(parents=True, exist_ok=True)
         p.write_text("another case's output")
     (out / "notes.txt").write_text("mine")
-    with pytest.warns(InputWarning, match="removed 4 output files of an earlier run"):
+    with pytest.warns(InputWarning, match="removing 4 output files of an earlier run"):
         summary = run_case(write_case(tmp_path, end="8 us"), out)
     assert not any(p.exists() and p.read_text() == "another case's output" for p in stale)
     assert (out / "notes.txt").read_text() == "mine"

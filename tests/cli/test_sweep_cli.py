@@ -293,7 +293,7 @@ def test_an_interrupted_variant_resumes_from_its_checkpoint(tmp_path: Path):
     # the same directory cut short again, then asked for with other values: from the start
     (cut / "summary.json").unlink()
     (cut / "parameters.json").write_text(json.dumps({"other": 1}) + "\n")
-    with pytest.warns(InputWarning, match="removed .* output files of an earlier run"):
+    with pytest.warns(InputWarning, match="removing .* output files of an earlier run"):
         assert run_study(study, tmp_path / "cut", workers=1)[0]["status"] == "done"
     again = summary(tmp_path / "cut")
     assert again["restarted_from_step"] is None and again["steps"] == whole["steps"]

@@ -75,3 +75,14 @@ def test_a_shortened_run_with_too_many_threads_runs_and_warns(tmp_path):
     assert "warning: --threads = 64 is more than" in err
     assert "warning:" in err and "run.checkpoint_interval = 25 us" in err
     assert (out / "summary.json").exists()
+
+
+def test_design_layers_says_it_takes_a_containment_case():
+    """``design layers`` is ``design plies`` under the name a casing designer looks for:
+    its help names the containment case it is for (it called its argument a
+    "plate-impact case")."""
+    for name in ("plies", "layers"):
+        text = " ".join(CliRunner().invoke(app, ["design", name, "--help"]).output.split())
+        assert "or a containment case (a casing and a blade" in text, name
+    layers = " ".join(CliRunner().invoke(app, ["design", "layers", "--help"]).output.split())
+    assert "Another name of `design plies`" in layers

@@ -15,7 +15,9 @@ app.add_typer(design_app, name="design")
 
 @design_app.command("plies")
 def plies(
-    case: Path = typer.Argument(..., help="Plate-impact case (a plate mesh and an impactor)."),
+    case: Path = typer.Argument(..., help="A plate-impact case (a plate mesh and an impactor: "
+                                "plies to stop it) or a containment case (a casing and a "
+                                "blade: casing layers to contain the fragment)."),
     out: Path = typer.Option(None, "--out", help="Where the runs go (default: out/design_<case>)."),
     workers: int = typer.Option(2, "--workers", min=1, help="Runs in parallel."),
     start: int = typer.Option(None, "--start", min=1, help="First ply count to try (default: the case's)."),
@@ -57,6 +59,7 @@ def plies(
         err_console.print(f"[bold yellow]warning:[/] {result['warning']}")
 
 
-design_app.command("layers", help="The same search on a containment case: the fewest "
-                   "casing layers (mesh.casing.layers: fabric plies of a hybrid casing, "
-                   "aluminium layers of an all-metal one) that contain the fragment.")(plies)
+design_app.command("layers", help="Another name of `design plies`, for a containment case: "
+                   "the fewest casing layers (mesh.casing.layers: fabric plies of a hybrid "
+                   "casing, aluminium layers of an all-metal one) that contain the "
+                   "fragment.")(plies)

@@ -145,3 +145,17 @@ def test_an_override_of_an_optional_table_the_case_omits_sets_it_and_a_typo_is_n
     for key in ("contatc", "impactor"):
         with pytest.raises(InputError, match=f"the base case has no '{key}'"):
             load_case(TOUR, [f"{key}.damping=0.1"])
+
+
+def test_a_study_may_set_an_omitted_default_table_before_any_case_is_read():
+    """The tables an override may create are known to ``set_dotted`` on its own, in a
+    fresh interpreter that has imported nothing but spec.fields (a sweep sets its
+    parameters before it validates a case)."""
+    import subprocess
+    import sys
+
+    code = ("from wovenimpact.spec.fields import set_dotted\n"
+            "d = {'run': {}}\nset_dotted(d, 'contact.damping', 0.1)\nprint(d['contact'])")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == "{'damping': 0.1}"

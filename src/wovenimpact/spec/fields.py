@@ -224,6 +224,8 @@ def set_dotted(doc: dict, key: str, value: Any, label: str = "parameters") -> No
     elsewhere the key must exist in the base case except for its last part (a new
     optional key). ``label`` names where the key came from in error messages (a study's
     ``parameters``, ``--set``)."""
+    import wovenimpact.spec.case  # noqa: F401  (fills DEFAULT_TABLES; imported here: a cycle)
+
     parts = key.split(".")
     node: Any = doc
     for i, part in enumerate(parts[:-1]):

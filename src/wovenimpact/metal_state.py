@@ -63,10 +63,16 @@ def _j2_point_values(model, state, column: int):
 
 def plastic_work(model, state) -> float:
     """Plastic work of every J2 point in the model (J; module docstring)."""
-    total = 0.0
-    for _, w_in, w_k, values in _j2_point_values(model, state, J.S_PLASTIC_WORK):
-        total += float(np.einsum("eg,egk,k->", w_in, values, w_k))
-    return total
+    return float(np.sum(element_plastic_work(model, state)))
+
+
+def element_plastic_work(model, state) -> np.ndarray:
+    """(n_elems,) plastic work of each element's J2 points (J, modelled part; 0 for
+    elements whose material is not J2; module docstring)."""
+    out = np.zeros(model.n_elems)
+    for elems, w_in, w_k, values in _j2_point_values(model, state, J.S_PLASTIC_WORK):
+        out[elems] = np.einsum("eg,egk,k->e", w_in, values, w_k)
+    return out
 
 
 def thickness_ratio(model, state) -> np.ndarray:

@@ -207,12 +207,16 @@ def residual_velocity(h: dict, quiet_time: float = QUIET_TIME) -> dict:
 
 
 def ply_energies(model, state) -> list[float]:
-    """Energy held by each ply (full-problem values, J): kinetic energy of its nodes plus
-    the stored energy of its elements (for eroded elements, the energy at erosion).
-    Energy dissipated by yarns that broke in elements that did not erode is not in it."""
+    """Energy each ply absorbed (full-problem values, J): kinetic energy of its nodes,
+    the stored energy of its elements (for eroded elements, the energy at erosion) and
+    a metal ply's plastic work. Energy dissipated by yarns that broke in elements that
+    did not erode is not in it (:func:`ply_contact_work` counts it)."""
+    from wovenimpact.metal_state import element_plastic_work
+
     factor = symmetry_factor(model)
-    return [float(factor * held_energy(model, state, np.flatnonzero(model.ply == p)))
-            for p in np.unique(model.ply)]
+    plastic = element_plastic_work(model, state)
+    return [float(factor * (held_energy(model, state, sel) + np.sum(plastic[sel])))
+            for sel in (np.flatnonzero(model.ply == p) for p in np.unique(model.ply))]
 
 
 def ply_contact_work(model, state) -> list[float]:

@@ -25,8 +25,10 @@ def test_the_blade_edge_strip_at_7_mm_perforates_and_its_layers_account_for_the_
     itself took (its springs' energy and what its dashpots dissipated):
     Σ contact_work_per_ply_J = absorbed_energy_J − contact_energy_J, to 1 % of the
     absorbed energy (the body's and the nodes' work are both trapezoid sums; measured
-    −4e-7 relative). The aluminium's share exceeds what it holds at the end (its plastic
-    work is in the contact work, not in absorbed_energy_per_ply_J: 66.0 against 11.4 J)."""
+    −4e-7 relative). The aluminium's absorbed_energy_per_ply_J (held at the end plus its
+    plastic work) is what it took through contact within 2 % (measured 64.6 against
+    65.2 J; without the plastic work it was 11.4 J); a ply's is less than its contact
+    work by the work of its broken yarns, which it does not count."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         s = run_case(STRIP, tmp_path / "o", threads=1, overrides=("mesh.element_size=7 mm",))
@@ -38,4 +40,6 @@ def test_the_blade_edge_strip_at_7_mm_perforates_and_its_layers_account_for_the_
     assert len(work) == 5 and len(s["absorbed_energy_per_ply_J"]) == 5
     assert sum(work) == pytest.approx(s["absorbed_energy_J"] - s["contact_energy_J"],
                                       abs=0.01 * s["absorbed_energy_J"])
-    assert work[4] > s["absorbed_energy_per_ply_J"][4] > 0.0
+    per_ply = s["absorbed_energy_per_ply_J"]
+    assert per_ply[4] == pytest.approx(work[4], rel=0.02)
+    assert all(0.0 < e < w for e, w in zip(per_ply[:4], work[:4]))

@@ -155,9 +155,11 @@ KEYS: dict[str, Key] = {
                                           meaning="the layers' absorbed energy summed by "
                                                   "material"),
     # --- structure: plies
-    "absorbed_energy_per_ply_J": Key(_S, "energy held per ply", "J",
+    "absorbed_energy_per_ply_J": Key(_S, "energy absorbed per ply", "J",
                                      meaning="kinetic + stored energy of each ply at the end "
-                                             "(eroded elements' at erosion)"),
+                                             "(eroded elements' at erosion) + a metal ply's "
+                                             "plastic work; broken yarns' work is in the "
+                                             "contact work per ply"),
     "contact_work_per_ply_J": Key(_S, "contact work per ply", "J",
                                   meaning="work the contact forces did on each ply's nodes"),
     "max_deflection_per_ply_m": Key(_S, "largest deflection per ply", *MM,

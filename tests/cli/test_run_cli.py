@@ -145,6 +145,16 @@ def test_a_run_logged_to_a_file_prints_progress_lines(tmp_path, monkeypatch):
     times = [float(t) for t, *_ in found]
     assert times == sorted(times) and 0.0 < times[-1] < 8.5  # the last step may pass 8 µs
     assert all(0 <= int(pct) <= 100 for _, pct, *_ in found)
+    # before any of them: that it compiles (a first run's minute is said, not silent),
+    # then the model's size and the steps ahead, once, as stepping starts
+    text = " ".join(result.output.split())
+    assert text.index("case: building the model") < text.index("case: stepping")
+    start = re.search(r"case: stepping ([\d,]+) elements, ([\d,]+) nodes; first step "
+                      r"([\d.e+-]+) s: at least ([\d,]+) steps to t = 8 µs", text)
+    assert start, text
+    dt1 = float(start.group(3))
+    assert int(start.group(4).replace(",", "")) == pytest.approx(8e-6 / dt1, abs=1)
+    assert text.count("case: stepping") == 1 and text.index("stepping") < text.index("case: t = ")
 
 
 def test_a_restart_may_change_the_stop_rules_but_not_what_the_steps_compute(tmp_path):

@@ -30,6 +30,17 @@ def _bar(quiet: bool):
     return progress
 
 
+def start_line(name: str, state, end_time: float) -> str:
+    """The line printed once stepping has begun: the model's size, its first step Δt₁
+    and the steps end_time/Δt₁ that take to the end (a lower bound: the step falls as
+    the mesh deforms)."""
+    dt1 = state.dt_first if state.dt_first > 0 else state.dt
+    steps = int(end_time / dt1) if dt1 > 0 else 0
+    return (f"{name}: stepping {state.elem.shape[0]:,} elements, {state.x.shape[0]:,} "
+            f"nodes; first step {dt1:.3g} s: at least {steps:,} steps to t = "
+            f"{end_time * 1e6:.4g} µs")
+
+
 @app.command("run")
 def run(
     case: Path = typer.Argument(..., help="Case file (TOML)."),
@@ -63,6 +74,9 @@ def run(
         now = time.perf_counter()
         if start["step"] is None:  # the bar appears once the case has compiled
             start["step"], start["wall"] = state.step, now
+            if not as_json:
+                err_console.print(start_line(case.stem, state, end_time),
+                                  highlight=False, soft_wrap=True)
             bar.start()
         wall = now - start["wall"]
         done = state.step - start["step"]
@@ -80,6 +94,10 @@ def run(
                 f"{end_time * 1e6:.2f} µs ({frac:.0%}), step {state.step}, Δt {state.dt:.3e} s, "
                 f"{rate:,.1f} steps/s, ETA {eta}", highlight=False, soft_wrap=True)
 
+    if not as_json:
+        err_console.print(f"{case.stem}: building the model (a machine's first run also "
+                          "compiles the kernels: a minute or two, then cached)",
+                          highlight=False, soft_wrap=True)
     try:
         summary = run_case(case, out, restart=restart, threads=threads, progress=report,
                            overrides=overrides or ())

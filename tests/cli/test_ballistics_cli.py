@@ -87,3 +87,15 @@ def test_plies_regression_of_a_containment_study_uses_the_exit_speed_and_layers(
     text = " ".join(bad.output.split())
     assert bad.exit_code == 2 and "mesh.casing.layers = 10 (variant x10)" in text
     assert "still losing speed" in text
+
+
+def test_v50_of_a_containment_study_says_which_fit_it_takes(tmp_path):
+    """A containment ladder has exit speeds, no striking velocity: ``v50`` says so and
+    names ``ballistics plies`` (it said only "no column 'impactor.velocity'")."""
+    path = tmp_path / "c.csv"
+    path.write_text("id,mesh.casing.layers,status,error,outcome,fragment_exit_speed_m_per_s\n"
+                    "a,4,done,,escaped,125\nb,8,done,,escaped,100\n")
+    result = CliRunner().invoke(app, ["ballistics", "v50", str(path)])
+    text = " ".join(result.output.split())
+    assert result.exit_code == 2
+    assert "a containment study" in text and "wovenimpact ballistics plies" in text

@@ -53,6 +53,12 @@ def v50(
 
     try:
         rows = _rows(results)
+        if EXIT in rows[0] and RESIDUAL not in rows[0]:
+            raise InputError(
+                f"{results}: a containment study (its runs have {EXIT}, no impactor "
+                "velocity): a V50 fits residual against striking velocity; for the casing "
+                "layers that contain the fragment, `wovenimpact ballistics plies` fits the "
+                "exit speed against mesh.casing.layers (thesis eq. 8.2)")
         vs = [to_si(json.loads(v) if v.startswith('"') else v, "velocity", key)
               for v in _column(rows, key, results)]
         require_decided(rows, key, str(results))

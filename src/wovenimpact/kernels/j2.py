@@ -28,7 +28,7 @@ reference material frame → current corotational frame) and the step Δt, the k
    step (to round-off);
 5. failure (J12–J13): ε̄p ≥ ε_f (the thesis's constant fracture strain) or the
    Johnson–Cook damage D = Σ Δε̄p / ε_f(η, ε̇*) ≥ 1; a failed point carries no
-   stress from then on and its alive flag is 0 for good. With a hinge length
+   stress from then on and its alive flag is 0 for good. With a hinge ratio
    (J17, :func:`fold_amplification`) each step's Δε̄p counts amp ≥ 1 times.
 
 What the caller (the shell section) must do
@@ -330,7 +330,7 @@ def j2_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, dt, thick, s_in, 
             unsigned integers (np.uint64) in loops.
         amp: the factor ≥ 1 on the step's Δε̄p when fracture is judged (J17: the
             section's fold amplification, :func:`fold_amplification`); 1 for a point
-            with no hinge length (S_HINGE = 1), which is then judged as before.
+            with no hinge ratio (S_HINGE = 1), which is then judged as before.
 
     Returns:
         (status, stiffness, N_xx, N_yy, N_xy): a STATUS_* code, an upper bound
@@ -435,7 +435,7 @@ def j2_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, dt, thick, s_in, 
         ef_const = s_frac * p[m, P_FRACTURE]
         if ef_const > 0.0 and s_in[i, S_HINGE] > 1.0:
             # (J17) with a constant ε_f (no Johnson–Cook damage: the material file refuses
-            # both with a hinge length): D = Σ amp Δε̄p / (s ε_f) in the damage column
+            # both with a hinge ratio): D = Σ amp Δε̄p / (s ε_f) in the damage column
             d_old = s_in[i, S_JC_DAMAGE]
             dmg = d_old + counted / ef_const
             s_out[i, S_JC_DAMAGE] = dmg

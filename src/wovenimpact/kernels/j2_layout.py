@@ -62,9 +62,9 @@ S_RETURN_ITER = 15  # iterations of the last return
 S_FRAC_SCALE = 16  # s, the scale of the fracture strain (constant and Johnson–Cook) (—)
 S_EVOLUTION = 17  # l_e/ū_f: damage D_e grows by l_e Δε̄p/ū_f after onset (1/—); 0: fail at onset
 S_SOFT_DAMAGE = 18  # D_e ∈ [0, 1], damage after the onset of failure; the stress is (1 − D_e) τ̃
-# per point, set at the start of a run (theory §7.3, "Folds"): x_b = max(1, l_e/l_h), l_h
-# the hinge ratio times the section's thickness t0, the
-# factor on the bending part of the plastic strain when fracture is judged; 1: none
+# per point, set at the start of a run (theory §7.3, "Folds"): the factor x_b = max(1, l_e/l_h)
+# on the bending part of the plastic strain when fracture is judged, l_h the hinge ratio
+# times the section's thickness t0; 1: none
 S_HINGE = 19
 N_STATE = 20
 

@@ -7,8 +7,8 @@ import os
 
 import pytest
 
-from wovenimpact.calibration.crimp import crimp_amplitude
 from wovenimpact.jit import configure_threading
+from wovenimpact.materials.crimp import crimp_amplitude
 from wovenimpact.materials.fabric import FabricOptions, FabricParameters, YarnFamily
 
 INCH = 0.0254

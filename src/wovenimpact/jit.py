@@ -51,6 +51,7 @@ from __future__ import annotations
 
 import contextlib
 import ctypes
+import functools
 import hashlib
 import multiprocessing
 import os
@@ -61,6 +62,8 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import numba
+
+PACKAGE = Path(__file__).resolve().parent  # the package's folder
 
 
 def _preload_tbb() -> None:
@@ -101,6 +104,17 @@ def _kernel_source_digest() -> str:
     for f in sorted((Path(__file__).parent / "kernels").glob("*.py")):
         h.update(f.name.encode() + f.read_bytes())
     h.update(Path(__file__).read_bytes())
+    return h.hexdigest()[:16]
+
+
+@functools.lru_cache(maxsize=1)
+def source_digest() -> str:
+    """SHA-256 (16 hex digits) of every ``.py`` file of the package, by relative path: the
+    code's version in a run's provenance (:mod:`wovenimpact.provenance`) and in the key of
+    a cached crossover table (``materials.fabric_table``)."""
+    h = hashlib.sha256()
+    for f in sorted(PACKAGE.rglob("*.py")):
+        h.update(f.relative_to(PACKAGE).as_posix().encode() + b"\0" + f.read_bytes())
     return h.hexdigest()[:16]
 
 

@@ -25,14 +25,13 @@ naming which.
 
 from __future__ import annotations
 
-import functools
 import hashlib
 import json
 from pathlib import Path
 
 from wovenimpact.errors import InputError
+from wovenimpact.jit import source_digest
 
-PACKAGE = Path(__file__).resolve().parent
 # [run] keys a restart may change: none changes the steps it replays (when to stop, on
 # how many threads, what to write, the verdict)
 RESTART_FREE = ("end_time", "threads", "field_interval", "history_interval",
@@ -40,17 +39,8 @@ RESTART_FREE = ("end_time", "threads", "field_interval", "history_interval",
                 "max_added_mass_fraction")
 
 
-@functools.lru_cache(maxsize=1)
-def source_digest() -> str:
-    """SHA-256 (16 hex digits) of every ``.py`` file of the package, by relative path."""
-    h = hashlib.sha256()
-    for f in sorted(PACKAGE.rglob("*.py")):
-        h.update(f.relative_to(PACKAGE).as_posix().encode() + b"\0" + f.read_bytes())
-    return h.hexdigest()[:16]
-
-
 def code_version() -> dict[str, str]:
-    """The package version and :func:`source_digest`."""
+    """The package version and :func:`~wovenimpact.jit.source_digest`."""
     from wovenimpact import __version__
 
     return {"code_version": __version__, "source_digest": source_digest()}

@@ -159,3 +159,16 @@ def test_a_study_may_set_an_omitted_default_table_before_any_case_is_read():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     assert out.returncode == 0, out.stderr
     assert out.stdout.strip() == "{'damping': 0.1}"
+
+
+def test_the_tables_an_override_may_create_are_the_cases_defaulted_tables():
+    """``spec.fields.DEFAULT_TABLES`` (known below the case schema, so that spec.fields
+    imports nothing above it) are exactly the top-level tables of ``CaseSpec`` whose
+    every key has a default."""
+    from pydantic import BaseModel
+
+    from wovenimpact.spec.case import CaseSpec
+    from wovenimpact.spec.fields import DEFAULT_TABLES
+
+    assert DEFAULT_TABLES == {name for name, f in CaseSpec.model_fields.items()
+                              if isinstance(f.default, BaseModel)}

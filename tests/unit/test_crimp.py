@@ -1,4 +1,4 @@
-"""calibration/crimp.py: crimp amplitude of a cosine yarn, thesis eq. (5.1)–(5.5)."""
+"""materials/crimp.py and calibration/crimp.py: crimp amplitude of a cosine yarn, thesis eq. (5.1)–(5.5)."""
 
 from __future__ import annotations
 
@@ -11,8 +11,8 @@ from hypothesis import given
 from hypothesis import strategies as st
 from scipy.integrate import quad
 
-from wovenimpact.calibration.crimp import (
-    calibrate_crimp,
+from wovenimpact.calibration.crimp import calibrate_crimp
+from wovenimpact.materials.crimp import (
     crimp_amplitude,
     crimp_of_amplitude,
     half_length_from_thread_count,

@@ -141,7 +141,7 @@ def scaled_parameters(scale):
     p = reference_fabric(**EXACT)
     yarn = dataclasses.replace(p.warp, modulus=p.warp.modulus * scale[0], area=p.warp.area * scale[1])
     fill = dataclasses.replace(p.fill, modulus=p.fill.modulus * scale[2], area=p.fill.area * scale[3])
-    from wovenimpact.calibration.crimp import crimp_amplitude
+    from wovenimpact.materials.crimp import crimp_amplitude
 
     yarn = dataclasses.replace(
         yarn, crimp=p.warp.crimp * scale[4], h0=crimp_amplitude(yarn.half_length, p.warp.crimp * scale[4])

@@ -35,7 +35,9 @@ from pathlib import Path
 import numpy as np
 
 from wovenimpact.errors import InputError
+from wovenimpact.jit import cache_root, source_digest
 from wovenimpact.kernels import fabric_layout as L
+from wovenimpact.materials.fabric_point import FabricOptions, initial_state, update_points
 
 FD_STEP = 1e-6  # λ step of the central differences for the cross and height derivatives
 LAMBDA_MIN = 0.8  # lower end of the table; below it the exact solve runs
@@ -54,8 +56,6 @@ MAX_FAILURE_STRETCH = 3.0
 
 def _exact_parameters(params):
     """The same fabric with failure off and the exact solve (the table's oracle)."""
-    from wovenimpact.materials.fabric import FabricOptions
-
     big = 1e30
     return dataclasses.replace(
         params,
@@ -73,8 +73,6 @@ def exact_crossover(params, lam_w, lam_f) -> dict[str, np.ndarray]:
     Failure is off (T_u → ∞). Where both yarns are slack the heights are not unique;
     these are the undeformed heights projected onto the admissible set.
     """
-    from wovenimpact.materials.fabric import initial_state, update_points
-
     ex = _exact_parameters(params)
     lam_w, lam_f = np.broadcast_arrays(np.asarray(lam_w, float), np.asarray(lam_f, float))
     shape = lam_w.shape
@@ -341,8 +339,6 @@ def mark_exact_cells(params, row, tol=BUILD_SAFETY * TOLERANCE):
 
 
 def _options_free(params):
-    from wovenimpact.materials.fabric import FabricOptions
-
     return dataclasses.replace(params, options=FabricOptions(crossover="exact"))
 
 
@@ -354,8 +350,6 @@ def table_cache_dir() -> Path | None:
     """Where built tables are kept between runs: ``$XDG_CACHE_HOME/wovenimpact/tables``
     (``~/.cache`` when unset), beside the compiled kernels; none with
     ``WOVENIMPACT_TABLE_CACHE=0``."""
-    from wovenimpact.jit import cache_root
-
     if os.environ.get("WOVENIMPACT_TABLE_CACHE", "1") in ("0", "false", "no"):
         return None
     return cache_root() / "tables"
@@ -363,10 +357,8 @@ def table_cache_dir() -> Path | None:
 
 def table_key(params) -> str:
     """The name of a table on disk: SHA-256 of the material's parameter vector (options
-    left out, as in the table) and of the package's sources (``provenance.source_digest``:
-    any change of the code builds the tables afresh)."""
-    from wovenimpact.provenance import source_digest
-
+    left out, as in the table) and of the package's sources (``jit.source_digest``: any
+    change of the code builds the tables afresh)."""
     head = _options_free(params).to_array()
     return hashlib.sha256(head.tobytes() + source_digest().encode()).hexdigest()[:24]
 

@@ -90,7 +90,6 @@ from pydantic import (
 from wovenimpact.errors import InputWarning
 from wovenimpact.impactor import BODY_PENALTY_SCALE, SIDEWAYS_COS
 from wovenimpact.spec.fields import (
-    DEFAULT_TABLES,
     STRICT,
     Problem,
     apply_overrides,
@@ -574,11 +573,6 @@ class CaseSpec(BaseModel):
     contact: ContactSpec = ContactSpec()
     initial_erosion: list[InitialErosionSpec] = []
     run: RunSpec
-
-
-# an override may create these when the case omits them (spec.fields.set_dotted)
-DEFAULT_TABLES.update(name for name, f in CaseSpec.model_fields.items()
-                      if isinstance(f.default, BaseModel))
 
 
 def mesh_sections(mesh) -> list[tuple[str, str]]:

@@ -212,9 +212,9 @@ def read_toml(path, what: str) -> dict:
         raise InputError(f"{path}: not valid TOML: {err}") from None
 
 
-# the case's top-level tables whose every key has a default ([contact], [amplitude]): a
-# dotted key may create one the case omits (spec.case fills this in)
-DEFAULT_TABLES: set[str] = set()
+# the case's top-level tables whose every key has a default: a dotted key may create one
+# the case omits (tests/unit/test_case_warnings.py checks this against spec.case.CaseSpec)
+DEFAULT_TABLES = frozenset({"amplitude", "contact"})
 
 
 def set_dotted(doc: dict, key: str, value: Any, label: str = "parameters") -> None:
@@ -224,8 +224,6 @@ def set_dotted(doc: dict, key: str, value: Any, label: str = "parameters") -> No
     elsewhere the key must exist in the base case except for its last part (a new
     optional key). ``label`` names where the key came from in error messages (a study's
     ``parameters``, ``--set``)."""
-    import wovenimpact.spec.case  # noqa: F401  (fills DEFAULT_TABLES; imported here: a cycle)
-
     parts = key.split(".")
     node: Any = doc
     for i, part in enumerate(parts[:-1]):

@@ -30,9 +30,9 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, Field, ValidationError
 
-from wovenimpact.calibration.crimp import crimp_amplitude, half_length_from_thread_count
 from wovenimpact.kernels.fabric_layout import REG_ROWS_MAX
 from wovenimpact.kernels.j2_layout import FRAC_ROWS_MAX, N_HARD_MAX
+from wovenimpact.materials.crimp import crimp_amplitude, half_length_from_thread_count
 from wovenimpact.materials.fabric import (
     FabricOptions,
     FabricParameters,

@@ -98,7 +98,7 @@ class Impactor:
         radius; a body flying sideways strikes with its side, the shank radius; nose
         first, a flat nose's fillet (0: a sharp rim), a hemispherical nose's radius, a
         conical or ogive nose's tip (0: pointed). A mesh resolves the contact only with
-        elements well below it (:mod:`wovenimpact.mesh_verdict`)."""
+        elements well below it (:mod:`wovenimpact.results.mesh_verdict`)."""
         if self.shape == "sphere" or sideways or self.nose == "hemispherical":
             return self.radius
         return self.fillet if self.nose == "flat" else 0.0

@@ -50,11 +50,11 @@ from wovenimpact.io.report import write_run_report
 from wovenimpact.interfaces import booked_totals, interface_energies
 from wovenimpact.kernels.contact_energy import DAMPING, FRICTION
 from wovenimpact.kernels import shell_layout as SL
-from wovenimpact.metal_state import has_metal, plastic_work
+from wovenimpact.results.metal_state import has_metal, plastic_work
 from wovenimpact.model.compile import CompiledCase, compile_case
-from wovenimpact.mesh_verdict import SUMMARY_KEY as MESH_VERDICT_KEY
-from wovenimpact.mesh_verdict import mesh_verdict
-from wovenimpact.quantities import (
+from wovenimpact.results.mesh_verdict import SUMMARY_KEY as MESH_VERDICT_KEY
+from wovenimpact.results.mesh_verdict import mesh_verdict
+from wovenimpact.results.quantities import (
     impactor_row,
     intact_material_ahead,
     ply_contact_work,
@@ -63,7 +63,7 @@ from wovenimpact.quantities import (
     residual_velocity,
     symmetry_factor,
 )
-from wovenimpact.containment import (
+from wovenimpact.results.containment import (
     CASING_ENERGY_COLUMNS,
     CONTAINMENT_COLUMNS,
     CasingWatch,
@@ -139,7 +139,7 @@ def history_row(model, state: State, normaliser: float = 0.0,
                 watch: CasingWatch | None = None) -> dict:
     """One history.csv row of ``state`` (columns :func:`history_columns`); ``normaliser``
     is the previous row's ``energy_normaliser_part_J`` (0 for the first row); ``watch``
-    the run's :class:`~wovenimpact.containment.CasingWatch` (containment models; made
+    the run's :class:`~wovenimpact.results.containment.CasingWatch` (containment models; made
     for the row when not given)."""
     eb = energy_balance(model, state)
     booked = booked_totals(state.contact_books[0])

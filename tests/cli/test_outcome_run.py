@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 
 from wovenimpact.io.history import read_csv
-from wovenimpact.quantities import QUIET_TIME, STEADY_VELOCITY
+from wovenimpact.results.quantities import QUIET_TIME, STEADY_VELOCITY
 from wovenimpact.runs import run_case
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -45,7 +45,7 @@ def test_a_plug_torn_free_is_not_intact_material(tmp_path):
     from tests.cli.test_run_cli import CASE, IMPACTOR, write_case
     from wovenimpact.kernels import shell_layout as SL
     from wovenimpact.model.compile import compile_case
-    from wovenimpact.quantities import attached_nodes, intact_material_ahead
+    from wovenimpact.results.quantities import attached_nodes, intact_material_ahead
     from wovenimpact.spec.case import load_case
 
     text = CASE.replace('[[initial_velocity]]\nvelocity = ["0 m/s", "0 m/s", "-60 m/s"]\n'

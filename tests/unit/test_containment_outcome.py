@@ -7,7 +7,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from wovenimpact.containment import containment_outcome
+from wovenimpact.results.containment import containment_outcome
 
 R = 0.25
 
@@ -59,7 +59,7 @@ def test_a_fragment_clear_of_the_casing_that_nothing_slows_is_escaped(v_end, n, 
     speed (6 aluminium layers on the 7 mm ring: 75.0 m/s from 3.4 ms, its innermost node
     11 cm outside the casing). Still losing speed, not yet clear, or a history shorter
     than the window: undecided."""
-    from wovenimpact.containment import EXIT_SPEED_SETTLED
+    from wovenimpact.results.containment import EXIT_SPEED_SETTLED
 
     outer = R + 0.003
     t = np.linspace(0.0, 4e-3, n)
@@ -174,7 +174,7 @@ def test_containment_outputs_bulge_layer_and_material_energies_and_fragment_plot
     # absorbed = the contact work the layer's nodes received: the run's per-node sums
     # (final checkpoint) add up to the whole contact work, the blade gave what the layers
     # took plus what the contact dashpots dissipated and the penalty springs hold
-    from wovenimpact.containment import layer_absorbed_energies
+    from wovenimpact.results.containment import layer_absorbed_energies
     from wovenimpact.io.checkpoint import latest_checkpoint, load_checkpoint
     from wovenimpact.spec.case import load_case
 
@@ -223,9 +223,9 @@ def test_layer_energies_are_the_generated_plies_energies():
     energies equal quantities.ply_energies of those plies for any velocities and element
     energies, and each layer is named by its material (inner shell aluminium, then the
     fabric)."""
-    from wovenimpact.containment import layer_energies, layer_materials
+    from wovenimpact.results.containment import layer_energies, layer_materials
     from wovenimpact.kernels import shell_layout as SL
-    from wovenimpact.quantities import ply_energies
+    from wovenimpact.results.quantities import ply_energies
 
     model, state = coarse_two_ply_casing()
     rng = np.random.default_rng(7)
@@ -244,7 +244,7 @@ def test_layer_absorbed_energies_sum_the_contact_work_of_each_layers_nodes():
     """The absorbed energy of a layer is the contact work of its own nodes (layers share
     no node; the blade's nodes count for none), and the per-material figures are the
     sums of their layers'."""
-    from wovenimpact.containment import (
+    from wovenimpact.results.containment import (
         energy_per_material,
         layer_absorbed_energies,
         layer_elements,
@@ -316,8 +316,8 @@ def test_a_piece_of_ply_torn_free_ahead_of_the_fragment_does_not_hold_it(one_wat
     erosion between rows)."""
     import math
 
-    from wovenimpact.containment import FRAGMENT, CasingWatch, layer_elements
-    from wovenimpact.containment import fragment_row as row_of
+    from wovenimpact.results.containment import FRAGMENT, CasingWatch, layer_elements
+    from wovenimpact.results.containment import fragment_row as row_of
     from wovenimpact.kernels import shell_layout as SL
 
     model, state = coarse_two_ply_casing()
@@ -357,7 +357,7 @@ def test_a_fragment_past_the_sectors_cut_edge_is_undecided_not_escaped():
     run is undecided, however it moves; inside the sector it is not."""
     import math
 
-    from wovenimpact.containment import FRAGMENT, fragment_row
+    from wovenimpact.results.containment import FRAGMENT, fragment_row
 
     def turned(model, state, deg):
         """The fragment's nodes of ``state`` turned by ``deg`` about the casing axis."""
@@ -398,7 +398,7 @@ def test_decided_since_is_the_start_of_the_last_outcomes_streak():
     """row_outcomes reads each row as containment_outcome would have had the run ended
     there; decided_since gives the outcome of the last row and the first time of the
     unbroken run of rows that read it."""
-    from wovenimpact.containment import decided_since, row_outcomes
+    from wovenimpact.results.containment import decided_since, row_outcomes
 
     t = np.arange(10) * 1e-4
     h = history(np.full(10, 100.0), [20, 20, -5, -5, 20, -5, -5, -5, -5, -5],
@@ -420,7 +420,7 @@ def test_an_escape_stops_the_run_only_once_the_fragments_speed_has_settled():
     the hold alone; undecided never stops."""
     from types import SimpleNamespace
 
-    from wovenimpact.containment import EXIT_SPEED_SETTLED, speed_settled
+    from wovenimpact.results.containment import EXIT_SPEED_SETTLED, speed_settled
     from wovenimpact.io.history import History
     from wovenimpact.runs import CONTAINMENT_COLUMNS, decision_watch
 
@@ -454,7 +454,7 @@ def test_an_escape_stops_the_run_only_once_the_fragments_speed_has_settled():
     assert read(wobble, np.full(n, 50.0), out) is None
     assert not speed_settled({"time_s": t, "fragment_speed_m_per_s": falling}, t[-1] + 1.0)
     # the summary's flag: the last 500 µs of an escape, None for any other outcome
-    from wovenimpact.containment import exit_speed_settled
+    from wovenimpact.results.containment import exit_speed_settled
 
     # Python bools (summary.json carries them: numpy's bool_ ended a run's summary with a
     # TypeError)
@@ -539,7 +539,7 @@ def test_the_casing_mass_per_area_sums_the_layers_areal_masses():
     1 mm aluminium shell (2.78 kg/m²) and two Kevlar plies (the sections' own areal
     masses) — not the mass over the mean layer area, which weighs the inner shell, at
     the smallest radius, low."""
-    from wovenimpact.containment import casing_summary, fragment_row
+    from wovenimpact.results.containment import casing_summary, fragment_row
     from wovenimpact.kernels import shell_layout as SL
 
     model, state = coarse_two_ply_casing()

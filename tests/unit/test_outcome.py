@@ -17,7 +17,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wovenimpact.errors import InputError
-from wovenimpact.quantities import OUTCOMES, QUIET_TIME, residual_velocity
+from wovenimpact.results.quantities import OUTCOMES, QUIET_TIME, residual_velocity
 
 US = 1e-6
 

@@ -23,7 +23,7 @@ from wovenimpact.kernels.contact_rigid import rigid_contact_forces
 from wovenimpact.model.compile import compile_case
 from wovenimpact.model.mesh import plate_mesh
 from wovenimpact.model.model import RigidBody, flies_sideways, travel_of_row
-from wovenimpact.quantities import impactor_row, intact_material_ahead, travel_direction
+from wovenimpact.results.quantities import impactor_row, intact_material_ahead, travel_direction
 from wovenimpact.spec.case import case_from_dict
 from wovenimpact.spec.fields import read_toml, set_dotted
 

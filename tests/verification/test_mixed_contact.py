@@ -18,7 +18,7 @@ import pytest
 from wovenimpact.impactor import Impactor
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as SL
-from wovenimpact.metal_state import plastic_work
+from wovenimpact.results.metal_state import plastic_work
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.model.compile import stack_plies
 from wovenimpact.model.mesh import plate_mesh

@@ -37,7 +37,7 @@ from wovenimpact.errors import InputError
 from wovenimpact.io.atomic import atomic_path, atomic_write_text
 from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels import shell_layout as SL
-from wovenimpact.metal_state import max_plastic_strain, thickness_ratio
+from wovenimpact.results.metal_state import max_plastic_strain, thickness_ratio
 from wovenimpact.state import State
 
 PVD_NAME = "fields.pvd"

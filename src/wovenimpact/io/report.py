@@ -13,7 +13,7 @@ answer and how far to trust it come first, on one screen, before any detail.
    residual velocity (green at 0 m/s; the rebound speed of a stopped impactor and the
    impact velocity beside it), the energy absorbed (J) and the largest deflection (mm).
    A run without an impactor: its largest displacement (mm).
-2. **How far to trust this**: the mesh verdict (:mod:`wovenimpact.mesh_verdict`: each
+2. **How far to trust this**: the mesh verdict (:mod:`wovenimpact.results.mesh_verdict`: each
    failing material's element lengths against the range its failure law is calibrated
    for; red for a law that is not regularised, on elements away from its reference
    size), the energy error against the run's ``energy_tolerance`` (default
@@ -243,9 +243,9 @@ MESH_THRESHOLD = "failure calibrated for these elements; the striker's edge reso
 
 
 def mesh_box(summary: dict) -> Verdict:
-    """The mesh verdict (:mod:`wovenimpact.mesh_verdict`): green when every failing
+    """The mesh verdict (:mod:`wovenimpact.results.mesh_verdict`): green when every failing
     material's elements lie at its reference size or within its calibrated range."""
-    from wovenimpact.mesh_verdict import SUMMARY_KEY, verdict_text
+    from wovenimpact.results.mesh_verdict import SUMMARY_KEY, verdict_text
 
     found = summary.get(SUMMARY_KEY)
     if found is None:

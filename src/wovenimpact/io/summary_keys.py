@@ -247,7 +247,7 @@ def row(key: str, value) -> Row:
     if k is None:
         return Row(key, key, number(value), "", "")
     if key == "mesh_verdict":
-        from wovenimpact.mesh_verdict import verdict_text
+        from wovenimpact.results.mesh_verdict import verdict_text
 
         text = verdict_text(value)[0] if isinstance(value, Mapping) else number(value)
         return Row(key, k.label, text, "", k.meaning)

@@ -1,6 +1,6 @@
 """Checks of a containment case's geometry (issue 11; docs/inputs.md, "Case: containment").
 
-A containment run reads its outcome from geometry (``containment.py``): the casing's
+A containment run reads its outcome from geometry (``results/containment.py``): the casing's
 layers as surfaces about the z axis, innermost first, and the fragment's path through
 them. A generated casing is built that way; an imported one (``[mesh.containment]``)
 or a generated one with unusual parameters can break those assumptions and still
@@ -25,7 +25,7 @@ import warnings
 
 import numpy as np
 
-from wovenimpact.containment import layer_sets
+from wovenimpact.results.containment import layer_sets
 from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.model.sanity import MAX_CROSSING, smallest_edge
 

@@ -113,7 +113,7 @@ def spin_state(spin_model, model, omega, centre=(0.0, 0.0, 0.0), nodes=None,
     relaxing = initial_state(spin_model)
     info = relax(spin_model, relaxing, tol=tol, max_steps=max_steps)
     if not info.converged:
-        from wovenimpact.metal_state import max_plastic_strain
+        from wovenimpact.results.metal_state import max_plastic_strain
 
         eps_p = float(np.max(max_plastic_strain(spin_model, relaxing), initial=0.0))
         why = (f"the spinning part yields at this rate (plastic strain up to {eps_p:.3g}): "

@@ -320,7 +320,7 @@ def rows_from_runs(paths) -> dict[str, list[dict]]:
     rows of each ladder, sorted by N, and the unfinished runs."""
     import json
 
-    from wovenimpact.containment import exit_speed_settled
+    from wovenimpact.results.containment import exit_speed_settled
     from wovenimpact.io.checkpoint import latest_checkpoint
     from wovenimpact.io.history import read_csv
 

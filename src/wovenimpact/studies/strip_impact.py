@@ -35,7 +35,7 @@ from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.materials.metal import MetalParameters
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.model.model import RigidBody
-from wovenimpact.quantities import impactor_row
+from wovenimpact.results.quantities import impactor_row
 from wovenimpact.solver import Workspace, step
 from wovenimpact.state import initial_state
 

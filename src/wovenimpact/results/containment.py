@@ -14,7 +14,7 @@ import math
 import numpy as np
 
 from wovenimpact.kernels import shell_layout as SL
-from wovenimpact.quantities import held_energy
+from wovenimpact.results.quantities import held_energy
 
 FRAGMENT = "blade.fragment"
 WINDOW = 1.5  # half-width of the path window, in fragment half-extents

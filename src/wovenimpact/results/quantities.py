@@ -211,7 +211,7 @@ def ply_energies(model, state) -> list[float]:
     the stored energy of its elements (for eroded elements, the energy at erosion) and
     a metal ply's plastic work. Energy dissipated by yarns that broke in elements that
     did not erode is not in it (:func:`ply_contact_work` counts it)."""
-    from wovenimpact.metal_state import element_plastic_work
+    from wovenimpact.results.metal_state import element_plastic_work
 
     factor = symmetry_factor(model)
     plastic = element_plastic_work(model, state)

@@ -18,7 +18,7 @@ import time
 from wovenimpact.jit import configure_threading, set_threads
 from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels import shell_layout as SL
-from wovenimpact.model.compile import compile_case
+from wovenimpact.setup.compile import compile_case
 from wovenimpact.solver.explicit import Workspace, shell_forces, step
 from wovenimpact.spec.case import load_case
 

@@ -28,7 +28,7 @@ FIELDS = ("x", "v", "omega", "energy", "elem", "mat", "f_int", "f_ext", "bodies"
 def save(case: str, steps: int, out: str, threads: int | None) -> None:
     import wovenimpact
     from wovenimpact.jit import configure_threading, set_threads
-    from wovenimpact.model.compile import compile_case
+    from wovenimpact.setup.compile import compile_case
     from wovenimpact.solver import Workspace, step
     from wovenimpact.spec.case import load_case
 

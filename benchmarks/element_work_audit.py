@@ -29,7 +29,7 @@ import numpy as np
 from wovenimpact.io.checkpoint import _read_arrays
 from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels import shell_layout as SL
-from wovenimpact.model.compile import compile_case
+from wovenimpact.setup.compile import compile_case
 from wovenimpact.solver.explicit import W_INT, Workspace, step
 from wovenimpact.spec.case import load_case
 from wovenimpact.state import State

@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 from wovenimpact.jit import configure_threading
-from wovenimpact.model.compile import compile_case
+from wovenimpact.setup.compile import compile_case
 from wovenimpact.solver.explicit import Workspace, step
 from wovenimpact.spec.case import load_case
 

@@ -37,6 +37,7 @@ from pathlib import Path
 import numpy as np
 
 from wovenimpact.errors import InputError, InputWarning, SimulationError
+from wovenimpact.interfaces import booked_totals, interface_energies
 from wovenimpact.io.atomic import atomic_write_text
 from wovenimpact.io.checkpoint import (
     checkpoint_meta,
@@ -47,22 +48,9 @@ from wovenimpact.io.checkpoint import (
 from wovenimpact.io.fields import FieldWriter
 from wovenimpact.io.history import History
 from wovenimpact.io.report import write_run_report
-from wovenimpact.interfaces import booked_totals, interface_energies
-from wovenimpact.kernels.contact_energy import DAMPING, FRICTION
 from wovenimpact.kernels import shell_layout as SL
-from wovenimpact.results.metal_state import has_metal, plastic_work
-from wovenimpact.model.compile import CompiledCase, compile_case
-from wovenimpact.results.mesh_verdict import SUMMARY_KEY as MESH_VERDICT_KEY
-from wovenimpact.results.mesh_verdict import mesh_verdict
-from wovenimpact.results.quantities import (
-    impactor_row,
-    intact_material_ahead,
-    ply_contact_work,
-    ply_deflections,
-    ply_energies,
-    residual_velocity,
-    symmetry_factor,
-)
+from wovenimpact.kernels.contact_energy import DAMPING, FRICTION
+from wovenimpact.provenance import changed_parts, digest_of, provenance, restart_parts
 from wovenimpact.results.containment import (
     CASING_ENERGY_COLUMNS,
     CONTAINMENT_COLUMNS,
@@ -77,7 +65,19 @@ from wovenimpact.results.containment import (
     layer_elements,
     speed_settled,
 )
-from wovenimpact.provenance import changed_parts, digest_of, provenance, restart_parts
+from wovenimpact.results.mesh_verdict import SUMMARY_KEY as MESH_VERDICT_KEY
+from wovenimpact.results.mesh_verdict import mesh_verdict
+from wovenimpact.results.metal_state import has_metal, plastic_work
+from wovenimpact.results.quantities import (
+    impactor_row,
+    intact_material_ahead,
+    ply_contact_work,
+    ply_deflections,
+    ply_energies,
+    residual_velocity,
+    symmetry_factor,
+)
+from wovenimpact.setup.compile import CompiledCase, compile_case
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.solver.explicit import error_fraction
 from wovenimpact.spec.case import load_case

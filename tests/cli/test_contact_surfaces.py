@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from wovenimpact.model.compile import compile_case
+from wovenimpact.setup.compile import compile_case
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.spec.case import load_case
 

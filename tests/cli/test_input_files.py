@@ -97,7 +97,7 @@ def test_a_utf8_byte_order_mark_is_accepted(corpus):
     ("/proc/wovenimpact_out", "cannot create the directory"),
 ])
 def test_an_unusable_out_is_refused_before_any_work(corpus, monkeypatch, argv, out, fragment):
-    import wovenimpact.model.compile as compile_module
+    import wovenimpact.setup.compile as compile_module
 
     def no_work(*a, **k):
         raise AssertionError("work started before --out was checked")
@@ -166,7 +166,7 @@ def test_a_mesh_that_would_take_minutes_is_refused_before_any_work(corpus, monke
     """0.05 mm elements on a 97 mm quarter plate (941 000 elements, 21 s and 3.5 GB to
     build) is one error line naming the count and run.allow_large_mesh, at once, not a
     silent minute; the flag lets it through to the build (here stopped by a stub)."""
-    import wovenimpact.model.compile as compile_module
+    import wovenimpact.setup.compile as compile_module
     import wovenimpact.runs as runs_module
 
     class Built(Exception):

@@ -44,7 +44,7 @@ def test_a_plug_torn_free_is_not_intact_material(tmp_path):
     clamped edge); the ply outside the ring is, once moved ahead of the nose too."""
     from tests.cli.test_run_cli import CASE, IMPACTOR, write_case
     from wovenimpact.kernels import shell_layout as SL
-    from wovenimpact.model.compile import compile_case
+    from wovenimpact.setup.compile import compile_case
     from wovenimpact.results.quantities import attached_nodes, intact_material_ahead
     from wovenimpact.spec.case import load_case
 

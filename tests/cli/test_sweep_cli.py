@@ -84,7 +84,7 @@ def test_sweep_on_a_dask_cluster_gives_the_local_results(tmp_path: Path):
 def test_example_studies_load_and_their_variants_validate():
     """Every variant of every shipped study is a valid case; material overrides (crimp,
     compaction) reach the material: the crimp study's h0 grows with the crimp."""
-    from wovenimpact.model.compile import load_case_material
+    from wovenimpact.setup.compile import load_case_material
     from wovenimpact.spec.case import case_from_dict
     from wovenimpact.studies.sweep import load_study
 

@@ -41,7 +41,7 @@ import pytest
 from typer.testing import CliRunner
 
 from wovenimpact.cli.app import app
-from wovenimpact.model.compile import compile_case
+from wovenimpact.setup.compile import compile_case
 from wovenimpact.spec.case import case_from_dict, load_case
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -1,6 +1,6 @@
 """A containment model from the user's own mesh (issue 11, deliverable 1): an Abaqus file
 whose sets ``[mesh.containment]`` names — blade, root, release, fragment, casing layers —
-gives the run of the generated case it was written from (model/compile.containment_sets)."""
+gives the run of the generated case it was written from (setup/compile.containment_sets)."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from wovenimpact.errors import InputError
-from wovenimpact.model.compile import compile_case, containment_mesh
+from wovenimpact.setup.compile import compile_case, containment_mesh
 from wovenimpact.solver import Workspace, step
 from wovenimpact.spec.case import case_from_dict
 from wovenimpact.spec.fields import read_toml, set_dotted

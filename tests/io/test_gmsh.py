@@ -73,7 +73,7 @@ def test_an_imported_casing_in_millimetres_with_circumferential_warp(tmp_path):
     """A case with ``kind = "gmsh"``, ``length_unit = "1 mm"`` and ``warp_direction =
     "circumferential"``: the nodes sit at r = 0.25 m, the element's warp axis e1 is the
     hoop direction at its centroid (to 1e-12), and the curve group clamps the end."""
-    from wovenimpact.model.compile import compile_case
+    from wovenimpact.setup.compile import compile_case
     from wovenimpact.spec.case import load_case
 
     write_cylinder_sector(tmp_path / "casing.msh")
@@ -148,7 +148,7 @@ def test_a_missing_set_of_a_gmsh_file_suggests_format_2_2(tmp_path):
     error for a set a .msh file lacks says so (and an Abaqus file's does not)."""
     from types import SimpleNamespace
 
-    from wovenimpact.model.compile import containment_sets
+    from wovenimpact.setup.compile import containment_sets
 
     write_cylinder_sector(tmp_path / "c.msh")
     sets = SimpleNamespace(blade="casing", release="RELEASE", root="end_low",

@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 
 from tests.corpus.generate import IMPACT, PLATE, _set
 from wovenimpact.errors import InputError, InputWarning
-from wovenimpact.model.compile import compile_case
+from wovenimpact.setup.compile import compile_case
 from wovenimpact.solver import Workspace, step
 from wovenimpact.spec.case import CaseSpec, case_from_dict
 

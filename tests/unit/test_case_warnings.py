@@ -96,7 +96,7 @@ def test_a_boundary_on_an_empty_node_set_is_an_error_naming_it():
     never the model meant (the run's answer is that of the model without it), so it is
     refused, naming the key, the set and the way out (issue 38, item 6)."""
     from wovenimpact.errors import InputError
-    from wovenimpact.model.compile import compile_case
+    from wovenimpact.setup.compile import compile_case
     from wovenimpact.spec.case import case_from_dict
     from wovenimpact.spec.fields import read_toml, set_dotted
 

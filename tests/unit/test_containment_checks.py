@@ -1,4 +1,4 @@
-"""model/containment_checks.py: a containment case whose geometry breaks what the
+"""setup/containment_checks.py: a containment case whose geometry breaks what the
 outcome rule assumes (layers about the z axis, innermost first; the blade inside the
 casing; the fragment's path meeting the modelled casing) is refused before the first
 step, and the doubtful ones are warned of (docs/inputs.md, "Case: containment")."""
@@ -24,7 +24,7 @@ COARSE = {"mesh.element_size": "12 mm", "mesh.casing.coarse_element_size": "30 m
 def compile_with(**changes):
     """The 4-ply example, coarse and with 2 plies, with ``changes`` (dotted keys with
     '__' for '.') applied; returns the compiled case."""
-    from wovenimpact.model.compile import compile_case
+    from wovenimpact.setup.compile import compile_case
     from wovenimpact.spec.case import case_from_dict
     from wovenimpact.spec.fields import read_toml, set_dotted
 
@@ -52,7 +52,7 @@ def ring():
 def checked(ring, spec_changes=None, *, x_shift=None, layers=None, blade_scale=None):
     """Run check_containment on a copy of ``ring`` with its geometry changed; the warnings
     it gave, as text (an error propagates)."""
-    from wovenimpact.model.containment_checks import check_containment
+    from wovenimpact.setup.containment_checks import check_containment
     from wovenimpact.spec.case import case_from_dict
     from wovenimpact.spec.fields import read_toml, set_dotted
 
@@ -125,7 +125,7 @@ def test_a_blade_reaching_the_casing_is_refused(ring):
 def test_casing_elements_in_no_layer_are_warned_of(ring):
     """Listing the inner shell alone (the plies left out of casing_layers) would read
     the outcome from it only: a warning names the elements left out."""
-    from wovenimpact.model.containment_checks import check_layers
+    from wovenimpact.setup.containment_checks import check_layers
     from wovenimpact.spec.case import case_from_dict
     from wovenimpact.spec.fields import read_toml
 

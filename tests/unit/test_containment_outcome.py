@@ -140,7 +140,7 @@ def test_containment_outputs_bulge_layer_and_material_energies_and_fragment_plot
     from pathlib import Path
 
     from wovenimpact.io.history import read_csv
-    from wovenimpact.model.compile import compile_case
+    from wovenimpact.setup.compile import compile_case
     from wovenimpact.runs import run_case
 
     case = Path(__file__).resolve().parents[2] / "examples" / "containment" / "hybrid_4.toml"
@@ -288,7 +288,7 @@ def coarse_two_ply_casing(sector: bool = False):
     ``sector``: a 120° sector, 60°–180°, its cut edges clamped, in place of the ring)."""
     from pathlib import Path
 
-    from wovenimpact.model.compile import compile_case
+    from wovenimpact.setup.compile import compile_case
     from wovenimpact.spec.case import case_from_dict
     from wovenimpact.spec.fields import read_toml, set_dotted
 

@@ -232,7 +232,7 @@ def test_a_case_can_add_a_regularisation_to_a_material_file_that_has_none(tmp_pa
     """``materials.NAME.set.regularisation…`` (a study's ``--set``) adds the table the shipped
     file does not have; a table the material schema does not know is refused by name."""
     from wovenimpact.errors import InputError
-    from wovenimpact.model.compile import load_case_material
+    from wovenimpact.setup.compile import load_case_material
     from wovenimpact.spec.case import MaterialRef
 
     base = Path(__file__).resolve().parents[2] / "examples" / "materials"

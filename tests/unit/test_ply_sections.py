@@ -12,7 +12,7 @@ import pytest
 
 from wovenimpact.errors import InputError
 from wovenimpact.kernels import shell_layout as SL
-from wovenimpact.model.compile import compile_case
+from wovenimpact.setup.compile import compile_case
 from wovenimpact.spec.case import case_from_dict
 
 HYBRID = Path(__file__).resolve().parents[2] / "examples" / "metal_impact" / "hybrid_coupon.toml"

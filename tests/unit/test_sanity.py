@@ -1,4 +1,4 @@
-"""Physical sanity of a case at compile time (model/sanity.py, issue 12): each check
+"""Physical sanity of a case at compile time (setup/sanity.py, issue 12): each check
 refuses (or warns of) the input it is for, with the key and the figure named, and
 lets the sane base cases through. Small meshes, compile only (no time steps)."""
 
@@ -12,8 +12,8 @@ import pytest
 
 from tests.corpus.generate import IMPACT, INP_CASE, METAL, PLATE, _set, dumps, plate_inp
 from wovenimpact.errors import InputError, InputWarning
-from wovenimpact.model.compile import compile_case
-from wovenimpact.model.sanity import first_step
+from wovenimpact.setup.compile import compile_case
+from wovenimpact.setup.sanity import first_step
 from wovenimpact.spec.case import DEFAULT_MAX_STEPS, case_from_dict
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -133,7 +133,7 @@ def test_an_imported_meshs_warp_direction_is_one_message_not_one_per_union_membe
 
 
 def compile_doc(doc: dict, base: Path):
-    from wovenimpact.model.compile import compile_case
+    from wovenimpact.setup.compile import compile_case
 
     return compile_case(case_from_dict(doc, "case.toml"), base)
 
@@ -261,7 +261,7 @@ def test_a_large_casing_names_the_key_that_sets_its_size():
 
 
 def test_a_large_imported_mesh_is_refused_once_read(tmp_path, monkeypatch):
-    import wovenimpact.model.compile as compile_module
+    import wovenimpact.setup.compile as compile_module
 
     monkeypatch.setattr(compile_module, "LARGE_MESH", 8)  # the 3×3 plate has 9 elements
     doc = imported_doc(tmp_path)

@@ -17,7 +17,7 @@ from typer.testing import CliRunner
 
 from wovenimpact.cli.app import app
 from wovenimpact.io.history import read_csv
-from wovenimpact.model.compile import compile_case
+from wovenimpact.setup.compile import compile_case
 from wovenimpact.runs import run_case
 from wovenimpact.spec.case import load_case
 
@@ -106,7 +106,7 @@ def test_a_failed_balance_ends_with_exit_4_and_keeps_the_figure(tmp_path):
     against a tolerance of 1e-5) writes its outputs, ends with exit 4 saying so, and
     summary.json keeps the figure. The blow-up of the issue — a section 1 m thick on a
     20 mm plate — no longer runs at all: it is refused before the first step (exit 2,
-    naming the thickness; model/sanity.py)."""
+    naming the thickness; setup/sanity.py)."""
     case = tmp_path / "strict.toml"
     case.write_text(PLATE.replace("[run]", '[run]\nenergy_tolerance = "1e-5"') + CLAMPED
                     + KICK, encoding="utf-8")

@@ -177,7 +177,7 @@ def test_the_default_blade_relaxes_with_coarse_elements(size, blade):
     blade with a curved tip, and its fragment too starts at ω r_cm (0.1 %)."""
     from pathlib import Path
 
-    from wovenimpact.model.compile import compile_case
+    from wovenimpact.setup.compile import compile_case
     from wovenimpact.spec.case import case_from_dict
     from wovenimpact.spec.fields import read_toml, set_dotted
 
@@ -389,7 +389,7 @@ def test_a_blade_whose_staggered_corners_reach_the_casing_is_refused():
     casing although tip_radius is inside it: the case is refused, naming the reach."""
     from pathlib import Path
 
-    from wovenimpact.model.compile import compile_case
+    from wovenimpact.setup.compile import compile_case
     from wovenimpact.spec.case import case_from_dict
     from wovenimpact.spec.fields import read_toml, set_dotted
 

@@ -71,6 +71,17 @@ class Mesh:
         return area_vectors(self.nodes, self.quads)
 
 
+def node_set(mesh: Mesh, name: str, key: str) -> np.ndarray:
+    """The nodes of the set ``name`` of ``mesh`` (``"all"``: every node); an InputError
+    naming the case ``key`` and the sets there if it has none of that name."""
+    if name == "all":
+        return np.arange(mesh.n_nodes)
+    if name not in mesh.node_sets:
+        raise InputError(f"{key}: node set {name!r} does not exist; sets: "
+                         f"{sorted(set(mesh.node_sets) | {'all'})}")
+    return np.asarray(mesh.node_sets[name], dtype=np.int64)
+
+
 def area_vectors(nodes: np.ndarray, quads: np.ndarray) -> np.ndarray:
     """½ (x3 − x1) × (x4 − x2) of each quad: its area along its normal."""
     xe = nodes[quads]

@@ -124,6 +124,8 @@ Spin = quantity("angular_velocity", example="1047 rad/s")
 Accel = quantity("acceleration", example="-9.81 m/s^2")
 Coordinate = quantity("length", example="0 mm")
 DOFS = ("ux", "uy", "uz", "rx", "ry", "rz")
+# the axis normal to the plane of each symmetry boundary type ([[boundary]] type)
+SYMMETRY_AXIS = {"symmetry_x": 0, "symmetry_y": 1, "symmetry_z": 2}
 # run.max_steps default: a long casing run (5 ms of 0.5 mm elements at Δt ≈ 5e-8 s is 1e5
 # steps) with 50× to spare; a run of 5e6 steps of 10⁵ elements is days on two cores
 DEFAULT_MAX_STEPS = 5_000_000
@@ -450,7 +452,7 @@ class RunSpec(BaseModel):
     # docs/theory.md §5): 1 %, the report's verdict line; the shipped examples and study
     # variants stay below 4e-3
     energy_tolerance: quantity("dimensionless", gt=0, le=1, example="0.01") = 0.01
-    # the predicted step count end_time / Δt₁ above which a run is refused (model.sanity)
+    # the predicted step count end_time / Δt₁ above which a run is refused (setup.sanity)
     max_steps: integer(ge=1, example=DEFAULT_MAX_STEPS) = DEFAULT_MAX_STEPS
     # a mesh of more than LARGE_MESH (500 000) elements is refused unless this is true: it
     # takes minutes to build and run on two cores (docs/inputs.md, "Large meshes")

@@ -260,7 +260,7 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
             "reruns": reruns,
             "warning": monotonic_warning(plies, seen, "layers", "contain the fragment"),
         }
-    from wovenimpact.model.compile import compile_case
+    from wovenimpact.setup.compile import compile_case
 
     spec = case_from_dict(_case_with_plies(doc, plies), source=str(path))
     model = compile_case(spec, Path(base)).model

@@ -3,7 +3,10 @@
 Reads the material files, makes the mesh (structured plate or Abaqus ``.inp``),
 assigns sections, turns the ``[[boundary]]`` entries into per-DOF constraints and
 the ``[[initial_velocity]]`` entries into the velocity field at t = 0. Errors name
-the case key that is wrong.
+the case key that is wrong. Then, in order: the pre-run checks
+(:mod:`~wovenimpact.setup.sanity`), and for a spinning blade the spin-up
+(:mod:`~wovenimpact.setup.spin_up`) and the checks of the spun blade
+(:mod:`~wovenimpact.setup.containment_checks`).
 """
 
 from __future__ import annotations
@@ -16,14 +19,13 @@ from pathlib import Path
 import numpy as np
 
 from wovenimpact.errors import InputError
-from wovenimpact.model.abaqus import read_inp
-from wovenimpact.model.gmsh import gmsh_hint, read_msh
-from wovenimpact.model.mesh import Mesh, plate_mesh
-from wovenimpact.model.containment_checks import check_containment, check_spin_speed
-from wovenimpact.model.sanity import check_case
 from wovenimpact.impactor import Impactor
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels.contact_rigid import rigid_contact_forces
+from wovenimpact.model.abaqus import read_inp
+from wovenimpact.model.casing import blade_mesh, casing_mesh, circumferential_directions, join
+from wovenimpact.model.gmsh import gmsh_hint, read_msh
+from wovenimpact.model.mesh import Mesh, node_set, plate_mesh
 from wovenimpact.model.model import (
     BoundaryConditions,
     Model,
@@ -32,28 +34,21 @@ from wovenimpact.model.model import (
     ShellContactParams,
     build_model,
 )
+from wovenimpact.setup.containment_checks import check_containment, check_spin_speed
+from wovenimpact.setup.sanity import check_case
+from wovenimpact.setup.spin_up import spin_blade
 from wovenimpact.spec.case import (
     DOFS,
     LARGE_MESH,
-    ImportedMeshSpec,
+    SYMMETRY_AXIS,
     CaseSpec,
     ContainmentMeshSpec,
+    ImportedMeshSpec,
     PlateMeshSpec,
 )
 from wovenimpact.spec.fields import read_toml
 from wovenimpact.spec.material import load_material, material_from_dict
-from wovenimpact.model.casing import blade_mesh, casing_mesh, circumferential_directions, join
-from wovenimpact.state import (
-    BODY_KINETIC,
-    KINETIC,
-    KINETIC0,
-    State,
-    initial_state,
-    rigid_rotation_velocity,
-)
-
-SYMMETRY_AXIS = {"symmetry_x": 0, "symmetry_y": 1, "symmetry_z": 2}
-
+from wovenimpact.state import State, initial_state, rigid_rotation_velocity
 
 @dataclass
 class CompiledCase:
@@ -180,15 +175,6 @@ def contact_surfaces(mesh: Mesh, how: str, elsets: list[str]) -> np.ndarray:
                            shape=(ne, mesh.n_nodes)).tocsr()
     _, label = connected_components(incidence @ incidence.T, directed=False)
     return label.astype(np.int64)
-
-
-def node_set(mesh: Mesh, name: str, key: str) -> np.ndarray:
-    if name == "all":
-        return np.arange(mesh.n_nodes)
-    if name not in mesh.node_sets:
-        raise InputError(f"{key}: node set {name!r} does not exist; sets: "
-                         f"{sorted(set(mesh.node_sets) | {'all'})}")
-    return np.asarray(mesh.node_sets[name], dtype=np.int64)
 
 
 def erode_at_start(model: Model, state: State, er, key: str) -> None:
@@ -413,41 +399,6 @@ def containment_sets(mesh: Mesh, sets, file: str) -> None:
             mesh.elem_sets[f"casing.layer{k}"] = np.asarray(mesh.elem_sets[name], dtype=np.int64)
 
 
-def spin_blade(model: Model, state: State, mesh: Mesh, section: Section, omega, tol,
-               warp) -> None:
-    """The blade's steady spin state (solver.relaxation) written into ``state``: the
-    blade alone, clamped at its root and loaded by ω² r⊥, relaxed; its configuration,
-    element and material state copied in, with v = ω × x and spins ω."""
-    from wovenimpact.solver.relaxation import centrifugal_acceleration, spin_state
-
-    elems = mesh.elem_sets["blade.blade"]
-    nodes = np.unique(mesh.quads[elems])
-    local = np.searchsorted(nodes, mesh.quads[elems])
-    x = mesh.nodes[nodes]
-    root = np.searchsorted(nodes, mesh.node_sets["blade.root"])
-    es = np.zeros(len(elems), dtype=np.int64)
-    bc = BoundaryConditions(len(x)).fix(root)
-    free = build_model(x, local, {"blade": section}, es, bcs=bc, alpha=model.alpha,
-                       warp_direction=warp[elems])
-    held = build_model(x, local, {"blade": section}, es, bcs=bc, alpha=model.alpha,
-                       warp_direction=warp[elems], body_accel=centrifugal_acceleration(x, omega))
-    spun, _ = spin_state(held, free, omega, tol=tol)
-    state.x[nodes] = spun.x
-    state.v[nodes] = spun.v
-    state.omega[nodes] = spun.omega
-    state.elem[elems] = spun.elem
-    width = min(free.point_width, model.point_width)
-    if width:  # the blade's points' rows (the same section, so as many rows per element)
-        n_rows = np.diff(free.mat_row)
-        src = np.arange(free.mat_row[-1])  # the blade model's rows, element by element
-        dst = src + np.repeat(model.mat_row[elems] - free.mat_row[:-1], n_rows)
-        state.mat[dst, :width] = spun.mat[src, :width]
-    ke = 0.5 * float(np.sum(model.node_mass[:, None] * state.v**2)
-                     + np.sum(model.node_inertia[:, None] * state.omega**2))
-    state.energy[KINETIC] = ke
-    state.energy[KINETIC0] = ke + state.energy[BODY_KINETIC]
-
-
 def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     """Build the Model and the State at t = 0 of a case (paths relative to ``base``)."""
     base = Path(base)
@@ -570,7 +521,7 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     w[model.bc_code[:, 3:] == 1] = 0.0
     check_impactor_clearance(model)
     state = initial_state(model, velocity=v, angular_velocity=w)
-    dt = check_case(spec, model, state, mesh, sections)  # model.sanity: before the spin-up
+    dt = check_case(spec, model, state, mesh, sections)  # setup.sanity: before the spin-up
     if spin is not None:
         check_spin_speed(spec, model, mesh, dt)
         blade = {elem_sections[e] for e in mesh.elem_sets["blade.blade"]}

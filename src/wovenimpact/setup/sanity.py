@@ -33,7 +33,9 @@ import numpy as np
 from wovenimpact.errors import InputError, InputWarning
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as SL
+from wovenimpact.model.mesh import node_set
 from wovenimpact.model.model import DOF_NAMES, flies_sideways, sideways_shadow
+from wovenimpact.spec.case import SYMMETRY_AXIS, PlateMeshSpec
 
 MAX_WAVE_SPEED = 2.0e4  # m/s: above any engineering material's (diamond ~18 km/s)
 MAX_CROSSING = 0.5  # of the smallest element length moved in one step
@@ -158,8 +160,6 @@ def warn_output_intervals(spec, dt: float) -> None:
 def check_plies(spec, model) -> None:
     """Plies of a plate whose mid-planes are closer than their shell thicknesses (the
     mean of two neighbours') overlap."""
-    from wovenimpact.spec.case import PlateMeshSpec
-
     m = spec.mesh
     if not (isinstance(m, PlateMeshSpec) and m.plies > 1 and m.spacing is not None):
         return  # without spacing (ply_sections) the plies are stacked by their thicknesses
@@ -229,8 +229,6 @@ def _median_edge(model, sec: int) -> float:
 
 def check_constraints(spec, mesh) -> None:
     """Refuse a degree of freedom both held and driven, or driven at two speeds."""
-    from wovenimpact.model.compile import SYMMETRY_AXIS, node_set
-
     code = np.zeros((mesh.n_nodes, 6), dtype=np.int8)  # 0 free, 1 held, 2 driven
     value = np.zeros((mesh.n_nodes, 6))
     owner = np.full((mesh.n_nodes, 6), -1, dtype=np.int64)

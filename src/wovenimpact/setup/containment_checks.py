@@ -7,7 +7,7 @@ or a generated one with unusual parameters can break those assumptions and still
 run to a confident, wrong answer. These checks refuse that before the first step:
 
 - :func:`check_spin_speed` (before the spin-up): the blade's tip must not cross more
-  than half the smallest element in one step (the velocity check of ``model.sanity``
+  than half the smallest element in one step (the velocity check of ``setup.sanity``
   runs before the blade spins);
 - :func:`check_containment` (on the spun blade): the layers are disjoint, listed
   innermost first, each a surface about the z axis (the spin axis), not coincident;
@@ -25,9 +25,9 @@ import warnings
 
 import numpy as np
 
-from wovenimpact.results.containment import layer_sets
 from wovenimpact.errors import InputError, InputWarning
-from wovenimpact.model.sanity import MAX_CROSSING, smallest_edge
+from wovenimpact.results.containment import layer_sets
+from wovenimpact.setup.sanity import MAX_CROSSING, smallest_edge
 
 MAX_RADIAL_SPREAD = 0.25  # a layer's (r_max − r_min) / r_mean about the z axis
 MIN_GAP_FRACTION = 0.1  # layers closer than this fraction of their thickness coincide

@@ -1,4 +1,4 @@
-"""studies/containment_validation: the containment report from ladder results (synthetic
+"""reports/containment_validation: the containment report from ladder results (synthetic
 rows, no runs): regression over escaped runs only, the fewest layers that contained, the
 mass table with the inner shell counted, undecided runs named and left out."""
 
@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from wovenimpact.studies import containment_validation as cv
+from wovenimpact.reports import containment_validation as cv
 
 
 def _row(n, outcome, exit_speed, per_area):

@@ -1,4 +1,4 @@
-"""The ring mesh-convergence sections (studies/mesh_validation.py, issue 36 V0 and V2): the
+"""The ring mesh-convergence sections (reports/mesh_validation.py, issue 36 V0 and V2): the
 fragment's energy loss, the per-mesh means over release angles, the spread and the
 acceptance, on rows shaped as the study's results."""
 
@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import pytest
 
-from wovenimpact.studies import mesh_validation as mv
+from wovenimpact.reports import mesh_validation as mv
 from wovenimpact.studies.sweep import load_study
 
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from wovenimpact.studies.metal_validation import jones_lines
+from wovenimpact.reports.metal_validation import jones_lines
 
 
 def test_jones_lines_tabulate_the_meshes_and_extrapolate(tmp_path):
@@ -25,7 +25,7 @@ def test_jones_lines_tabulate_the_meshes_and_extrapolate(tmp_path):
 def test_the_v50_mesh_line_judges_the_spread_against_five_percent():
     """Issue 36, V3: (max − min)/min of the ladders' V50; 75 / 73 / 72 m/s is 4.2 %, met;
     75 / 65 m/s is 15.4 %, not met; a ladder without a V50 gives no verdict."""
-    from wovenimpact.studies.metal_validation import v50_mesh_line
+    from wovenimpact.reports.metal_validation import v50_mesh_line
 
     ok = v50_mesh_line({"1 mm": 75.0, "0.5 mm": 73.0, "0.25 mm": 72.0}, "0.5 mm")
     assert "75.0 / 73.0 / 72.0 m/s on 1 mm / 0.5 mm / 0.25 mm" in ok

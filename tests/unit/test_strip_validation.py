@@ -1,13 +1,13 @@
-"""The blade-edge strip section of docs/validation.md (studies/strip_validation.py): its
+"""The blade-edge strip section of docs/validation.md (reports/strip_validation.py): its
 table, its spread and the acceptance verdict, on rows of the study's results."""
 
 from __future__ import annotations
 
 import pytest
 
-from wovenimpact.studies.strip_validation import early_loss, spread, table_lines, verdict_line
+from wovenimpact.reports.strip_validation import early_loss, spread, table_lines, verdict_line
 from wovenimpact.studies.sweep import load_study
-from wovenimpact.studies.strip_validation import ROOT, STUDY
+from wovenimpact.reports.strip_validation import ROOT, STUDY
 
 
 def rows(energies: dict) -> list[dict]:

@@ -3,7 +3,7 @@ convergence verdicts and the hourglass spread (synthetic summaries, no runs)."""
 
 from wovenimpact.spec.case import case_from_dict
 from wovenimpact.spec.fields import read_toml
-from wovenimpact.studies.validation import ROOT, commentary, full_plate, spread_line
+from wovenimpact.reports.validation import ROOT, commentary, full_plate, spread_line
 
 
 def test_full_plate_drops_only_the_symmetry_conditions_and_validates():
@@ -68,7 +68,7 @@ def test_early_impulse_is_the_momentum_lost_by_the_window_end(tmp_path):
     contact is the first sample with a force."""
     import json
 
-    from wovenimpact.studies.validation import early_impulse, first_contact_time
+    from wovenimpact.reports.validation import early_impulse, first_contact_time
 
     (tmp_path / "history.csv").write_text(
         "time_s,impactor_velocity_m_per_s,contact_force_full_N\n"
@@ -159,7 +159,8 @@ def test_a_failed_design_search_is_reported_not_fatal(tmp_path, monkeypatch):
     """A pack whose run fails (e.g. its energy check) stops the design search; validate
     writes that into the report instead of losing the whole report."""
     from wovenimpact.errors import InputError
-    from wovenimpact.studies import design, validation
+    from wovenimpact.reports import validation
+    from wovenimpact.studies import design
 
     def failing(*args, **kwargs):
         raise InputError("8 plies: the run failed: energy balance failed")

@@ -12,7 +12,7 @@ from wovenimpact.model import Section, build_model
 from wovenimpact.model.model import RigidBody
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.state import initial_state
-from wovenimpact.studies.strip_impact import StripImpact, smith_theory, strip_impact
+from wovenimpact.verification.strip_impact import StripImpact, smith_theory, strip_impact
 from tests.verification.meshes import elastic, rect_grid
 
 

@@ -14,7 +14,7 @@ from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.spec import load_material
 from wovenimpact.state import initial_state
-from wovenimpact.studies.jones_plate import JonesPlate
+from wovenimpact.verification.jones_plate import JonesPlate
 from tests.verification.meshes import rect_grid
 
 ALUMINIUM = Path(__file__).resolve().parents[2] / "examples" / "materials" / "aluminium.toml"
@@ -95,7 +95,7 @@ def test_impulsive_clamped_plate_deflects_between_jones_limits_and_books_plastic
     """A fully clamped 100 mm square 6061-T6 plate (1 mm, perfectly plastic, 5 points,
     quarter model 8 × 8) given 77 m/s (λ = 145): its permanent mid-point deflection lies
     between Jones's pyramid-mode predictions, the mode started at V0 (W/H = 4.02) and
-    the whole impulse's energy (11.08) (studies/jones_plate.py; the study runs three
+    the whole impulse's energy (11.08) (verification/jones_plate.py; the study runs three
     meshes); the energy balance holds to 1e-3 and the plastic work of the points
     (metal_state.plastic_work, the kernels' own trapezoidal sums) is the internal work
     of the shell's forces less the stored elastic and the hourglass energy to 1 % (the

@@ -29,7 +29,7 @@ def validate(
 ) -> None:
     """Run (or resume) the example cases and thesis studies; write the validation report."""
     from wovenimpact.io.outdir import check_output_file, prepare_output_dir, write_failure
-    from wovenimpact.studies.validation import ON_REQUEST, ROOT, STUDIES, run_validation
+    from wovenimpact.reports.validation import ON_REQUEST, ROOT, STUDIES, run_validation
 
     if containment:
         _containment(work, report or ROOT / "docs" / "validation_containment.md", workers,
@@ -66,7 +66,7 @@ def _containment(work: Path, report: Path, workers: int, overrides=(), runs=()) 
 
     from wovenimpact.io.atomic import atomic_write_text
     from wovenimpact.io.outdir import check_output_file, prepare_output_dir, write_failure
-    from wovenimpact.studies.containment_validation import containment_section
+    from wovenimpact.reports.containment_validation import containment_section
 
     try:
         if not runs:

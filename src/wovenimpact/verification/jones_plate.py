@@ -45,9 +45,9 @@ from pathlib import Path
 import numpy as np
 
 from wovenimpact.materials.metal import MetalParameters
-from wovenimpact.results.metal_state import plastic_work
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.model.mesh import plate_mesh
+from wovenimpact.results.metal_state import plastic_work
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.state import initial_state
 

@@ -2,11 +2,11 @@
 
 :func:`metal_section` runs (or reuses, from ``work``) the metal verification and
 validation cases and returns their section: Jones's impulsively loaded clamped plate on
-three meshes (studies/jones_plate.py), the examples of ``examples/metal_impact/`` (their
+three meshes (verification/jones_plate.py), the examples of ``examples/metal_impact/`` (their
 outcome, energies and balance error), and the perforation ladder of
 ``examples/studies/metal_perforation_v50.toml`` with its Lambert–Jonas V50.
-``studies.validation.run_validation`` appends it to its report; ``python -m
-wovenimpact.studies.metal_validation WORK OUT.md`` writes it alone (docs/validation_metal.md).
+``reports.validation.run_validation`` appends it to its report; ``python -m
+wovenimpact.reports.metal_validation WORK OUT.md`` writes it alone (docs/validation_metal.md).
 """
 
 from __future__ import annotations
@@ -33,7 +33,7 @@ def _quiet(message: str) -> None:
 
 def jones_lines(work: Path, figures: Path, log=_quiet) -> list[str]:
     """The Jones plate on three meshes (results cached in ``work/jones.json``)."""
-    from wovenimpact.studies.jones_plate import jones_figure, jones_study
+    from wovenimpact.verification.jones_plate import jones_figure, jones_study
 
     cache = work / "jones.json"
     figure = figures / "jones_plate.png"
@@ -49,7 +49,7 @@ def jones_lines(work: Path, figures: Path, log=_quiet) -> list[str]:
         cache.write_text(json.dumps(rows, indent=1))
     r0 = rows[0]
     lines = [
-        "### Jones's impulsively loaded clamped plate (studies/jones_plate.py)", "",
+        "### Jones's impulsively loaded clamped plate (verification/jones_plate.py)", "",
         "100 mm square 6061-T6 plate, 1 mm, elastic–perfectly plastic (σ0 = 276 MPa), "
         f"5 points, clamped, uniform 77 m/s: λ = ρV0²L²/(σ0H²) = {r0['lambda']:.0f}. "
         "Jones's pyramid mechanism with the square yield curve gives W_f/H = √(1 + Γ) − 1, "
@@ -179,7 +179,7 @@ def metal_section(work: str | Path, figures: str | Path, log=_quiet, workers: in
 
 
 def main(argv: list[str]) -> None:
-    """``python -m wovenimpact.studies.metal_validation WORK OUT.md``."""
+    """``python -m wovenimpact.reports.metal_validation WORK OUT.md``."""
     from wovenimpact.io.atomic import atomic_write_text
 
     work, out = Path(argv[0]), Path(argv[1])

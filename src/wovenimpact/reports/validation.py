@@ -22,12 +22,12 @@ import numpy as np
 from wovenimpact.errors import InputError
 from wovenimpact.io.atomic import atomic_write_text
 from wovenimpact.io.report import write_index
-from wovenimpact.studies.ballistics import DECIDED
-from wovenimpact.studies.metal_validation import metal_section
-from wovenimpact.studies.strip_validation import STUDY as STRIP_STUDY
-from wovenimpact.studies.mesh_validation import RING_STUDIES, ring_section
-from wovenimpact.studies.strip_validation import strip_section
+from wovenimpact.reports.mesh_validation import RING_STUDIES, ring_section
+from wovenimpact.reports.metal_validation import metal_section
+from wovenimpact.reports.strip_validation import STUDY as STRIP_STUDY
+from wovenimpact.reports.strip_validation import strip_section
 from wovenimpact.spec.fields import read_toml, set_dotted
+from wovenimpact.studies.ballistics import DECIDED
 
 ROOT = Path(__file__).resolve().parents[3]
 CASES = ("plies1_100", "plies2_100", "plies4_100", "plies6_100", "plies4_120")

@@ -6,7 +6,7 @@
 is, with ``run.eroded_nodes = "keep"`` and struck by a blunter edge (radius 10 mm), and returns its section as Markdown
 lines: the case, the commands that reproduce it, one table per variant of the study and
 the acceptance of issue 36 (the strip's absorbed energy within 10 % from 2 to 7 mm).
-``studies.validation.run_validation`` appends it to its report (``wovenimpact validate
+``reports.validation.run_validation`` appends it to its report (``wovenimpact validate
 --study mesh_strip_edge`` runs it alone).
 """
 

@@ -12,8 +12,8 @@ from typer.testing import CliRunner
 from wovenimpact.cli.app import app
 from wovenimpact.io.checkpoint import latest_checkpoint, load_checkpoint
 from wovenimpact.io.history import read_csv
-from wovenimpact.setup.compile import compile_case
 from wovenimpact.runs import run_case
+from wovenimpact.setup.compile import compile_case
 from wovenimpact.spec.case import load_case
 
 ROOT = Path(__file__).resolve().parents[2]

@@ -11,12 +11,12 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pytest  # noqa: E402
 
-from wovenimpact.results.containment import CASING_ENERGY_COLUMNS  # noqa: E402
 from wovenimpact.io.plots import (  # noqa: E402
     containment_energy_figure,
     energy_plot,
     single_energy_figure,
 )
+from wovenimpact.results.containment import CASING_ENERGY_COLUMNS  # noqa: E402
 from wovenimpact.runs import HISTORY_COLUMNS  # noqa: E402
 
 N = 41

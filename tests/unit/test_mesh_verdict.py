@@ -12,9 +12,9 @@ from wovenimpact.benchmark import REFERENCE_FABRIC, REFERENCE_METAL
 from wovenimpact.io.report import mesh_box
 from wovenimpact.materials.fabric import FailureRegularisation
 from wovenimpact.materials.metal import FractureRegularisation
-from wovenimpact.results.mesh_verdict import mesh_verdict
 from wovenimpact.model import Section, build_model
 from wovenimpact.model.mesh import plate_mesh
+from wovenimpact.results.mesh_verdict import mesh_verdict
 from wovenimpact.spec import load_material
 from wovenimpact.state import initial_state
 

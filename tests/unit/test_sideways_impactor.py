@@ -20,10 +20,10 @@ from wovenimpact.errors import InputError
 from wovenimpact.impactor import Impactor
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels.contact_rigid import rigid_contact_forces
-from wovenimpact.setup.compile import compile_case
 from wovenimpact.model.mesh import plate_mesh
 from wovenimpact.model.model import RigidBody, flies_sideways, travel_of_row
 from wovenimpact.results.quantities import impactor_row, intact_material_ahead, travel_direction
+from wovenimpact.setup.compile import compile_case
 from wovenimpact.spec.case import case_from_dict
 from wovenimpact.spec.fields import read_toml, set_dotted
 

@@ -6,8 +6,8 @@ from __future__ import annotations
 import pytest
 
 from wovenimpact.reports.strip_validation import early_loss, spread, table_lines, verdict_line
-from wovenimpact.studies.sweep import load_study
 from wovenimpact.reports.strip_validation import ROOT, STUDY
+from wovenimpact.studies.sweep import load_study
 
 
 def rows(energies: dict) -> list[dict]:

@@ -1,9 +1,9 @@
 """The pieces of docs/validation.md that judge acceptance: full-plate cases, the
 convergence verdicts and the hourglass spread (synthetic summaries, no runs)."""
 
+from wovenimpact.reports.validation import ROOT, commentary, full_plate, spread_line
 from wovenimpact.spec.case import case_from_dict
 from wovenimpact.spec.fields import read_toml
-from wovenimpact.reports.validation import ROOT, commentary, full_plate, spread_line
 
 
 def test_full_plate_drops_only_the_symmetry_conditions_and_validates():

@@ -9,8 +9,8 @@ import pytest
 
 from wovenimpact.kernels import j2_layout as J
 from wovenimpact.kernels import shell_layout as SL
-from wovenimpact.results.metal_state import plastic_work, thickness_ratio
 from wovenimpact.model import BoundaryConditions, Section, build_model
+from wovenimpact.results.metal_state import plastic_work, thickness_ratio
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.spec import load_material
 from wovenimpact.state import initial_state

@@ -18,11 +18,11 @@ import pytest
 from wovenimpact.impactor import Impactor
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as SL
-from wovenimpact.results.metal_state import plastic_work
 from wovenimpact.model import BoundaryConditions, Section, build_model
-from wovenimpact.setup.compile import stack_plies
 from wovenimpact.model.mesh import plate_mesh
 from wovenimpact.model.model import RigidBody
+from wovenimpact.results.metal_state import plastic_work
+from wovenimpact.setup.compile import stack_plies
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.spec import load_material
 from wovenimpact.state import initial_state

@@ -55,8 +55,8 @@ from scipy.optimize import brentq
 from wovenimpact.errors import InputError, SimulationError
 from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.materials.metal import FractureRegularisation, MetalParameters
-from wovenimpact.results.metal_state import plastic_work
 from wovenimpact.model import BoundaryConditions, Section, build_model
+from wovenimpact.results.metal_state import plastic_work
 from wovenimpact.solver import Workspace, energy_balance, step
 from wovenimpact.state import initial_state
 

@@ -1,4 +1,4 @@
-"""The mesh verdict of a run (src/wovenimpact/mesh_verdict.py, docs/theory.md §1.4): each
+"""The mesh verdict of a run (src/wovenimpact/results/mesh_verdict.py, docs/theory.md §1.4): each
 failing material's element lengths against its reference size or the range its failure
 table was calibrated on, and the report's box that shows it."""
 

@@ -1,4 +1,5 @@
-"""materials/crimp.py and calibration/crimp.py: crimp amplitude of a cosine yarn, thesis eq. (5.1)–(5.5)."""
+"""materials/crimp.py and calibration/crimp.py: crimp amplitude of a cosine yarn, thesis
+eq. (5.1)–(5.5)."""
 
 from __future__ import annotations
 

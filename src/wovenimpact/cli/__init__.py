@@ -4,6 +4,7 @@ from wovenimpact.cli import (  # noqa: F401  (register commands)
     ballistics,
     bench,
     calibrate,
+    convergence,
     design,
     element_test,
     run,

@@ -57,6 +57,10 @@ def main(argv: list[str]) -> None:
         contact_parts(shells, state)
 
 
+# the assembly adds the contact forces to ``out`` (as the solver calls it, into f_ext)
+ACCUMULATE = True
+
+
 def best_ms(f, repeats: int = 10):
     """Best wall time of ``repeats`` calls of f (ms) and its last result."""
     best, out = float("inf"), None
@@ -71,6 +75,7 @@ def contact_parts(sc, state) -> None:
     """The shell contact's search and narrow phase at ``state``, each timed alone."""
     from wovenimpact.kernels import contact_broad as B
     from wovenimpact.kernels import contact_update as U
+    from wovenimpact.kernels.bundles import ContactSearch
     from wovenimpact.kernels.contact_narrow import (
         GEO_SIDE,
         assemble_contact_forces,
@@ -89,20 +94,16 @@ def contact_parts(sc, state) -> None:
     t_bin, entries = best_ms(lambda: B.bin_segments(
         sc.seg_on, sc.seg_box, sc.ply, 1.0 / edge, sc.bucket_ptr, sc.entry_seg, sc.entry_cell,
         sc.entry_box, sc.entry_ply))
+    search = ContactSearch(x=x, sigma=sigma, seg_plane=sc.seg_plane, edge=edge)
     t_query, _ = best_ms(lambda: B.query_candidates(
-        x, sc.quads, sc.ply, sc.node_ply, sc.node_on, sc.h_node, sigma, sc.self_contact,
-        sc.node_ptr, sc.node_elem, sc.seg_plane, edge, sc.bucket_ptr, sc.entry_seg,
-        sc.entry_cell, sc.entry_box, sc.entry_ply, sc.no_skip, sc.slots, sc.pair_ptr,
-        sc.pair_seg))
+        sc.surfaces, search, sc.node_on, sc.bins, sc.no_skip, sc.slots, sc.candidates_now))
     nodes = int((sc.node_on != 0).sum())
     print(f"  one search {t_all:.2f} ms: boxes {t_box:.2f}, binning {t_bin:.2f} ({entries} "
           f"entries, cell {edge * 1e3:.2f} mm), query {t_query:.2f} ({n} candidates, "
           f"{t_query / max(nodes, 1) * 1e6:.0f} ns per node)")
     segment_geometry(x, sc.quads, sc.seg_on, sc.seg_geo)
-    args = (x, state.v, sc.quads, sc.ply, sc.node_mass, sc.h_node, sc.h_seg, sc.margin,
-            sc.overlap, sc.beta, sc.damping, sc.friction, sc.approach, float(state.dt),
-            sc.seg_geo, sc.seg_on, sc.node_on, sc.pair_ptr, sc.pair_seg, sc.geo, sc.pair_on,
-            sc.pair_f, sc.pair_w, sc.pair_e, sc.pair_sd, sc.power, sc.node_f)
+    args = (x, state.v, float(state.dt), sc.surfaces, sc.law, sc.overlap, sc.seg_geo, sc.seg_on,
+            sc.node_on, sc.candidates_now, sc.pair_tables, sc.node_f)
     sc.geo[:n, GEO_SIDE] = 0.0  # the narrow phase writes the rows of projected pairs only
     t_pen, _ = best_ms(lambda: penalty_forces(*args))
     projected = int((sc.geo[:n, GEO_SIDE] != 0).sum())
@@ -120,8 +121,8 @@ def contact_parts(sc, state) -> None:
     t_geo, _ = best_ms(lambda: segment_geometry(x, sc.quads, sc.seg_on, sc.seg_geo))
     out = np.zeros((x.shape[0], 3))
     t_asm, _ = best_ms(lambda: assemble_contact_forces(
-        sc.quads, sc.pair_ptr, sc.pair_seg, sc.pair_on, sc.pair_f, sc.pair_w, sc.pair_e,
-        sc.node_f, sc.seg_ptr, sc.seg_entry, sc.cursor, out, True, sc.active))
+        sc.quads, sc.candidates_now, sc.pair_tables, sc.node_f, sc.seg_ptr, sc.seg_entry,
+        sc.cursor, out, ACCUMULATE, sc.active))
     work = np.zeros(x.shape[0])
     t_pow, _ = best_ms(lambda: force_pair_power(out, out, state.v, float(state.dt), work))
     sc.n_active = int((sc.pair_on[:n] != 0).sum())  # the pairs the assembly listed

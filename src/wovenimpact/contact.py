@@ -14,6 +14,15 @@ import numpy as np
 
 from wovenimpact.errors import InputError
 from wovenimpact.kernels import shell_layout as SL
+from wovenimpact.kernels.bundles import (
+    Candidates,
+    ContactLaw,
+    ContactSearch,
+    ContactSurfaces,
+    EnergyBooks,
+    PairTables,
+    SegmentBinTables,
+)
 from wovenimpact.kernels.contact_broad import (
     N_SEG_BOX,
     N_SEG_PLANE,
@@ -75,17 +84,18 @@ PARALLEL_BOOK_PAIRS = 4096
 
 class SegmentBins:
     """Hashed-grid bins of a subset of the segments (``contact_broad.bin_segments``),
-    growing on overflow: ``arrays`` = (bucket_ptr, entry_seg, entry_cell, entry_box,
-    entry_ply)."""
+    growing on overflow: ``arrays``, a kernels.bundles.SegmentBinTables."""
 
     def __init__(self, capacity: int = 64) -> None:
         self._alloc(capacity)
 
     def _alloc(self, capacity: int) -> None:
         cap = max(64, int(capacity))
-        self.arrays = (np.zeros(bucket_count(cap) + 1, dtype=np.int64),
-                       np.zeros(cap, dtype=np.int64), np.zeros((cap, 3), dtype=np.int64),
-                       np.zeros((cap, N_SEG_BOX)), np.zeros(cap, dtype=np.int64))
+        self.arrays = SegmentBinTables(
+            bucket_ptr=np.zeros(bucket_count(cap) + 1, dtype=np.int64),
+            entry_seg=np.zeros(cap, dtype=np.int64),
+            entry_cell=np.zeros((cap, 3), dtype=np.int64),
+            entry_box=np.zeros((cap, N_SEG_BOX)), entry_ply=np.zeros(cap, dtype=np.int64))
 
     def fill(self, seg_mask, seg_box, ply, inv_edge: float) -> int:
         """Bin the segments of ``seg_mask``; returns the number of entries."""
@@ -265,6 +275,13 @@ class ShellContact:
         for c in range(4):
             np.maximum.at(self.h_node, quads[on, c], self.h_seg[on])
         self.node_ply = node_plies(self.node_ptr, self.node_elem, self.ply)
+        # what the kernels read of the surfaces and the law (fixed)
+        self.surfaces = ContactSurfaces(
+            quads=self.quads, ply=self.ply, node_ply=self.node_ply, node_ptr=self.node_ptr,
+            node_elem=self.node_elem, node_mass=self.node_mass, h_node=self.h_node,
+            h_seg=self.h_seg, margin=self.margin, self_contact=self.self_contact)
+        self.law = ContactLaw(beta=self.beta, zeta=self.damping, mu=self.friction,
+                              approach=self.approach)
         self.slots = np.zeros((nn, CANDIDATE_SLOTS), dtype=np.int64)
         self.node_part = np.zeros(nn, dtype=np.int8)
         self.node_part[quads[on].ravel()] = 1
@@ -328,9 +345,27 @@ class ShellContact:
                           self.node_part, self.seg_on, self.node_on)
             self._search(x, self.no_skin)
             segment_geometry(x, self.quads, self.seg_on, self.seg_geo)
-            initial_overlap(x, self.quads, self.ply, self.h_node, self.h_seg, self.margin,
-                            self.seg_geo, self.seg_on, self.pair_ptr, self.pair_seg, self.geo,
-                            self.pair_on, self.overlap)
+            initial_overlap(x, self.surfaces, self.seg_geo, self.seg_on, self.candidates_now,
+                            self.pair_tables, self.overlap)
+
+    @property
+    def candidates_now(self) -> Candidates:
+        """The candidate lists (pair_ptr, pair_seg) as the kernels take them."""
+        return Candidates(ptr=self.pair_ptr, seg=self.pair_seg)
+
+    @property
+    def pair_tables(self) -> PairTables:
+        """The narrow phase's pair tables as the kernels take them."""
+        return PairTables(geo=self.geo, on=self.pair_on, force=self.pair_f,
+                          weights=self.pair_w, energy=self.pair_e, spring_damper=self.pair_sd,
+                          power=self.power)
+
+    @property
+    def bins(self) -> SegmentBinTables:
+        """The bins of the last full search as the kernels take them."""
+        return SegmentBinTables(bucket_ptr=self.bucket_ptr, entry_seg=self.entry_seg,
+                                entry_cell=self.entry_cell, entry_box=self.entry_box,
+                                entry_ply=self.entry_ply)
 
     @property
     def capacity(self) -> int:
@@ -368,9 +403,7 @@ class ShellContact:
         """The live segments (seg_on) into the bins at their padded boxes (seg_box), on
         cells of edge ``edge``; the bins grow on overflow."""
         while True:
-            n = bin_segments(self.seg_on, self.seg_box, self.ply, 1.0 / edge,
-                             self.bucket_ptr, self.entry_seg, self.entry_cell,
-                             self.entry_box, self.entry_ply)
+            n = bin_segments(self.seg_on, self.seg_box, self.ply, 1.0 / edge, *self.bins)
             if n <= self.entry_seg.shape[0]:
                 break
             self._alloc_entries(int(1.5 * n))
@@ -383,13 +416,10 @@ class ShellContact:
                       self.seg_box, self.seg_plane)
         edge = cell_edge(self.seg_on, self.seg_box)
         self._bin(edge)
+        search = ContactSearch(x=x, sigma=sigma, seg_plane=self.seg_plane, edge=edge)
         while True:
-            n = query_candidates(
-                x, self.quads, self.ply, self.node_ply, self.node_on, self.h_node, sigma,
-                self.self_contact, self.node_ptr, self.node_elem, self.seg_plane, edge,
-                self.bucket_ptr, self.entry_seg, self.entry_cell, self.entry_box,
-                self.entry_ply, self.no_skip, self.slots, self.pair_ptr, self.pair_seg,
-            )
+            n = query_candidates(self.surfaces, search, self.node_on, self.bins, self.no_skip,
+                                 self.slots, self.candidates_now)
             if n <= self.capacity:
                 break
             self._alloc_pairs(int(1.5 * n) + 64)
@@ -444,18 +474,15 @@ class ShellContact:
         self.new_bins.fill(self.seg_new, self.seg_box, self.ply, inv)
         self.side_bins.fill(self.seg_side, self.seg_box, self.ply, inv)
         bounding_box(self.seg_new, self.seg_box, self.new_bounds)
-        bp, es, ec, eb, _ = self.new_bins.arrays
-        n_req = mark_requery(self.x_search, self.h_node, self.sigma, self.node_on, self.far,
-                             self.cell, self.seg_plane, self.new_bounds, bp, es, ec, eb,
-                             self.req_pos, self.req_list)
-        main = (self.bucket_ptr, self.entry_seg, self.entry_cell, self.entry_box,
-                self.entry_ply)
+        search = ContactSearch(x=self.x_search, sigma=self.sigma, seg_plane=self.seg_plane,
+                               edge=self.cell)
+        n_req = mark_requery(self.surfaces, search, self.node_on, self.far, self.new_bounds,
+                             self.new_bins.arrays, self.req_pos, self.req_list)
         while True:
             n = requery_candidates(
-                self.req_list, n_req, self.x_search, self.quads, self.ply, self.node_ply,
-                self.h_node, self.sigma, self.self_contact, self.node_ptr, self.node_elem,
-                self.seg_plane, self.cell, main, self.seg_moved, self.side_bins.arrays,
-                self.no_skip, self.slots, self.req_ptr, self.req_seg)
+                self.req_list, n_req, self.surfaces, search, self.bins, self.seg_moved,
+                self.side_bins.arrays, self.no_skip, self.slots,
+                Candidates(ptr=self.req_ptr, seg=self.req_seg))
             if n <= self.req_seg.shape[0]:
                 break
             self.req_seg = np.zeros(int(1.5 * n) + 64, dtype=np.int64)
@@ -510,18 +537,12 @@ class ShellContact:
             if n_far and not self._update(x, v, dt, n_far):
                 self._full_search(x, v, dt)
         segment_geometry(x, self.quads, self.seg_on, self.seg_geo)
-        penalty_forces(
-            x, v, self.quads, self.ply, self.node_mass, self.h_node, self.h_seg, self.margin,
-            self.overlap, self.beta, self.damping, self.friction, self.approach, float(dt),
-            self.seg_geo, self.seg_on, self.node_on, self.pair_ptr, self.pair_seg,
-            self.geo, self.pair_on, self.pair_f, self.pair_w, self.pair_e, self.pair_sd,
-            self.power, self.node_f,
-        )
+        candidates, pairs = self.candidates_now, self.pair_tables
+        penalty_forces(x, v, float(dt), self.surfaces, self.law, self.overlap, self.seg_geo,
+                       self.seg_on, self.node_on, candidates, pairs, self.node_f)
         energy, n_active = assemble_contact_forces(
-            self.quads, self.pair_ptr, self.pair_seg, self.pair_on, self.pair_f, self.pair_w,
-            self.pair_e, self.node_f, self.seg_ptr, self.seg_entry, self.cursor,
-            out_force, bool(accumulate), self.active,
-        )
+            self.quads, candidates, pairs, self.node_f, self.seg_ptr, self.seg_entry,
+            self.cursor, out_force, bool(accumulate), self.active)
         self.n_active = int(n_active)
         return float(energy), int(n_active)
 
@@ -540,18 +561,17 @@ class ShellContact:
         n = self.n_active
         if n == 0:
             return
+        books = EnergyBooks(w_before=float(w_before), before=books_before,
+                            w_after=float(w_after), after=books_after)
         if n < PARALLEL_BOOK_PAIRS:
-            book_shell_pairs(v, self.quads, self.pair_seg, self.pair_w, self.geo, self.pair_f,
-                             self.pair_sd, self.power, self.active, n, self.friction > 0.0,
-                             node_part, seg_part, float(w_before), books_before,
-                             float(w_after), books_after)
+            book_shell_pairs(v, self.quads, self.pair_seg, self.pair_tables, self.active, n,
+                             self.friction > 0.0, node_part, seg_part, books)
             return
         if self.act_if.shape[0] < n:  # the compact tables grow with the acting pairs
             self.act_if = np.zeros(int(1.5 * n), dtype=np.int64)
             self.act_pw = np.zeros((int(1.5 * n), 2 * N_KINDS))
         n_parts = books_before.shape[1]
-        shell_pair_powers(v, self.quads, self.pair_seg, self.pair_w, self.geo, self.pair_f,
-                          self.pair_sd, self.power, self.active, n, self.friction > 0.0,
-                          node_part, seg_part, n_parts, self.act_if, self.act_pw)
-        book_compact(self.act_if, self.act_pw, n, n_parts, float(w_before), books_before,
-                     float(w_after), books_after)
+        shell_pair_powers(v, self.quads, self.pair_seg, self.pair_tables, self.active, n,
+                          self.friction > 0.0, node_part, seg_part, n_parts, self.act_if,
+                          self.act_pw)
+        book_compact(self.act_if, self.act_pw, n, n_parts, books)

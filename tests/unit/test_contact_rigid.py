@@ -10,6 +10,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from wovenimpact.impactor import Impactor
+from wovenimpact.kernels.bundles import BodyContact, BodyContactOut, ContactNodes
 from wovenimpact.kernels.contact_rigid import profile_distance, rigid_contact_forces
 
 R = 2e-3
@@ -58,11 +59,14 @@ def test_penalty_force_pushes_nodes_out_along_the_normal():
     energy = np.zeros(3)
     zero = np.zeros(3)
     # k = β m / Δt² = 1e6 N/m with β = 1, m = 1 kg, Δt = 1 ms; no dashpot, no friction
-    rigid_contact_forces(x, np.zeros((3, 3)), np.ones(3, np.int8), np.ones(3),
-                         np.full(3, 0.25e-3), 1.0, 0.0, 0.0, 1e-3, 1e30, tip, axis, zero, zero,
-                         zero,
-                         prof[:, 0], prof[:, 1], 10e-3, force, energy, np.zeros((3, 11)),
-                         np.zeros(3, dtype=np.int64))
+    nodes = ContactNodes(x=x, v=np.zeros((3, 3)), active=np.ones(3, np.int8), mass=np.ones(3),
+                         offset=np.full(3, 0.25e-3))
+    body = BodyContact(tip=tip, axis=axis, velocity=zero, spin=zero, centre=zero,
+                       prof_z=prof[:, 0], prof_r=prof[:, 1], reach=10e-3, mass=1e30, beta=1.0,
+                       zeta=0.0, mu=0.0)
+    rigid_contact_forces(nodes, body, 1e-3, BodyContactOut(
+        force=force, energy=energy, parts=np.zeros((3, 11)),
+        contact_list=np.zeros(3, dtype=np.int64)))
     gap = 0.25e-3 - 0.1e-3
     assert force[0] == pytest.approx([0.0, 0.0, 1e6 * gap])
     assert force[1] == pytest.approx([0.0, 0.0, 1e6 * gap])
@@ -89,10 +93,14 @@ def test_dashpot_and_friction_act_on_the_velocity_relative_to_the_body():
     beta, zeta, mu, dt, m = 0.1, 0.7, 0.3, 1e-7, 2e-6
     force = np.zeros((2, 3))
     energy = np.zeros(2)
-    rigid_contact_forces(x, v, np.ones(2, np.int8), np.full(2, m), np.full(2, 0.25e-3), beta,
-                         zeta, mu, dt, 2.0 * m, tip, axis, body_v, body_w, centre, prof[:, 0],
-                         prof[:, 1], 10e-3, force, energy, np.zeros((2, 11)),
-                         np.zeros(2, dtype=np.int64))
+    nodes = ContactNodes(x=x, v=v, active=np.ones(2, np.int8), mass=np.full(2, m),
+                         offset=np.full(2, 0.25e-3))
+    body = BodyContact(tip=tip, axis=axis, velocity=body_v, spin=body_w, centre=centre,
+                       prof_z=prof[:, 0], prof_r=prof[:, 1], reach=10e-3, mass=2.0 * m,
+                       beta=beta, zeta=zeta, mu=mu)
+    rigid_contact_forces(nodes, body, dt, BodyContactOut(
+        force=force, energy=energy, parts=np.zeros((2, 11)),
+        contact_list=np.zeros(2, dtype=np.int64)))
     k = beta * m / dt**2
     c = 2.0 * zeta * np.sqrt(beta) * (m / 2.0) / dt
     gap = 0.25e-3 - 0.1e-3

@@ -13,6 +13,12 @@ from hypothesis import strategies as st
 from wovenimpact.contact import ShellContact, node_plies
 from wovenimpact.jit import set_threads
 from wovenimpact.kernels import shell_layout as SL
+from wovenimpact.kernels.bundles import (
+    Candidates,
+    ContactSearch,
+    ContactSurfaces,
+    SegmentBinTables,
+)
 from wovenimpact.kernels.contact_broad import (
     N_SEG_BOX,
     N_SEG_PLANE,
@@ -210,17 +216,22 @@ class RawSearch:
                                  np.zeros(65, np.int64), np.zeros(0, np.int64),
                                  np.zeros((0, 3), np.int64), np.zeros((0, 6)),
                                  np.zeros(0, np.int64))  # too small: counts only
-        bins = (np.zeros(bucket_count(n_entries) + 1, np.int64), np.zeros(n_entries, np.int64),
-                np.zeros((n_entries, 3), np.int64), np.zeros((n_entries, 6)),
-                np.zeros(n_entries, np.int64))
+        bins = SegmentBinTables(
+            bucket_ptr=np.zeros(bucket_count(n_entries) + 1, np.int64),
+            entry_seg=np.zeros(n_entries, np.int64), entry_cell=np.zeros((n_entries, 3), np.int64),
+            entry_box=np.zeros((n_entries, 6)), entry_ply=np.zeros(n_entries, np.int64))
         assert bin_segments(seg_on, self.seg_box, m.ply, 1.0 / edge, *bins) == n_entries
-        args = (x, m.quads, m.ply, self.node_ply, node_on, self.h_node, sigma,
-                self.self_contact, self.ptr, self.elem, self.seg_plane, edge, *bins,
-                np.zeros(m.n_elems, np.int8), self.slots, self.pair_ptr)
-        n = query_candidates(*args, self.pair_seg)
+        surfaces = ContactSurfaces(
+            quads=m.quads, ply=m.ply, node_ply=self.node_ply, node_ptr=self.ptr,
+            node_elem=self.elem, node_mass=np.ones(m.n_nodes), h_node=self.h_node,
+            h_seg=self.h_seg, margin=self.margin, self_contact=self.self_contact)
+        search = ContactSearch(x=x, sigma=sigma, seg_plane=self.seg_plane, edge=edge)
+        args = (surfaces, search, node_on, bins, np.zeros(m.n_elems, np.int8), self.slots)
+        n = query_candidates(*args, Candidates(ptr=self.pair_ptr, seg=self.pair_seg))
         if n > self.pair_seg.shape[0]:  # overflow: nothing written but the count
             self.pair_seg = np.full(n, -1, np.int64)
-            assert query_candidates(*args, self.pair_seg) == n
+            assert query_candidates(*args, Candidates(ptr=self.pair_ptr,
+                                                      seg=self.pair_seg)) == n
         nodes = np.repeat(np.arange(m.n_nodes), np.diff(self.pair_ptr))
         return list(zip(nodes.tolist(), self.pair_seg[:n].tolist()))
 

@@ -19,6 +19,7 @@ from tests.corpus.generate import IMPACT, _set
 from wovenimpact.errors import InputError
 from wovenimpact.impactor import Impactor
 from wovenimpact.kernels import rigid_body as RB
+from wovenimpact.kernels.bundles import BodyContact, BodyContactOut, ContactNodes
 from wovenimpact.kernels.contact_rigid import rigid_contact_forces
 from wovenimpact.model.mesh import plate_mesh
 from wovenimpact.model.model import RigidBody, flies_sideways, travel_of_row
@@ -183,10 +184,14 @@ def test_the_side_of_a_cylinder_pushes_nodes_out_along_its_radius():
     n = len(x)
     force, energy, zero = np.zeros((n, 3)), np.zeros(n), np.zeros(3)
     # k = β m / Δt² = 1e6 N/m with β = 1, m = 1 kg, Δt = 1 ms; no dashpot, no friction
-    rigid_contact_forces(x, np.zeros((n, 3)), np.ones(n, np.int8), np.ones(n),
-                         np.full(n, 0.25e-3), 1.0, 0.0, 0.0, 1e-3, 1e30, tip, axis, zero, zero,
-                         zero, prof[:, 0], prof[:, 1], 0.02, force, energy, np.zeros((n, 8)),
-                         np.zeros(n, dtype=np.int64))
+    nodes = ContactNodes(x=x, v=np.zeros((n, 3)), active=np.ones(n, np.int8), mass=np.ones(n),
+                         offset=np.full(n, 0.25e-3))
+    body = BodyContact(tip=tip, axis=axis, velocity=zero, spin=zero, centre=zero,
+                       prof_z=prof[:, 0], prof_r=prof[:, 1], reach=0.02, mass=1e30, beta=1.0,
+                       zeta=0.0, mu=0.0)
+    rigid_contact_forces(nodes, body, 1e-3, BodyContactOut(
+        force=force, energy=energy, parts=np.zeros((n, 11)),
+        contact_list=np.zeros(n, dtype=np.int64)))
     for i in (0, 1):
         rel = np.array([x[i, 0], 0.0, x[i, 2] - zc])
         d = np.linalg.norm(rel) - r

@@ -13,6 +13,16 @@ statement, before the loop: writes through a bundle in the loop body can be lost
 :class:`ShellMesh`, :class:`ElementResults`, :class:`NodeMap` and :class:`NodeEnergies`
 are built once per Workspace, the others per step from the arrays the step swaps; none
 is stored in a checkpoint.
+
+The contact kernels take bundles too (issue 37): the shell–shell contact's
+:class:`ContactSurfaces` and :class:`ContactLaw` are built once per ``ShellContact``, its
+search, bins, candidate lists and pair tables (:class:`ContactSearch`,
+:class:`SegmentBinTables`, :class:`Candidates`, :class:`PairTables`) at each call from the
+buffers of the moment (they grow and swap); the rigid bodies' :class:`ContactNodes`,
+:class:`BodyContact` and :class:`BodyContactOut` per body and step
+(``solver.contact_stage``); :class:`EnergyBooks` per step. A kernel called from outside
+``kernels/`` takes at most 12 arguments (tests/docs/test_kernel_calls.py); the inner
+stages of a loop keep their long signatures where they say so.
 """
 
 from __future__ import annotations
@@ -164,3 +174,124 @@ class HexResults(NamedTuple):
 
     blocks: np.ndarray  # (n_elems, 8, 3) internal corner forces (global)
     status: np.ndarray  # (n_elems,) int32 EL_* codes
+
+
+# Contact (issue 37): the bundles of the shell–shell contact (contact_broad, contact_update,
+# contact_narrow, contact_energy), built by its driver (``contact.ShellContact``), and of
+# the rigid bodies (contact_rigid, built by ``solver.contact_stage``). The contact kernels
+# read each member into a local, one per statement, at their top.
+
+
+class ContactSurfaces(NamedTuple):
+    """The shell surfaces of a contact as its kernels read them: fixed for a
+    ``ShellContact`` (never written)."""
+
+    quads: np.ndarray  # (n_elems, 4) int64 the segments' nodes
+    ply: np.ndarray  # (n_elems,) int64 each segment's ply
+    node_ply: np.ndarray  # (n_nodes,) int64 the ply of all of a node's elements, −1 if several
+    node_ptr: np.ndarray  # (n_nodes + 1,) node → element CSR (Model)
+    node_elem: np.ndarray
+    node_mass: np.ndarray  # (n_nodes,) lumped masses (kg)
+    h_node: np.ndarray  # (n_nodes,) node offsets h_p (m)
+    h_seg: np.ndarray  # (n_elems,) segment offsets h_s (m)
+    margin: float  # the search margin m (m)
+    self_contact: bool  # pairs within a ply (unless the node's element shares a node)
+
+
+class ContactSearch(NamedTuple):
+    """Where a search looks: the positions it is made at, the nodes' skins, the
+    segments' planes (contact_broad.segment_boxes) and the cell edge of its bins."""
+
+    x: np.ndarray  # (n_nodes, 3) positions of the search (m)
+    sigma: np.ndarray  # (n_nodes,) node skins σ_p (m)
+    seg_plane: np.ndarray  # (n_elems, N_SEG_PLANE)
+    edge: float  # the cell edge L (m)
+
+
+class SegmentBinTables(NamedTuple):
+    """The hashed-grid bins of segments (contact_broad.bin_segments): a bucket CSR over
+    entries, one entry per (segment, cell) its padded box overlaps."""
+
+    bucket_ptr: np.ndarray  # (n_buckets + 1,) int64
+    entry_seg: np.ndarray  # (capacity,) int64 the entry's segment
+    entry_cell: np.ndarray  # (capacity, 3) int64 its cell
+    entry_box: np.ndarray  # (capacity, N_SEG_BOX) its segment's padded box
+    entry_ply: np.ndarray  # (capacity,) int64 its segment's ply
+
+
+class Candidates(NamedTuple):
+    """Candidate (node, segment) pairs, node-major: node p's segments are
+    seg[ptr[p]:ptr[p + 1]] in increasing order (written by the searches)."""
+
+    ptr: np.ndarray  # (n_nodes + 1,) int64
+    seg: np.ndarray  # (capacity,) int64
+
+
+class ContactLaw(NamedTuple):
+    """The penalty law of the shell pairs (contact_narrow.penalty_forces)."""
+
+    beta: float  # penalty scale β of k = β min(m_p, m̄_s) / Δt²
+    zeta: float  # pair dashpot, fraction ζ of critical
+    mu: float  # Coulomb friction coefficient μ (0: frictionless)
+    approach: bool  # the dashpot acts only while the pair closes (damping_mode "approach")
+
+
+class PairTables(NamedTuple):
+    """What the narrow phase writes of each candidate pair, (capacity, …) each
+    (contact_narrow.penalty_forces: rows of the acting pairs, ``on`` ≠ 0)."""
+
+    geo: np.ndarray  # (capacity, N_GEO) the projection (ξ, η, d, n, side)
+    on: np.ndarray  # (capacity,) int8 1 for an acting pair
+    force: np.ndarray  # (capacity, 3) force on the node (N)
+    weights: np.ndarray  # (capacity, 4) N_I(ξ, η) of the contact point
+    energy: np.ndarray  # (capacity,) ½ k g² (J)
+    spring_damper: np.ndarray  # (capacity, 2) normal forces of the spring and the dashpot (N)
+    power: np.ndarray  # (capacity, N_KINDS) powers of spring, dashpot, friction (W)
+
+
+class EnergyBooks(NamedTuple):
+    """Both halves of a step's contact work (kernels.contact_energy): ``before[kind, a,
+    b] −= w_before · P`` with the powers at the velocities of the forces, ``after`` with
+    those at the velocities after the node update (both written)."""
+
+    w_before: float  # ½ Δt^{n−1/2} (s)
+    before: np.ndarray  # (N_KINDS, P, P)
+    w_after: float  # ½ Δt^{n+1/2} (s)
+    after: np.ndarray  # (N_KINDS, P, P)
+
+
+class ContactNodes(NamedTuple):
+    """The nodes as the rigid-body contact reads them (contact_rigid; never written)."""
+
+    x: np.ndarray  # (n, 3) positions x^n
+    v: np.ndarray  # (n, 3) velocities v^{n−1/2}
+    active: np.ndarray  # (n,) 0 for a node that takes no contact (eroded)
+    mass: np.ndarray  # (n,) lumped masses (kg)
+    offset: np.ndarray  # (n,) contact offsets h (m)
+
+
+class BodyContact(NamedTuple):
+    """A rigid body of revolution as the contact kernel sees it at x^n, with its
+    penalty law (contact_rigid.rigid_contact_forces)."""
+
+    tip: np.ndarray  # (3,) nose-tip position
+    axis: np.ndarray  # (3,) unit axis, tip → tail
+    velocity: np.ndarray  # (3,) the body's velocity V
+    spin: np.ndarray  # (3,) its global spin ω
+    centre: np.ndarray  # (3,) its centre of mass c
+    prof_z: np.ndarray  # meridian profile polyline (ζ_i, ρ_i), tip to tail
+    prof_r: np.ndarray
+    reach: float  # bounding radius about the tip plus the largest offset (m)
+    mass: float  # the body's mass in the model M (kg; its share in a symmetry model)
+    beta: float  # penalty scale β of k = β m / Δt²
+    zeta: float  # dashpot, fraction ζ of critical
+    mu: float  # Coulomb friction coefficient μ
+
+
+class BodyContactOut(NamedTuple):
+    """What the rigid-body contact writes (contact_rigid.rigid_contact_forces)."""
+
+    force: np.ndarray  # (n, 3) contact force on each node (N)
+    energy: np.ndarray  # (n,) penalty energy ½ k g² of each node (J)
+    parts: np.ndarray  # (n, 11) the pair's spring, dashpot, normal, force and powers
+    contact_list: np.ndarray  # (n,) int64 the nodes in contact, in node order

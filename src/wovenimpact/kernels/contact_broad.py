@@ -247,6 +247,9 @@ def sort_ascending(a, start, stop):
         a[j + 1] = v
 
 
+# keeps its long signature: a stage called in the loop of ``query_candidates`` and ``scan_twice``,
+# its arguments that loop's locals (a bundle written through in a parallel loop's body can lose
+# its writes: kernels/bundles.py)
 @kernel
 def scan_node(p, x, quads, ply, node_ply, h_node, sigma, self_contact, node_ptr, node_elem,
               seg_plane, edge, bucket_ptr, entry_seg, entry_cell, entry_box, entry_ply,
@@ -303,35 +306,48 @@ def scan_node(p, x, quads, ply, node_ply, h_node, sigma, self_contact, node_ptr,
 
 
 @loop_kernel
-def query_candidates(
-    x, quads, ply, node_ply, node_on, h_node, sigma, self_contact, node_ptr, node_elem,
-    seg_plane, edge, bucket_ptr, entry_seg, entry_cell, entry_box, entry_ply, skip, slots,
-    pair_ptr, pair_seg,
-):
+def query_candidates(surfaces, search, node_on, bins, skip, slots, out):
     """Candidate (node, segment) pairs of the binned segments (module docstring, step 3).
 
     Args:
-        x: (n_nodes, 3) positions; quads, ply: (n_elems, 4) segments, (n_elems,) plies.
-        node_ply: (n_nodes,) the ply of all of a node's elements, −1 if they are of
-            several plies (or it has none).
+        surfaces: kernels.bundles.ContactSurfaces: segments (quads) and their plies;
+            node_ply, the ply of all of a node's elements, −1 if they are of several
+            plies (or it has none); node offsets h_p (m); self_contact (False: no pair
+            within one ply; True: pairs within a ply unless the node's element shares a
+            node with the segment); the node → element CSR (Model).
+        search: kernels.bundles.ContactSearch: positions, node skins σ_p (m), the
+            planes of :func:`segment_boxes` and the cell edge L.
         node_on: (n_nodes,) nonzero for a node taking part now (active and selected).
-        h_node: (n_nodes,) node offsets h_p (m); sigma: (n_nodes,) node skins σ_p (m).
-        self_contact: 0: no pair within one ply; 1: pairs within a ply unless the node's
-            element shares a node with the segment.
-        node_ptr, node_elem: node → element CSR (Model).
-        seg_plane: the planes of :func:`segment_boxes`; edge: the cell edge L.
-        bucket_ptr, entry_seg, entry_cell, entry_box, entry_ply: the bins of
-            :func:`bin_segments`.
+        bins: kernels.bundles.SegmentBinTables, the bins of :func:`bin_segments`.
         skip: (n_segments,) int8: binned segments to pass over (all 0 in a search).
         slots: (n_nodes, m) int64 scratch: the first m candidates of each node, kept
             from the counting pass (a node with more is scanned again to write).
-        pair_ptr: (n_nodes + 1,) int64 written: candidates of node p are
-            pair_seg[pair_ptr[p]:pair_ptr[p + 1]], in increasing segment order.
-        pair_seg: (capacity,) int64 written when the total fits.
+        out: kernels.bundles.Candidates, written: ``ptr`` (n_nodes + 1,), candidates of
+            node p are seg[ptr[p]:ptr[p + 1]], in increasing segment order; ``seg``
+            (capacity,) written when the total fits.
 
     Returns:
-        the number of candidates (> capacity: overflow, pair_seg not written).
+        the number of candidates (> capacity: overflow, ``out.seg`` not written).
     """
+    # the bundles' members as locals, one per statement, before the parallel loops
+    x = search.x
+    sigma = search.sigma
+    seg_plane = search.seg_plane
+    edge = search.edge
+    quads = surfaces.quads
+    ply = surfaces.ply
+    node_ply = surfaces.node_ply
+    h_node = surfaces.h_node
+    self_contact = surfaces.self_contact
+    node_ptr = surfaces.node_ptr
+    node_elem = surfaces.node_elem
+    bucket_ptr = bins.bucket_ptr
+    entry_seg = bins.entry_seg
+    entry_cell = bins.entry_cell
+    entry_box = bins.entry_box
+    entry_ply = bins.entry_ply
+    pair_ptr = out.ptr
+    pair_seg = out.seg
     n_nodes = x.shape[0]
     room = slots.shape[1]
     flat = slots.reshape(-1)

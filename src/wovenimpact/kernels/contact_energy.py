@@ -58,8 +58,8 @@ def relative_velocity(v, quads, pair_w, geo, p, k, s):
 
 
 @loop_kernel
-def shell_pair_powers(v, quads, pair_seg, pair_w, geo, pair_f, pair_sd, pair_pw, active,
-                      n_active, friction, node_part, seg_part, n_parts, act_if, act_pw):
+def shell_pair_powers(v, quads, pair_seg, pairs, active, n_active, friction, node_part,
+                      seg_part, n_parts, act_if, act_pw):
     """For each active pair j (node active[j, 0], pair k = active[j, 1]: the list of
     ``assemble_contact_forces``), in rows j of compact tables: act_if[j] = a · n_parts + b,
     a the part of the node and b of the segment, and act_pw[j] = the powers (P_spring,
@@ -68,7 +68,13 @@ def shell_pair_powers(v, quads, pair_seg, pair_w, geo, pair_f, pair_sd, pair_pw,
     ``penalty_forces`` left them (the same expressions as its own; P_friction = 0 unless
     ``friction``: with μ = 0, f = (s + d) n and the difference is round-off). Parallel,
     each pair its own row: the pairs' scattered rows are read here, and the serial sum
-    (:func:`book_compact`) reads the compact tables in order."""
+    (:func:`book_compact`) reads the compact tables in order. ``pairs``: the narrow
+    phase's tables (kernels.bundles.PairTables)."""
+    pair_w = pairs.weights
+    geo = pairs.geo
+    pair_f = pairs.force
+    pair_sd = pairs.spring_damper
+    pair_pw = pairs.power
     for j in prange(n_active):
         p = active[j, 0]
         k = active[j, 1]
@@ -89,11 +95,15 @@ def shell_pair_powers(v, quads, pair_seg, pair_w, geo, pair_f, pair_sd, pair_pw,
 
 
 @kernel
-def book_compact(act_if, act_pw, n_active, n_parts, w_before, books_before, w_after,
-                 books_after):
+def book_compact(act_if, act_pw, n_active, n_parts, books):
     """books_before[kind, a, b] −= w_before · act_pw[j, kind] for the rows j in order,
     then books_after[kind, a, b] −= w_after · act_pw[j, 3 + kind] (a, b from act_if[j] =
-    a · n_parts + b; :func:`shell_pair_powers`). Serial: deterministic."""
+    a · n_parts + b; :func:`shell_pair_powers`). Serial: deterministic. ``books``:
+    kernels.bundles.EnergyBooks."""
+    w_before = books.w_before
+    books_before = books.before
+    w_after = books.w_after
+    books_after = books.after
     for j in range(n_active):
         a = act_if[j] // n_parts
         b = act_if[j] - a * n_parts
@@ -107,15 +117,24 @@ def book_compact(act_if, act_pw, n_active, n_parts, w_before, books_before, w_af
 
 
 @kernel
-def book_shell_pairs(v, quads, pair_seg, pair_w, geo, pair_f, pair_sd, pair_pw, active,
-                     n_active, friction, node_part, seg_part, w_before, books_before,
-                     w_after, books_after):
+def book_shell_pairs(v, quads, pair_seg, pairs, active, n_active, friction, node_part,
+                     seg_part, books):
     """Both halves of a step's shell pairs in one serial pass each, for a few pairs (a
     parallel launch costs more than their work): the powers at the velocities of the
     forces (``pair_pw``, written by ``penalty_forces``) times ``w_before`` into
     ``books_before``, then those at v (:func:`shell_pair_powers`) times ``w_after`` into
     ``books_after`` — the same sums in the same order as :func:`shell_pair_powers` with
-    :func:`book_compact`, so bitwise the books of that parallel route."""
+    :func:`book_compact`, so bitwise the books of that parallel route. ``pairs``:
+    kernels.bundles.PairTables; ``books``: kernels.bundles.EnergyBooks."""
+    pair_w = pairs.weights
+    geo = pairs.geo
+    pair_f = pairs.force
+    pair_sd = pairs.spring_damper
+    pair_pw = pairs.power
+    w_before = books.w_before
+    books_before = books.before
+    w_after = books.w_after
+    books_after = books.after
     for j in range(n_active):
         k = active[j, 1]
         a = node_part[active[j, 0]]
@@ -140,7 +159,7 @@ def book_shell_pairs(v, quads, pair_seg, pair_w, geo, pair_f, pair_sd, pair_pw, 
 
 @kernel
 def book_body_pairs(v, body_v, parts, contact_list, count, friction, node_part, body_part,
-                    w_before, books_before, w_after, books_after):
+                    books):
     """Both halves of a step's pairs of the nodes i = contact_list[j] in contact with a
     body (a the part of the node), their forces as ``rigid_contact_forces`` left them in
     ``parts``: the powers it wrote at the velocities of the forces times ``w_before``
@@ -149,7 +168,11 @@ def book_body_pairs(v, body_v, parts, contact_list, count, friction, node_part, 
     P_friction = f · v_r − (s + d) v_n (0 without friction), v_r = v_i − V — the solver
     books the work of the force on the body with its translation only
     (solver.contact_stage.advance_bodies). Serial, in node order: the nodes in contact
-    with a body are few."""
+    with a body are few. ``books``: kernels.bundles.EnergyBooks."""
+    w_before = books.w_before
+    books_before = books.before
+    w_after = books.w_after
+    books_after = books.after
     for j in range(count):
         i = contact_list[j]
         a = node_part[i]

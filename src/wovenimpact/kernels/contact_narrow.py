@@ -217,6 +217,9 @@ def shape_functions(xi, eta):
     )
 
 
+# keeps its long signature: a stage inlined into ``initial_overlap`` and ``penalty_forces``, its
+# arguments that loop's locals (a bundle written through in a parallel loop's body can lose its
+# writes: kernels/bundles.py)
 @block_kernel
 def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, seg_on, pair_ptr,
                         pair_seg, geo, keep):
@@ -305,43 +308,61 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, seg_on, pa
 
 
 @loop_kernel
-def penalty_forces(
-    x, v, quads, ply, node_mass, h_node, h_seg, margin, overlap, beta, zeta, mu, approach, dt,
-    seg, seg_on, node_on, pair_ptr, pair_seg, geo, pair_on, pair_f, pair_w, pair_e, pair_sd,
-    pair_pw, node_f,
-):
+def penalty_forces(x, v, dt, surfaces, law, overlap, seg, seg_on, node_on, candidates, pairs,
+                   node_f):
     """Penalty (and friction) force of every candidate pair (module docstring).
 
     Args:
         x, v: (n_nodes, 3) positions x^n and velocities (v^{n−1/2} in the solver).
-        quads, ply: segments and their plies; node_mass: (n_nodes,) lumped masses.
-        h_node, h_seg: node and segment offsets (m); margin: the search margin m (m);
-        overlap: (n_nodes,) o_p (m).
-        beta: penalty scale β; zeta: damping ζ (fraction of critical); mu: friction
-            coefficient μ (0: frictionless).
-        approach: the dashpot acts only while the pair closes (v_n < 0; the
-            ``damping_mode = "approach"`` law), not while it separates.
         dt: the time step the forces are for (s), > 0.
+        surfaces: kernels.bundles.ContactSurfaces: segments and their plies, lumped
+            masses, node and segment offsets (m), the search margin m (m).
+        law: kernels.bundles.ContactLaw: penalty scale β, damping ζ (fraction of
+            critical), friction coefficient μ (0: frictionless), and ``approach``: the
+            dashpot acts only while the pair closes (v_n < 0; the ``damping_mode =
+            "approach"`` law), not while it separates.
+        overlap: (n_nodes,) o_p (m).
         seg: (n_elems, N_SEG_GEO) the segments' table at x (:func:`segment_geometry`).
         seg_on, node_on: (n_elems,), (n_nodes,) int8: the segments and nodes taking part
             now; the candidates may be of a search when more did (Verlet reuse): pairs
             of a node or segment that is off no longer act.
-        pair_ptr, pair_seg: candidates (contact_broad.query_candidates).
-        geo: (capacity, N_GEO), pair_on: (capacity,) int8: scratch / written.
-        pair_f: (capacity, 3) written for the active pairs (pair_on ≠ 0): force on the
-            node of each pair (N); rows of the other pairs are left as they were (no
-            reader looks at them).
-        pair_w: (capacity, 4) written for the active pairs: N_I(ξ, η) of each pair.
-        pair_e: (capacity,) written for the active pairs: ½ k g² of each pair (J).
-        pair_sd: (capacity, 2) written for the active pairs: the normal force of the
-            spring, −k g, and of the dashpot, −c v_n, on the node (N; the rest of
-            pair_f is friction): what the energy books split the pair's work by
-            (kernels.contact_energy).
-        pair_pw: (capacity, 3) written for the active pairs: the powers of the spring,
-            the dashpot and friction at v (W; kernels.contact_energy, where the same are
-            computed at other velocities).
+        candidates: kernels.bundles.Candidates (contact_broad.query_candidates).
+        pairs: kernels.bundles.PairTables, (capacity, …) each:
+            geo: (capacity, N_GEO), on: (capacity,) int8: scratch / written.
+            force: (capacity, 3) written for the active pairs (on ≠ 0): force on the
+                node of each pair (N); rows of the other pairs are left as they were
+                (no reader looks at them).
+            weights: (capacity, 4) written for the active pairs: N_I(ξ, η) of each pair.
+            energy: (capacity,) written for the active pairs: ½ k g² of each pair (J).
+            spring_damper: (capacity, 2) written for the active pairs: the normal force
+                of the spring, −k g, and of the dashpot, −c v_n, on the node (N; the rest
+                of the force is friction): what the energy books split the pair's work
+                by (kernels.contact_energy).
+            power: (capacity, 3) written for the active pairs: the powers of the spring,
+                the dashpot and friction at v (W; kernels.contact_energy, where the same
+                are computed at other velocities).
         node_f: (n_nodes, 3) written: Σ of each node's own pair forces (N).
     """
+    # the bundles' members as locals, one per statement, before the parallel loop
+    quads = surfaces.quads
+    ply = surfaces.ply
+    node_mass = surfaces.node_mass
+    h_node = surfaces.h_node
+    h_seg = surfaces.h_seg
+    margin = surfaces.margin
+    beta = law.beta
+    zeta = law.zeta
+    mu = law.mu
+    approach = law.approach
+    pair_ptr = candidates.ptr
+    pair_seg = candidates.seg
+    geo = pairs.geo
+    pair_on = pairs.on
+    pair_f = pairs.force
+    pair_w = pairs.weights
+    pair_e = pairs.energy
+    pair_sd = pairs.spring_damper
+    pair_pw = pairs.power
     n_nodes = x.shape[0]
     inv_dt2 = 1.0 / (dt * dt)
     for p in prange(n_nodes):
@@ -408,8 +429,7 @@ def penalty_forces(
 
 
 @loop_kernel
-def initial_overlap(x, quads, ply, h_node, h_seg, margin, seg, seg_on, pair_ptr, pair_seg,
-                    geo, keep, overlap):
+def initial_overlap(x, surfaces, seg, seg_on, candidates, pairs, overlap):
     """Initial-overlap allowance o_p = max(0, max over kept pairs of h_p + h_s − d).
 
     With it the gap g = d − (h_p + h_s − o_p) of every kept pair is ≥ 0 in the
@@ -418,13 +438,24 @@ def initial_overlap(x, quads, ply, h_node, h_seg, margin, seg, seg_on, pair_ptr,
     run (the plies then contact at their nested distance again after separating).
 
     Args:
-        x: (n_nodes, 3) initial positions; margin: the search margin (m);
+        x: (n_nodes, 3) initial positions; surfaces: kernels.bundles.ContactSurfaces.
         seg: the segments' table at x (:func:`segment_geometry`); seg_on: the
             segments taking part.
-        pair_ptr, pair_seg: candidates at x.
-        geo, keep: scratch as in ``penalty_forces``.
+        candidates: kernels.bundles.Candidates at x.
+        pairs: kernels.bundles.PairTables: ``geo`` and ``on`` (the pairs kept) are
+            scratch as in ``penalty_forces``.
         overlap: (n_nodes,) written (m).
     """
+    # the bundles' members as locals, one per statement, before the parallel loop
+    quads = surfaces.quads
+    ply = surfaces.ply
+    h_node = surfaces.h_node
+    h_seg = surfaces.h_seg
+    margin = surfaces.margin
+    pair_ptr = candidates.ptr
+    pair_seg = candidates.seg
+    geo = pairs.geo
+    keep = pairs.on
     for p in prange(x.shape[0]):
         o = 0.0
         k0, k1 = pair_ptr[p], pair_ptr[p + 1]
@@ -438,17 +469,15 @@ def initial_overlap(x, quads, ply, h_node, h_seg, margin, seg, seg_on, pair_ptr,
 
 
 @loop_kernel
-def assemble_contact_forces(
-    quads, pair_ptr, pair_seg, pair_on, pair_f, pair_w, pair_e, node_f,
-    seg_ptr, seg_entry, cursor, out, accumulate, active,
-):
+def assemble_contact_forces(quads, candidates, pairs, node_f, seg_ptr, seg_entry, cursor,
+                            out, accumulate, active):
     """Nodal contact forces: out[n] (=, or += with ``accumulate``) node_f[n] − Σ N_I f_k
     over the pairs k whose segment has n as its corner I; the segment side is gathered
     through a CSR built by a serial counting sort in pair order (no scatter-add).
 
     Args:
-        quads, pair_ptr, pair_seg, pair_on, pair_f, pair_w, pair_e, node_f: as written
-            by ``penalty_forces``.
+        quads, candidates, pairs (kernels.bundles.PairTables), node_f: as written by
+            ``penalty_forces``.
         seg_ptr: (n_nodes + 1,) int64, seg_entry: (4 capacity,) int64, cursor:
             (n_nodes,) int64: scratch.
         out: (n_nodes, ≥ 3) columns 0–2 written (or added to).
@@ -460,6 +489,13 @@ def assemble_contact_forces(
     Returns:
         (energy, n_active): Σ ½ k g² (J), summed in pair order, and the active pairs.
     """
+    # the bundles' members as locals, one per statement, before the parallel loop
+    pair_ptr = candidates.ptr
+    pair_seg = candidates.seg
+    pair_on = pairs.on
+    pair_f = pairs.force
+    pair_w = pairs.weights
+    pair_e = pairs.energy
     n_nodes = pair_ptr.shape[0] - 1
     for n in range(n_nodes + 1):
         seg_ptr[n] = 0

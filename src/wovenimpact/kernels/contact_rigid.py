@@ -83,10 +83,7 @@ def node_gap(x, i, offset, tip, axis, prof_z, prof_r, reach, length):
 
 
 @loop_kernel
-def rigid_contact_forces(
-    x, v, node_active, node_mass, offset, beta, zeta, mu, dt, body_mass, tip, axis, body_v,
-    body_w, body_c, prof_z, prof_r, reach, force, energy, parts, contact_list,
-):
+def rigid_contact_forces(nodes, body, dt, out):
     """Penalty, damping and friction forces on the nodes from a rigid body of revolution.
 
     For a node with gap g = h − d > 0 (h its offset, d its signed distance to the body),
@@ -107,30 +104,52 @@ def rigid_contact_forces(
     gaps (parallel), the contact mass m_c (a serial sum, deterministic), the forces.
 
     Args:
-        x, v: (n, 3) node positions x^n and velocities v^{n−1/2}.
-        node_active: (n,) 0 for nodes that take no contact (eroded).
-        node_mass: (n,) lumped masses (kg); offset: (n,) contact offsets h (m).
-        beta, zeta, mu: penalty scale β, damping ζ, friction coefficient μ.
+        nodes: the nodes (kernels.bundles.ContactNodes): positions x^n, velocities
+            v^{n−1/2}, ``active`` (0 for nodes that take no contact, eroded), lumped
+            masses (kg) and contact offsets h (m).
+        body: the body (kernels.bundles.BodyContact): tip position and unit axis (tip →
+            tail), velocity V, global spin ω and centre of mass c, meridian profile
+            polyline, reach (bounding radius about the tip plus the largest offset, m:
+            nodes farther are skipped), its mass in the model M (kg; its share in a
+            symmetry model) and its law: penalty scale β, damping ζ, friction μ.
         dt: the step the forces are for (s).
-        body_mass: the body's mass in the model M (kg; its share in a symmetry model).
-        tip, axis: (3,) nose-tip position and unit axis (tip → tail).
-        body_v, body_w, body_c: (3,) the body's velocity, global spin and centre of mass.
-        prof_z, prof_r: meridian profile polyline.
-        reach: bounding radius of the body about its tip plus the largest offset (m),
-            nodes farther are skipped.
-        force: (n, 3) written: contact force on each node (N).
-        energy: (n,) written: penalty energy ½ k g² of each node (J).
-        parts: (n, 11) written for the nodes in contact: the normal forces of the
-            spring k g and of the dashpot −c v_n (N), the normal n, the force f, and the
-            powers of the spring, the dashpot and friction (W) with the node's velocity
-            relative to the body's translation, v − V (what the energy books split the
-            pair's work by, kernels.contact_energy; the friction power 0 if μ = 0).
-        contact_list: (n,) int64, its first ``count`` entries written: the nodes in
-            contact, in node order.
+        out: written (kernels.bundles.BodyContactOut):
+            force: (n, 3) contact force on each node (N).
+            energy: (n,) penalty energy ½ k g² of each node (J).
+            parts: (n, 11) written for the nodes in contact: the normal forces of the
+                spring k g and of the dashpot −c v_n (N), the normal n, the force f, and
+                the powers of the spring, the dashpot and friction (W) with the node's
+                velocity relative to the body's translation, v − V (what the energy
+                books split the pair's work by, kernels.contact_energy; the friction
+                power 0 if μ = 0).
+            contact_list: (n,) int64, its first ``count`` entries written: the nodes in
+                contact, in node order.
 
     Returns:
         count: the nodes in contact.
     """
+    # the bundles' members as locals, one per statement, before the parallel loops
+    x = nodes.x
+    v = nodes.v
+    node_active = nodes.active
+    node_mass = nodes.mass
+    offset = nodes.offset
+    tip = body.tip
+    axis = body.axis
+    body_v = body.velocity
+    body_w = body.spin
+    body_c = body.centre
+    prof_z = body.prof_z
+    prof_r = body.prof_r
+    reach = body.reach
+    body_mass = body.mass
+    beta = body.beta
+    zeta = body.zeta
+    mu = body.mu
+    force = out.force
+    energy = out.energy
+    parts = out.parts
+    contact_list = out.contact_list
     n = x.shape[0]
     length = prof_z[prof_z.shape[0] - 1]
     # pass 1: gaps (in energy[i]) and normals (in force[i])

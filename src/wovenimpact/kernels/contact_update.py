@@ -181,12 +181,23 @@ def bounding_box(seg_mask, seg_box, out):
 
 
 @loop_kernel
-def mark_requery(x_search, h_node, sigma, node_on, far, edge, seg_plane, bounds, bucket_ptr,
-                 entry_seg, entry_cell, entry_box, req_pos, req_list):
+def mark_requery(surfaces, search, node_on, far, bounds, bins, req_pos, req_list):
     """Step 3: R = F ∪ {nodes on whose box x_search,p ± (h_p + σ_p) meets a segment of
     the bins of S_F} (``bounds``: the box around those segments, a first test).
     req_pos[p] = position of p in req_list (−1 outside R); req_list holds R in
-    increasing node order. Returns |R|."""
+    increasing node order. Returns |R|. ``surfaces``: kernels.bundles.ContactSurfaces
+    (h_p); ``search``: kernels.bundles.ContactSearch of the last full search (x_search,
+    σ); ``bins``: kernels.bundles.SegmentBinTables of S_F."""
+    # the bundles' members as locals, one per statement, before the parallel loop
+    x_search = search.x
+    sigma = search.sigma
+    seg_plane = search.seg_plane
+    edge = search.edge
+    h_node = surfaces.h_node
+    bucket_ptr = bins.bucket_ptr
+    entry_seg = bins.entry_seg
+    entry_cell = bins.entry_cell
+    entry_box = bins.entry_box
     n = x_search.shape[0]
     for p in prange(n):
         flag = -1
@@ -214,6 +225,9 @@ def mark_requery(x_search, h_node, sigma, node_on, far, edge, seg_plane, bounds,
     return count
 
 
+# keeps its long signature: a stage called in the loop of ``requery_candidates``, its arguments
+# that loop's locals (a bundle written through in a parallel loop's body can lose its writes:
+# kernels/bundles.py)
 @kernel
 def scan_twice(p, x, quads, ply, node_ply, h_node, sigma, self_contact, node_ptr, node_elem,
                seg_plane, edge, main_bins, skip, side_bins, no_skip, out, start, room):
@@ -229,14 +243,29 @@ def scan_twice(p, x, quads, ply, node_ply, h_node, sigma, self_contact, node_ptr
 
 
 @loop_kernel
-def requery_candidates(req_list, n_req, x_search, quads, ply, node_ply, h_node, sigma,
-                       self_contact, node_ptr, node_elem, seg_plane, edge, main_bins, skip,
-                       side_bins, no_skip, slots, req_ptr, req_seg):
-    """Step 4: the candidates of the nodes req_list[:n_req] at x_search, node-major in
-    req_ptr/req_seg (each list in increasing segment order). ``main_bins`` and
-    ``side_bins`` are (bucket_ptr, entry_seg, entry_cell, entry_box, entry_ply) tuples.
-    Returns the total; when it exceeds req_seg's size nothing is written but req_ptr
-    (the caller grows req_seg and calls again)."""
+def requery_candidates(req_list, n_req, surfaces, search, main_bins, skip, side_bins, no_skip,
+                       slots, out):
+    """Step 4: the candidates of the nodes req_list[:n_req] at the search's positions,
+    node-major in ``out`` (kernels.bundles.Candidates, req_ptr/req_seg; each list in
+    increasing segment order). ``surfaces``: kernels.bundles.ContactSurfaces;
+    ``search``: kernels.bundles.ContactSearch of the last full search; ``main_bins`` and
+    ``side_bins``: kernels.bundles.SegmentBinTables. Returns the total; when it exceeds
+    req_seg's size nothing is written but req_ptr (the caller grows req_seg and calls
+    again)."""
+    # the bundles' members as locals, one per statement, before the parallel loops
+    x_search = search.x
+    sigma = search.sigma
+    seg_plane = search.seg_plane
+    edge = search.edge
+    quads = surfaces.quads
+    ply = surfaces.ply
+    node_ply = surfaces.node_ply
+    h_node = surfaces.h_node
+    self_contact = surfaces.self_contact
+    node_ptr = surfaces.node_ptr
+    node_elem = surfaces.node_elem
+    req_ptr = out.ptr
+    req_seg = out.seg
     room = slots.shape[1]
     flat = slots.reshape(-1)
     for i in prange(n_req):

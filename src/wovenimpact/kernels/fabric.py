@@ -217,6 +217,9 @@ def tension_predictor(tension, k, ell_truss0, ell, h_prev):
     return math.sqrt(q) if q > 0.0 else h_prev
 
 
+# keeps its long signature: a stage called in the loop of ``intact_crimp_heights``, its arguments
+# that loop's locals (a bundle written through in a parallel loop's body can lose its writes:
+# kernels/bundles.py)
 @kernel
 def solve_crimp_heights(k_a, ell_a, ell0_a, h0_a, lt0_a, k_b, ell_b, ell0_b, h0_b, lt0_b, a, b, h_a_prev):
     """Crimp heights of two intact yarns in contact (eq. 6.21–6.25; theory §1.3).
@@ -645,6 +648,9 @@ def sliver_erodes(p, m, s_in, i, d_w, d_f, lam_w, lam_f):
     ) or (intact > 0.0 and lam_w * lam_f < intact)
 
 
+# keeps its long signature: a stage inlined into ``fabric_point``, its arguments that loop's
+# locals (a bundle written through in a parallel loop's body can lose its writes:
+# kernels/bundles.py)
 @inline_kernel
 def yarn_resultant(p, m, use_table, lam_w, lam_f, sin_t, d_w, d_f, t_w, t_f, l_w, l_f,
                    gw_cross, gf_cross):
@@ -709,6 +715,9 @@ def table_virial(gw, gf, lam_w, lam_f, sin_t, ell_w, ell_f, ea_w, ea_f, lt0_w, l
     return c_w, c_f, yarn_w, yarn_f, den_w, den_f
 
 
+# keeps its long signature: a stage inlined into ``crossover_points`` and ``yarn_resultant``, its
+# arguments that loop's locals (a bundle written through in a parallel loop's body can lose its
+# writes: kernels/bundles.py)
 @inline_kernel
 def family_stiffness(scale, yarn_w, yarn_f, t_w, t_f, den_w, den_f, l_w, l_f, lt0_w, lt0_f,
                      lam_w, lam_f, sin_t):
@@ -723,6 +732,9 @@ def family_stiffness(scale, yarn_w, yarn_f, t_w, t_f, den_w, den_f, l_w, l_f, lt
     return stiff, k_w, k_f
 
 
+# keeps its long signature: a stage inlined into ``crossover_points`` and ``fabric_point``, its
+# arguments that loop's locals (a bundle written through in a parallel loop's body can lose its
+# writes: kernels/bundles.py)
 @inline_kernel
 def shear_resultant(n_xx, n_yy, n_xy, thick, tau, lam_w, lam_f, ewx, ewy, efx, efy, cos_t,
                     sin_t):
@@ -777,6 +789,10 @@ def stored_energy(p, m, use_table, w_cross, e_shear, d_w, d_f, ext_w, ext_f, h_w
     return (u_yarn + compaction_energy(delta, a, b)) / (4.0 * ell0_w * ell0_f) + e_shear
 
 
+# keeps its long signature: a stage called in the loop of ``exact_points`` and
+# ``fabric_update_for_points`` and ``fabric_update_point`` and ``point_response``, its arguments
+# that loop's locals (a bundle written through in a parallel loop's body can lose its writes:
+# kernels/bundles.py)
 @kernel
 def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, i):
     """Update crossover material point i from F_old to F_new (the module's steps 1–5).

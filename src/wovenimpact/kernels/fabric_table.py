@@ -115,6 +115,9 @@ def hermite_corner(p, m, k, ax, bx, dax, dbx, ay, by, day, dby):
                          ax, bx, dax, dbx, ay, by, day, dby)
 
 
+# keeps its long signature: a stage inlined into ``cell_corner`` and ``hermite_corner``, its
+# arguments that loop's locals (a bundle written through in a parallel loop's body can lose its
+# writes: kernels/bundles.py)
 @inline_kernel
 def hermite_terms(f, fx, fy, fxy, h0, h1, h2, h3, k0, k1, k2, k3, ax, bx, dax, dbx, ay, by,
                   day, dby):

@@ -97,6 +97,9 @@ def force_pair_power(f_old, f_new, v, dt, node_work):
     return 0.5 * s
 
 
+# keeps its long signature: a stage inlined into ``gather_and_update``, its arguments that loop's
+# locals (a bundle written through in a parallel loop's body can lose its writes:
+# kernels/bundles.py)
 @inline_kernel
 def update_node(
     n, mass, inertia, bc_code, bc_velocity, body_accel, keep_free, f_con, amplitude, dt_old,

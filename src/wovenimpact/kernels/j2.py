@@ -314,6 +314,9 @@ def clear_failed_point(s_out, i):
 
 
 # --- one material point ------------------------------------------------------------
+# keeps its long signature: a stage called in the loop of ``j2_update_for_points`` and
+# ``point_response``, its arguments that loop's locals (a bundle written through in a parallel
+# loop's body can lose its writes: kernels/bundles.py)
 @kernel
 def j2_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, dt, thick, s_in, s_out, i,
              amp=1.0):
@@ -487,6 +490,9 @@ def j2_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, dt, thick, s_in, 
     return STATUS_OK, stiff * max(1.0, jac), n_xx, n_yy, n_xy
 
 
+# keeps its long signature: a stage called in the loop of ``section_response``, its arguments that
+# loop's locals (a bundle written through in a parallel loop's body can lose its writes:
+# kernels/bundles.py)
 @kernel
 def fold_amplification(x_b, ko11, ko12, ko21, ko22, kn11, kn12, kn21, kn22,
                        fo11, fo12, fo21, fo22, f11, f12, f21, f22):

@@ -236,6 +236,9 @@ def through_thickness_f(z, kx, ky, kxy2, f11, f12, f21, f22):
     )
 
 
+# keeps its long signature: a stage inlined into ``section_response``, its arguments that loop's
+# locals (a bundle written through in a parallel loop's body can lose its writes:
+# kernels/bundles.py)
 @inline_kernel
 def point_response(kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, dt, thick,
                    rows_in, rows_out, row, amp=1.0):
@@ -278,6 +281,9 @@ def point_response(kind, mat_params, m, o11, o12, o21, o22, g11, g12, g21, g22, 
     return 0, True, c, energy, a, b, c12, c, 0.0, 0.0
 
 
+# keeps its long signature: a stage inlined into ``full_membrane`` and ``shell_force``, its
+# arguments that loop's locals (a bundle written through in a parallel loop's body can lose its
+# writes: kernels/bundles.py)
 @inline_kernel
 def section_response(
     n_pts, thick, kind, mat_params, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22,
@@ -365,6 +371,8 @@ def sync_yarn_damage(rows_out, row0, n_pts):
                 rows_out[row0 + np.uint64(g * n_pts + k), FL.S_DAMAGE + fam] = d
 
 
+# keeps its long signature: a stage inlined into ``shell_force``, its arguments that loop's locals
+# (a bundle written through in a parallel loop's body can lose its writes: kernels/bundles.py)
 @inline_kernel
 def full_membrane(
     e, lx, ly, gauss_grad, gauss_weight, a0, n_pts, thick, kind, mat_params, m, el_in, el_out,
@@ -554,6 +562,8 @@ def centre_membrane_forces(a0, n11, n22, n12, f11, f12, f21, f22, g1, g2):
     return mf_x, mf_y
 
 
+# keeps its long signature: a stage inlined into ``shell_force``, its arguments that loop's locals
+# (a bundle written through in a parallel loop's body can lose its writes: kernels/bundles.py)
 @inline_kernel
 def bending_and_shear(e, el_in, el_out, area, integrated, c_memb, thick, e_b, nu_b, kgt,
                       mi_xx, mi_yy, mi_xy, dkx, dky, dkxy2, dgxz, dgyz):
@@ -593,6 +603,8 @@ def bending_and_shear(e, el_in, el_out, area, integrated, c_memb, thick, e_b, nu
     return d_b, mxx, myy, mxy, qx, qy, w_bend
 
 
+# keeps its long signature: a stage inlined into ``shell_force``, its arguments that loop's locals
+# (a bundle written through in a parallel loop's body can lose its writes: kernels/bundles.py)
 @inline_kernel
 def hourglass_resultants(e, el_in, el_out, k_m, k_w, k_t, gam_mid, vx, vy, vz, tx, ty, dt):
     """The five hourglass resultants of element e (in-plane x, y; w; θ_x, θ_y), each
@@ -616,6 +628,8 @@ def hourglass_resultants(e, el_in, el_out, k_m, k_w, k_t, gam_mid, vx, vy, vz, t
     return hg0, hg1, hg2, hg3, hg4
 
 
+# keeps its long signature: a stage inlined into ``shell_force``, its arguments that loop's locals
+# (a bundle written through in a parallel loop's body can lose its writes: kernels/bundles.py)
 @inline_kernel
 def corner_forces(e, blocks, frame, mf_x, mf_y, fzs, gam, hg0, hg1, hg2, hg3, hg4,
                   mxx, myy, mxy, qx, qy):
@@ -640,6 +654,9 @@ def corner_forces(e, blocks, frame, mf_x, mf_y, fzs, gam, hg0, hg1, hg2, hg3, hg
     return fsum
 
 
+# keeps its long signature: a stage inlined into ``corner_forces`` and ``element_tail``, its
+# arguments that loop's locals (a bundle written through in a parallel loop's body can lose its
+# writes: kernels/bundles.py)
 @inline_kernel
 def corner_global(frame, area, b1i, b2i, mfx, mfy, gam, fzs, hg0, hg1, hg2, hg3, hg4, mxx, myy,
                   mxy, qx, qy):

@@ -393,6 +393,9 @@ def crossover_points(tid, kin, coef, geo, res, mc):
         res[tid, atq(R_E_SHEAR, q)] = e_shear
 
 
+# keeps its long signature: a stage inlined into ``internal_force_blocks``, its arguments that
+# loop's locals (a bundle written through in a parallel loop's body can lose its writes:
+# kernels/bundles.py)
 @block_kernel
 def exact_points(p, m, tid, b, elems, mat_row, el_in, rows_in, rows_out, kin, exact, flag, res):
     """Stage 4′ (scalar): the points marked in exact (a yarn damaged, outside the table or
@@ -477,6 +480,9 @@ def membrane_point(tid, bu, lu, g, gg, gw, res, lx, ly, out_el):
             fx, fy)
 
 
+# keeps its long signature: a stage inlined into ``elastic_element_lanes`` and ``element_lanes``,
+# its arguments that loop's locals (a bundle written through in a parallel loop's body can lose
+# its writes: kernels/bundles.py)
 @block_kernel
 def element_tail(tid, bu, lu, old, out_el, out_blk, inert, dt, px, py, pz, vx_, vy_, vz_,
                  frame, mid, rates, g1, g2, mf_x, mf_y, c_memb, cs_max, kw_max, kf_max,
@@ -563,6 +569,9 @@ def element_tail(tid, bu, lu, old, out_el, out_blk, inert, dt, px, py, pz, vx_, 
     return 1.0 if fsum + dt_e - (fsum + dt_e) == 0.0 else 0.0
 
 
+# keeps its long signature: a stage inlined into ``internal_force_blocks``, its arguments that
+# loop's locals (a bundle written through in a parallel loop's body can lose its writes:
+# kernels/bundles.py)
 @block_kernel
 def element_lanes(tid, bu, cn, old, res, flag, gg, gw, rg, a0s, inert, out_el, out_blk, dt,
                   thick, mu, e_b, nu_b, kgt, r_hg, step_yarn):
@@ -668,6 +677,9 @@ def elastic_membrane_lanes(tid, bu, cn, old, rg, a0s, dt, res, flag, modulus, po
         flag[tid, lu] = flag[tid, lu] + (1.0 if bad else 0.0)
 
 
+# keeps its long signature: a stage inlined into ``internal_force_blocks``, its arguments that
+# loop's locals (a bundle written through in a parallel loop's body can lose its writes:
+# kernels/bundles.py)
 @block_kernel
 def elastic_element_lanes(tid, bu, cn, old, res, flag, rg, inert, out_el, out_blk, dt, thick,
                           mu, e_b, nu_b, kgt, r_hg, step_yarn):

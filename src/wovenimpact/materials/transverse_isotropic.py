@@ -24,6 +24,9 @@ import numpy as np
 from wovenimpact.errors import InputError, MaterialPointError
 from wovenimpact.kernels import solid_layout as L
 
+# the row of the parameter table a point update reads: a table of one material's row
+ONLY_ROW = 0
+
 
 @dataclass(frozen=True)
 class TransverseIsotropicParameters:
@@ -188,7 +191,8 @@ def update_points(params: TransverseIsotropicParameters, frames, f, state) -> np
     state_in = np.ascontiguousarray(np.asarray(state, dtype=np.float64).reshape(n, -1))
     state_out = state_in.copy()
     status = np.zeros(n, dtype=np.int32)
-    ti_update_for_points(params.to_array()[None, :], 0, frames, f, state_in, state_out, status)
+    ti_update_for_points(params.to_array()[None, :], ONLY_ROW, frames, f, state_in, state_out,
+                         status)
     bad = np.flatnonzero(status != L.POINT_OK)
     if bad.size:
         i = int(bad[0])

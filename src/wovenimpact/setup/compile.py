@@ -21,6 +21,7 @@ import numpy as np
 from wovenimpact.errors import InputError
 from wovenimpact.impactor import Impactor
 from wovenimpact.kernels import rigid_body as RB
+from wovenimpact.kernels.bundles import BodyContact, BodyContactOut, ContactNodes
 from wovenimpact.kernels.contact_rigid import rigid_contact_forces
 from wovenimpact.model.abaqus import read_inp
 from wovenimpact.model.casing import blade_mesh, casing_mesh, circumferential_directions, join
@@ -225,11 +226,21 @@ def check_quarter_sideways(im, geometry: Impactor) -> None:
             "position = [0, −length/2, z]")
 
 
+# the clearance probe of the impactors: a body at rest of unit mass, k = β m / Δt² = 1 N/m
+# per node (unit node masses, Δt = 1 s), no dashpot, no friction
+PROBE_LAW = {"mass": 1.0, "beta": 1.0, "zeta": 0.0, "mu": 0.0}
+PROBE_DT = 1.0
+
+
 def check_impactor_clearance(model: Model) -> None:
     """Every node must start outside each impactor by at least its contact offset."""
     n = model.n_nodes
-    force = np.zeros((n, 3))
-    energy = np.zeros(n)
+    # every node active, at rest, of unit mass: with PROBE_LAW its energy is ½ g²
+    nodes = ContactNodes(x=model.x0, v=np.zeros((n, 3)), active=np.ones(n, np.int8),
+                         mass=np.ones(n), offset=model.node_offset)
+    out = BodyContactOut(force=np.zeros((n, 3)), energy=np.zeros(n), parts=np.zeros((n, 11)),
+                         contact_list=np.zeros(n, dtype=np.int64))
+    energy = out.energy
     zero = np.zeros(3)
     for b in range(model.body_params.shape[0]):
         p = model.body_params[b]
@@ -237,12 +248,12 @@ def check_impactor_clearance(model: Model) -> None:
         axis = st[RB.B_R:RB.B_R + 9].reshape(3, 3)[:, 0]
         tip = st[RB.B_X:RB.B_X + 3] - p[RB.BP_TIP] * axis
         prof = model.body_profiles[b, : int(p[RB.BP_NPTS])]
-        # k = 1 N/m per node: energy ½ g², no dashpot
-        rigid_contact_forces(model.x0, np.zeros((n, 3)), np.ones(n, np.int8), np.ones(n),
-                             model.node_offset, 1.0, 0.0, 0.0, 1.0, 1.0, tip, axis, zero, zero, zero,
-                             np.ascontiguousarray(prof[:, 0]), np.ascontiguousarray(prof[:, 1]),
-                             p[RB.BP_REACH] + float(model.node_offset.max()), force, energy,
-                             np.zeros((n, 11)), np.zeros(n, dtype=np.int64))
+        body = BodyContact(tip=tip, axis=axis, velocity=zero, spin=zero, centre=zero,
+                           prof_z=np.ascontiguousarray(prof[:, 0]),
+                           prof_r=np.ascontiguousarray(prof[:, 1]),
+                           reach=p[RB.BP_REACH] + float(model.node_offset.max()),
+                           **PROBE_LAW)
+        rigid_contact_forces(nodes, body, PROBE_DT, out)
         bad = np.flatnonzero(energy > 0.0)
         if bad.size:
             worst = int(bad[np.argmax(energy[bad])])

@@ -16,6 +16,7 @@ import numpy as np
 
 from wovenimpact.interfaces import n_parts, part_arrays
 from wovenimpact.kernels import rigid_body as RB
+from wovenimpact.kernels.bundles import BodyContact, BodyContactOut, ContactNodes, EnergyBooks
 from wovenimpact.kernels.contact_energy import book_body_pairs
 from wovenimpact.kernels.contact_rigid import add_body_forces, rigid_contact_forces
 from wovenimpact.kernels.gather import nodes_with_live_elements, node_sum
@@ -112,15 +113,17 @@ def contact_forces(model, state, cb: ContactBuffers, dt: float, elem_alive,
         rot = row[RB.B_R:RB.B_R + 9].reshape(3, 3)
         spin = rot @ row[RB.B_W:RB.B_W + 3]
         prof = model.body_profiles[b, : int(p[RB.BP_NPTS])]
-        cb.body_count[b] = rigid_contact_forces(
-            state.x, state.v, active, model.node_mass, model.node_offset, p[RB.BP_BETA],
-            p[RB.BP_DAMPING], p[RB.BP_FRICTION], dt, p[RB.BP_MASS], tip, axis,
-            np.ascontiguousarray(row[RB.B_V:RB.B_V + 3]), spin,
-            np.ascontiguousarray(row[RB.B_X:RB.B_X + 3]),
-            np.ascontiguousarray(prof[:, 0]), np.ascontiguousarray(prof[:, 1]),
-            p[RB.BP_REACH] + float(model.node_offset.max()), cb.f_body, cb.e_body,
-            cb.body_parts[b], cb.body_list[b],
-        )
+        nodes = ContactNodes(x=state.x, v=state.v, active=active, mass=model.node_mass,
+                             offset=model.node_offset)
+        body = BodyContact(
+            tip=tip, axis=axis, velocity=np.ascontiguousarray(row[RB.B_V:RB.B_V + 3]),
+            spin=spin, centre=np.ascontiguousarray(row[RB.B_X:RB.B_X + 3]),
+            prof_z=np.ascontiguousarray(prof[:, 0]), prof_r=np.ascontiguousarray(prof[:, 1]),
+            reach=p[RB.BP_REACH] + float(model.node_offset.max()), mass=p[RB.BP_MASS],
+            beta=p[RB.BP_BETA], zeta=p[RB.BP_DAMPING], mu=p[RB.BP_FRICTION])
+        out = BodyContactOut(force=cb.f_body, energy=cb.e_body, parts=cb.body_parts[b],
+                             contact_list=cb.body_list[b])
+        cb.body_count[b] = rigid_contact_forces(nodes, body, dt, out)
         cb.penalty_energy += node_sum(cb.e_body)
         fx, fy, fz, tx, ty, tz = add_body_forces(state.x, row[RB.B_X:RB.B_X + 3], cb.f_body,
                                                  cb.f_con)
@@ -154,6 +157,8 @@ def book_contact_work(model, state, cb: ContactBuffers, w_before: float, books_b
     if cb.shells is not None:
         cb.shells.book(state.v, w_before, books_before, w_after, books_after, cb.node_part,
                        cb.elem_part)
+    books = EnergyBooks(w_before=float(w_before), before=books_before, w_after=float(w_after),
+                        after=books_after)
     for b, count in enumerate(cb.body_count):
         if count == 0:
             continue
@@ -161,8 +166,7 @@ def book_contact_work(model, state, cb: ContactBuffers, w_before: float, books_b
         book_body_pairs(state.v, np.ascontiguousarray(row[RB.B_V:RB.B_V + 3]),
                         cb.body_parts[b], cb.body_list[b], count,
                         model.body_params[b, RB.BP_FRICTION] > 0.0, cb.node_part,
-                        int(cb.body_part[b]), float(w_before), books_before, float(w_after),
-                        books_after)
+                        int(cb.body_part[b]), books)
 
 
 def advance_bodies(model, state, resultants, dt_old: float, dt_new: float) -> tuple[float, float]:

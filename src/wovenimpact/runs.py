@@ -62,7 +62,11 @@ from wovenimpact.results.containment import (
     decided_since,
     fragment_row,
     is_containment,
+    layer_columns,
     layer_elements,
+    layer_materials,
+    layer_row,
+    layer_sets,
     speed_settled,
 )
 from wovenimpact.results.mesh_verdict import SUMMARY_KEY as MESH_VERDICT_KEY
@@ -71,9 +75,13 @@ from wovenimpact.results.metal_state import has_metal, plastic_work
 from wovenimpact.results.quantities import (
     impactor_row,
     intact_material_ahead,
+    outcome_decided_at,
+    ply_columns,
     ply_contact_work,
     ply_deflections,
     ply_energies,
+    ply_perforation_times,
+    ply_row,
     residual_velocity,
     symmetry_factor,
 )
@@ -128,11 +136,27 @@ def history_columns(model) -> tuple[str, ...]:
     (the kinetic energy the added mass brought, an input of the balance) and
     ``mass_scaled_elements``. A containment model's rows add the fragment's and the
     casing's columns (containment.fragment_row, containment.casing_energy_row: the
-    fragment's kinetic energy and the casing's kinetic, element and absorbed energies)."""
+    fragment's kinetic energy and the casing's kinetic, element and absorbed energies).
+
+    Last come the columns of each layer or ply (appended after all the others, so the
+    columns before them keep their places): a containment model's
+    ``casing_layer{k}_absorbed_energy_part_J`` and ``casing_layer{k}_intact_outside``
+    (containment.layer_row), a plate impact's ``ply{p}_contact_work_part_J`` and
+    ``ply{p}_intact_ahead`` (quantities.ply_row)."""
     return (HISTORY_COLUMNS + (IMPACT_COLUMNS if model.body_params.shape[0] else ())
             + (METAL_COLUMNS if has_metal(model) else ())
             + (MASS_SCALING_COLUMNS if model.mass_scaling_fraction > 0.0 else ())
-            + (CONTAINMENT_COLUMNS + CASING_ENERGY_COLUMNS if is_containment(model) else ()))
+            + (CONTAINMENT_COLUMNS + CASING_ENERGY_COLUMNS if is_containment(model) else ())
+            + per_layer_columns(model))
+
+
+def per_layer_columns(model) -> tuple[str, ...]:
+    """The layer or ply columns ending a history row (:func:`history_columns`)."""
+    if is_containment(model):
+        return layer_columns(len(layer_sets(model)))
+    if model.body_params.shape[0]:
+        return ply_columns(model)
+    return ()
 
 
 def history_row(model, state: State, normaliser: float = 0.0,
@@ -153,6 +177,9 @@ def history_row(model, state: State, normaliser: float = 0.0,
         watch = CasingWatch(model) if watch is None else watch
         impact.update(fragment_row(model, state, watch))
         impact.update(casing_energy_row(model, state, watch))
+        impact.update(layer_row(model, state, watch))
+    elif model.body_params.shape[0]:
+        impact.update(ply_row(model, state))
     if has_metal(model):
         impact["plastic_work_part_J"] = plastic_work(model, state)
     if model.mass_scaling_fraction > 0.0:
@@ -341,19 +368,10 @@ def run_spec(
     if is_containment(model):  # the outcome that ended the run early (None: end_time)
         summary["stopped_when_decided"] = decided
     summary["provenance"] = prov
-    from wovenimpact.io.plots import deflection_plot, energy_plot, fragment_plot, impactor_plot
+    write_plots(out, spec.case.name, model, state, history.arrays(), summary)
+    from wovenimpact.io.pictures import write_pictures
 
-    h = history.arrays()
-    energy_plot(h, out / "plots" / "energy.png", title=spec.case.name,
-                symmetry_factor=symmetry_factor(model))
-    if is_containment(model):  # a plate's deflection along y = 0 means nothing on a casing
-        fragment_plot(h, out / "plots" / "fragment.png", title=spec.case.name,
-                      outcome=summary.get("outcome", ""))
-    else:
-        deflection_plot(model, state, out / "plots" / "ply_deflection.png",
-                        title=spec.case.name)
-    if "impactor_velocity_m_per_s" in h:
-        impactor_plot(h, out / "plots" / "impactor.png", title=spec.case.name)
+    write_pictures(out, history.arrays())
     # numpy scalars as Python numbers: a summary key computed with numpy must not end an
     # hour's run with a TypeError after its last step (it did: numpy's bool_)
     atomic_write_text(out / "summary.json",
@@ -362,8 +380,44 @@ def run_spec(
     return summary
 
 
+def write_plots(out: Path, title: str, model, state: State, h: dict, summary: dict) -> None:
+    """The plots of a finished run in ``OUT/plots``: energies; a containment run's fragment
+    plot, a plate's deflection profile and impactor plot, each with the instants its
+    layers (plies) were first perforated and its outcome decided; the energy each layer
+    or ply absorbed over time."""
+    from wovenimpact.io.plots import (
+        deflection_plot,
+        energy_plot,
+        event_markers,
+        fragment_plot,
+        impactor_plot,
+        layer_energy_plot,
+    )
+
+    plots = out / "plots"
+    factor = symmetry_factor(model)
+    energy_plot(h, plots / "energy.png", title=title, symmetry_factor=factor)
+    if is_containment(model):  # a plate's deflection along y = 0 means nothing on a casing
+        names = [f"layer {k} ({m})" for k, m in enumerate(layer_materials(model))]
+        markers = event_markers(summary.get("layer_perforated_at_s", []),
+                                summary.get("outcome_decided_at_s"), names)
+        fragment_plot(h, plots / "fragment.png", title=title,
+                      outcome=summary.get("outcome", ""), markers=markers)
+    else:
+        deflection_plot(model, state, plots / "ply_deflection.png", title=title)
+        numbers = np.unique(model.ply)
+        names = [f"ply {p}" for p in numbers]
+        markers = event_markers(summary.get("ply_perforated_at_s", []),
+                                summary.get("outcome_decided_at_s"), names)
+    if "impactor_velocity_m_per_s" in h:
+        impactor_plot(h, plots / "impactor.png", title=title, markers=markers)
+    layer_energy_plot(h, plots / "layer_energy.png", title=title, symmetry_factor=factor,
+                      names=names, markers=markers)
+
+
 OUTPUT_PATTERNS = ("checkpoints/checkpoint_*.npz", "fields/step_*.vtu", "fields/fields.pvd",
-                   "plots/*.png", "history.csv", "summary.json", "report.html",
+                   "plots/*.png", "pictures/frame_*.png", "pictures/pictures.json",
+                   "history.csv", "summary.json", "report.html",
                    "error.txt")  # error.txt: a failed run of a sweep or design search
 
 
@@ -489,6 +543,8 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
         per_ply = ply_energies(model, state)
         impact = {
             **residual_velocity(h),
+            "ply_perforated_at_s": ply_perforation_times(h),
+            "outcome_decided_at_s": outcome_decided_at(h),
             "initial_velocity_m_per_s": float(h["impactor_velocity_m_per_s"][0]),
             "absorbed_energy_J": ke_body0 - ke1,
             "absorbed_energy_per_ply_J": per_ply,
@@ -600,7 +656,8 @@ def mass_scaling_summary(model, state: State, factor: float) -> dict:
 
 
 IMPACT_SUMMARY_KEYS = ("outcome", "perforated", "residual_velocity_m_per_s",
-                       "rebound_velocity_m_per_s", "initial_velocity_m_per_s",
+                       "rebound_velocity_m_per_s", "ply_perforated_at_s",
+                       "outcome_decided_at_s", "initial_velocity_m_per_s",
                        "absorbed_energy_J", "absorbed_energy_per_ply_J",
                        "contact_work_per_ply_J", "max_deflection_m",
                        "max_deflection_per_ply_m", "peak_contact_force_N")
@@ -610,6 +667,7 @@ CONTAINMENT_SUMMARY_KEYS = ("outcome", "contained", "fragment_exit_speed_m_per_s
                             "absorbed_energy_per_layer_J", "casing_absorbed_energy_J",
                             "held_energy_per_layer_J",
                             "absorbed_energy_per_material_J", "stopped_when_decided",
+                            "layer_perforated_at_s", "outcome_decided_at_s",
                             "blade_element_size_m")
 COMMON_SUMMARY_KEYS = (
     "summary_version", "case", "end_time_s", "steps", "elements", "nodes", "first_time_step_s",

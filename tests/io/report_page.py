@@ -149,7 +149,10 @@ def check_run_page(out: Path) -> Page:
     summary = json.loads((out / "summary.json").read_text())
     assert not page.external, page.external
     pngs = sorted(p.name for p in (out / "plots").glob("*.png"))
-    assert pngs and sorted(decoded_images(page)) == pngs
+    # the deformed structure's pictures (pictures.json lists those shown), then the plots
+    index = out / "pictures" / "pictures.json"
+    pictures = [e["file"] for e in json.loads(index.read_text())] if index.exists() else []
+    assert pngs and sorted(decoded_images(page)) == sorted(pngs + pictures)
     assert set(page.verdicts) == ANSWER_BOXES[kind(summary)] | TRUST_BOXES
     for key, v in page.verdicts.items():
         assert v["status"] == expected_status(summary, key), (key, v, summary.get(key))

@@ -216,6 +216,37 @@ def test_containment_outputs_bulge_layer_and_material_energies_and_fragment_plot
     for m in (casing, blade):
         used = np.unique(np.concatenate([c.data.ravel() for c in m.cells]))
         assert used.size == m.points.shape[0]  # no point outside the part's cells
+    check_layer_columns(out, summary)
+
+
+def check_layer_columns(out, summary):
+    """The per-layer history columns of a containment run: each layer's absorbed energy
+    sums, at every row, to the casing's absorbed energy (a conservation check within
+    round-off: the layers share no node) and ends at the summary's per-layer figure; a
+    row's intact-casing flag is 1 exactly when one of the layers' is; the layer energy
+    plot and the pictures (casing near the fragment and the blade, every alive element
+    in view drawn) are written."""
+    import json
+
+    from wovenimpact.io.history import read_csv
+    from wovenimpact.results.containment import layer_perforation_times
+
+    h = read_csv(out / "history.csv")
+    n = summary["casing_layers"]
+    energy = np.array([h[f"casing_layer{k}_absorbed_energy_part_J"] for k in range(n)])
+    total = h["casing_absorbed_energy_part_J"]
+    assert np.any(total > 0.0)
+    scale = np.maximum(np.abs(energy).sum(axis=0), 1e-300)
+    assert np.all(np.abs(energy.sum(axis=0) - total) <= 1e-12 * scale)
+    assert energy[:, -1].tolist() == summary["absorbed_energy_per_layer_J"]
+    flags = np.array([h[f"casing_layer{k}_intact_outside"] for k in range(n)])
+    assert np.array_equal(flags.max(axis=0), h["intact_casing_outside"])
+    assert summary["layer_perforated_at_s"] == layer_perforation_times(h, n)
+    assert (out / "plots" / "layer_energy.png").stat().st_size > 1000
+    index = json.loads((out / "pictures" / "pictures.json").read_text())
+    assert index and all(e["drawn"] == e["alive_in_view"] > 0 for e in index)
+    assert all(e["vtu"][0].endswith("_casing.vtu") and e["vtu"][1].endswith("_blade.vtu")
+               for e in index)
 
 
 def test_layer_energies_are_the_generated_plies_energies():

@@ -7,9 +7,10 @@ configuration ``State.x`` with
 - cell data ``membrane_resultant`` (N_xx, N_yy, N_xy; N/m, corotational frame),
   ``alive`` (1 alive, 0 eroded), ``ply``, ``element`` (the Model's element index),
   and ``tension_warp``, ``tension_fill`` (N), ``damage_warp``, ``damage_fill`` (—),
-  which are 0 for elements that are not fabric, and ``thickness_ratio`` t/t0 and
+  which are 0 for elements that are not fabric, ``thickness_ratio`` t/t0 and
   ``plastic_strain`` (the largest ε̄p of the element's points), 1 and 0 for elements
-  that are not metal (metal_state).
+  that are not metal (metal_state), and ``fabric`` (1 where the element's material is
+  a fabric, else 0).
 
 Quads are written as VTK quads; an element whose quad repeats a node (a triangle)
 is written as a VTK triangle in a second cell block, so VTK filters never see a
@@ -100,6 +101,7 @@ def element_fields(model, state: State, fabric: np.ndarray) -> dict[str, np.ndar
         out[name] = values
     out["thickness_ratio"] = thickness_ratio(model, state)
     out["plastic_strain"] = max_plastic_strain(model, state)
+    out["fabric"] = np.asarray(fabric, dtype=np.int64)
     return out
 
 

@@ -184,11 +184,14 @@ def containment_energy_figure(h: dict, title: str = "", symmetry_factor: float =
     return fig
 
 
-def impactor_plot(h: dict, path: str | Path, title: str = "") -> Path:
-    """Impactor velocity along its travel, and the contact force on it, against time."""
+def impactor_plot(h: dict, path: str | Path, title: str = "", markers=()) -> Path:
+    """Impactor velocity along its travel, and the contact force on it, against time;
+    ``markers`` (time in s, label; :func:`event_markers`): each ply's first perforation
+    and the instant the outcome was decided, as labelled vertical lines."""
     path = Path(path)
     t = h["time_s"] * 1e6
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
+    _mark((a1, a2), markers)
     a1.plot(t, h["impactor_velocity_m_per_s"])
     a1.set_ylabel("impactor velocity (m/s)")
     a1.set_title(title)
@@ -202,14 +205,45 @@ def impactor_plot(h: dict, path: str | Path, title: str = "") -> Path:
     return path
 
 
-def fragment_plot(h: dict, path: str | Path, title: str = "", outcome: str = "") -> Path:
+def event_markers(perforated, decided, names=None) -> list[tuple[float, str]]:
+    """(time in s, label) of the instants marked on the fragment and impactor plots: each
+    layer's (ply's) first perforation (``perforated``, one time or None a layer, in
+    order; ``names`` their labels) and the instant the outcome was decided (``decided``,
+    None: not decided). Layers perforated at the same instant share one marker."""
+    names = list(names) if names is not None else [f"layer {k}" for k in range(len(perforated))]
+    at: dict[float, list[str]] = {}
+    for name, t in zip(names, perforated):
+        if t is not None:
+            at.setdefault(float(t), []).append(name)
+    out = [(t, " + ".join(n) + " perforated") for t, n in at.items()]
+    if decided is not None:
+        out.append((float(decided), "outcome decided"))
+    return out
+
+
+def _mark(axes, markers) -> None:
+    """Vertical lines at the ``markers`` (time s, label), labelled on the first axes."""
+    for i, (t, label) in enumerate(markers):
+        colour = "k" if label == "outcome decided" else "C2"
+        for ax in axes:
+            ax.axvline(t * 1e6, color=colour, lw=0.9, ls="--" if colour == "k" else ":")
+        axes[0].annotate(label, (t * 1e6, 1.0), xycoords=("data", "axes fraction"),
+                         xytext=(2, -4 - 9 * (i % 4)), textcoords="offset points",
+                         fontsize=6.5, color=colour, va="top")
+
+
+def fragment_plot(h: dict, path: str | Path, title: str = "", outcome: str = "",
+                  markers=()) -> Path:
     """A containment run against time: the fragment's centre-of-mass speed and its
     radial velocity (outward positive), and the outermost casing layer's bulge (its
     largest outward radial displacement), from the history columns of
-    ``containment.fragment_row``."""
+    ``containment.fragment_row``; ``markers`` (time in s, label; :func:`event_markers`)
+    are drawn as labelled vertical lines: each layer's first perforation and the
+    instant the outcome was decided."""
     path = Path(path)
     t = h["time_s"] * 1e6
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(7, 5.5), sharex=True)
+    _mark((a1, a2), markers)
     a1.plot(t, h["fragment_speed_m_per_s"], label="speed of the centre of mass")
     a1.plot(t, h["fragment_radial_velocity_m_per_s"], label="radial velocity (outward +)")
     a1.axhline(0.0, color="k", lw=0.6)
@@ -221,6 +255,55 @@ def fragment_plot(h: dict, path: str | Path, title: str = "", outcome: str = "")
     a2.set_ylabel("outermost layer bulge (mm)")
     a2.set_xlabel("time (µs)")
     a2.grid(alpha=0.3)
+    fig.tight_layout()
+    _save(fig, path)
+    return path
+
+
+def layer_energy_columns(h: dict) -> list[str]:
+    """The per-layer (casing) or per-ply (plate) energy columns of a history, in layer
+    order: ``casing_layer{k}_absorbed_energy_part_J`` or ``ply{p}_contact_work_part_J``."""
+    import re
+
+    found = []
+    for c in h:
+        m = (re.fullmatch(r"casing_layer(\d+)_absorbed_energy_part_J", c)
+             or re.fullmatch(r"ply(\d+)_contact_work_part_J", c))
+        if m:
+            found.append((int(m.group(1)), c))
+    return [c for _, c in sorted(found)]
+
+
+def layer_energy_plot(h: dict, path: str | Path, title: str = "",
+                      symmetry_factor: float = 1.0, names=None, markers=()) -> Path | None:
+    """The energy each casing layer (or ply) absorbed against time (J, whole problem):
+    the contact work its nodes received (:func:`layer_energy_columns` × the symmetry
+    factor), one line a layer, with their sum; ``names`` label the layers (default
+    "layer k" / "ply p"), ``markers`` as on the fragment plot. None (nothing written)
+    when the history has no such column."""
+    columns = layer_energy_columns(h)
+    if not columns:
+        return None
+    path = Path(path)
+    t = h["time_s"] * 1e6
+    plate = columns[0].startswith("ply")
+    if names is None:
+        names = [c.split("_")[0].replace("casing_layer", "layer ").replace("ply", "ply ")
+                 for c in columns]
+    fig, ax = plt.subplots(figsize=(7.5, 4.4))
+    total = np.zeros(t.shape)
+    for name, c in zip(names, columns):
+        y = symmetry_factor * np.asarray(h[c], dtype=float)
+        total = total + y
+        ax.plot(t, y, label=name)
+    ax.plot(t, total, "k--", lw=1.0, label="sum over the " + ("plies" if plate else "layers"))
+    _mark((ax,), markers)
+    ax.set_xlabel("time (µs)")
+    ax.set_ylabel(("contact work per ply" if plate else "absorbed energy per layer")
+                  + ", whole problem (J)")
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, ncol=2, loc="center left")
     fig.tight_layout()
     _save(fig, path)
     return path

@@ -29,7 +29,10 @@ answer and how far to trust it come first, on one screen, before any detail.
    engineering units (mm, m/s, J, kg/m², ms, µs, %), each row with its meaning and its
    summary.json key (:mod:`wovenimpact.io.summary_keys`); ``summary_version`` and
    ``provenance`` are in the provenance section instead;
-4. every PNG of ``plots/``, inlined as base64;
+4. the deformed structure at a few instants (``pictures/``, drawn from the run's VTU
+   frames by :mod:`wovenimpact.io.pictures`), each ``<figure data-frame=K
+   data-vtu=FILES data-drawn=N data-alive=N>`` with its caption, then every PNG of
+   ``plots/``, inlined as base64;
 5. the case as run: the TOML text as written, then the ``--set`` overrides that were
    applied on top of it (a study variant: the validated case as JSON, in SI units, and
    its parameters);
@@ -83,6 +86,9 @@ td.num { text-align: right; font-variant-numeric: tabular-nums; }
 td.pass { color: #2e7d32; font-weight: bold; background: none; }
 td.fail { color: #c62828; font-weight: bold; background: none; }
 img { max-width: 100%; display: block; margin: 1em 0; }
+.pictures { display: flex; flex-wrap: wrap; gap: 0.5em; }
+.pictures figure { margin: 0; width: 34em; max-width: 100%; }
+.pictures figcaption { font-size: 0.8em; color: #555; }
 pre { background: #f5f5f5; padding: 1em; overflow-x: auto; }
 .pass-text { color: #2e7d32; } .fail-text { color: #c62828; }
 """
@@ -346,6 +352,40 @@ def _images(folder: Path) -> list[str]:
     return out or ["<p>(no plots)</p>"]
 
 
+def _pictures_html(out: Path) -> list[str]:
+    """The section of the deformed structure's pictures (``OUT/pictures``, listed in its
+    pictures.json by :func:`wovenimpact.io.pictures.write_pictures`), each inlined with a
+    caption: its time, the frame's VTU files, what is in view and how many elements were
+    drawn; nothing when the run has none."""
+    index = out / "pictures" / "pictures.json"
+    if not index.exists():
+        return []
+    entries = json.loads(index.read_text(encoding="utf-8"))
+    if not entries:
+        return []
+    body = ['<h2 id="pictures">Deformed structure</h2>',
+            "<p>The structure at a few instants (from first contact to the end), drawn from "
+            "the run's field frames (<code>fields/</code>): fabric coloured by damage, metal "
+            "by plastic strain; eroded elements are not drawn.</p>",
+            '<div class="pictures">']
+    for e in entries:
+        png = out / "pictures" / e["file"]
+        if not png.exists():
+            continue
+        data = base64.b64encode(png.read_bytes()).decode("ascii")
+        vtu = ", ".join(e.get("vtu", []))
+        eroded = int(e["elements_in_view"]) - int(e["alive_in_view"])
+        body.append(
+            f'<figure data-frame="{int(e["frame"])}" data-vtu="{escape(vtu)}" '
+            f'data-drawn="{int(e["drawn"])}" data-alive="{int(e["alive_in_view"])}">'
+            f'<img alt="{escape(e["file"])}" src="data:image/png;base64,{data}">'
+            f"<figcaption>t = {e['time_s'] * 1e6:.1f} µs ({escape(vtu)}): "
+            f"{escape(e.get('caption', ''))}; {int(e['drawn'])} elements drawn of "
+            f"{int(e['elements_in_view'])} in view ({eroded} eroded, hidden).</figcaption>"
+            "</figure>")
+    return body + ["</div>"]
+
+
 def digest(text: str) -> str:
     """SHA-256 of a text, 16 hex digits (the case digest of a report)."""
     return hashlib.sha256(text.encode("utf-8")).hexdigest()[:16]
@@ -391,6 +431,7 @@ def write_run_report(out_dir: str | Path, *, spec=None, case_text: str | None = 
             "<p>summary.json in engineering units (the file itself is in SI units); every "
             "energy is of the whole problem.</p>",
             *_summary_html(summary),
+            *_pictures_html(out),
             '<h2 id="plots">Plots</h2>', *_images(out / "plots"),
             '<h2 id="case">Case as run</h2>']
     if case_text is not None:

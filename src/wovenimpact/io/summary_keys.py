@@ -72,6 +72,10 @@ KEYS: dict[str, Key] = {
     "stopped_when_decided": Key(
         _A, "stopped when decided", meaning="the outcome that ended the run early "
         "(run.stop_when_decided); none: it ran to its end time"),
+    "outcome_decided_at_s": Key(
+        _A, "outcome decided at", *US,
+        meaning="from this time on every history row read the final outcome; none: "
+                "undecided (or, for a plate, no contact)"),
     # --- answer: plate impact
     "perforated": Key(_A, "perforated", meaning="the impactor passed every ply"),
     "residual_velocity_m_per_s": Key(
@@ -154,6 +158,10 @@ KEYS: dict[str, Key] = {
     "absorbed_energy_per_material_J": Key(_S, "absorbed energy per material", "J",
                                           meaning="the layers' absorbed energy summed by "
                                                   "material"),
+    "layer_perforated_at_s": Key(_S, "layer first perforated at", *US,
+                                 meaning="per layer, innermost first: the first time no "
+                                         "intact material of it lay outside the fragment "
+                                         "along its path; none: not perforated"),
     # --- structure: plies
     "absorbed_energy_per_ply_J": Key(_S, "energy absorbed per ply", "J",
                                      meaning="kinetic + stored energy of each ply at the end "
@@ -162,6 +170,10 @@ KEYS: dict[str, Key] = {
                                              "contact work per ply"),
     "contact_work_per_ply_J": Key(_S, "contact work per ply", "J",
                                   meaning="work the contact forces did on each ply's nodes"),
+    "ply_perforated_at_s": Key(_S, "ply first perforated at", *US,
+                               meaning="per ply: the first time none of its intact material "
+                                       "within the impactor's reach lay ahead of the nose; "
+                                       "none: not perforated"),
     "max_deflection_per_ply_m": Key(_S, "largest deflection per ply", *MM,
                                     meaning="each ply's largest node displacement at the end"),
     "eroded_elements": Key(_S, "eroded elements", meaning="elements failed and removed"),

@@ -108,6 +108,11 @@ class CasingWatch:
         self.layer_elems = np.concatenate(layer_elements(model))
         self.layer_nodes = np.unique(model.quads[self.layer_elems])
         self.layer_node_mass = model.node_mass[self.layer_nodes]
+        # each layer's nodes (layer_absorbed_energies) and each node's layer (−1: none)
+        self.nodes_of_layer = [np.unique(model.quads[e]) for e in layer_elements(model)]
+        self.node_layer = np.full(model.n_nodes, -1, dtype=np.int64)
+        for k, nodes in enumerate(self.nodes_of_layer):
+            self.node_layer[nodes] = k
         self._live = -1
         self._anchored = np.zeros(model.n_nodes, dtype=bool)
 
@@ -133,12 +138,35 @@ def fragment_row(model, state, watch: CasingWatch | None = None) -> dict:
     when not given).
     """
     w = CasingWatch(model) if watch is None else watch
+    k = _path_window(model, state, w)
+    x, cm, r_nodes, v_cm = k["x"], k["cm"], k["r_nodes"], k["v_cm"]
+    r_cm = math.hypot(cm[0], cm[1])
+    radial = (v_cm[0] * cm[0] + v_cm[1] * cm[1]) / r_cm if r_cm > 0 else 0.0
+    outside = bool(np.any(k["r_window"] > float(r_nodes.max())))
+    # is there casing at the fragment's angle and height at all? A sector's cut edges
+    # end the model: past them the rest of the ring is missing, not broken
+    size, r_casing = w.size, w.r_casing
+    x0 = w.x0[np.abs(w.x0[:, 2] - cm[2]) <= size]
+    covered = bool(np.any(_within_angle(x0, k["phi_cm"], size / r_casing)))
+    return {
+        "fragment_speed_m_per_s": float(np.linalg.norm(v_cm)),
+        "fragment_radial_velocity_m_per_s": float(radial),
+        "fragment_cm_radius_m": float(r_cm),
+        "fragment_max_radius_m": float(r_nodes.max()),
+        "fragment_min_radius_m": float(r_nodes.min()),
+        "intact_casing_outside": int(outside),
+        "fragment_beyond_casing": int(not covered),
+        "outer_layer_bulge_m": outer_layer_bulge(model, state, k["anchored"]),
+    }
+
+
+def _path_window(model, state, w: CasingWatch) -> dict:
+    """The fragment's nodes and centre of mass, and the anchored casing nodes within its
+    path window (:func:`fragment_row`): their indices ``window`` and radii ``r_window``."""
     m, mass = w.m, w.mass
     x = state.x[w.nodes]
     cm = (m[:, None] * x).sum(axis=0) / mass
     v_cm = (m[:, None] * state.v[w.nodes]).sum(axis=0) / mass
-    r_cm = math.hypot(cm[0], cm[1])
-    radial = (v_cm[0] * cm[0] + v_cm[1] * cm[1]) / r_cm if r_cm > 0 else 0.0
     r_nodes = np.hypot(x[:, 0], x[:, 1])
     phi = np.arctan2(x[:, 1], x[:, 0])
     phi_cm = math.atan2(cm[1], cm[0])
@@ -149,24 +177,73 @@ def fragment_row(model, state, watch: CasingWatch | None = None) -> dict:
     half_z = max(WINDOW * float(np.max(np.abs(x[:, 2] - cm[2]))), size)
     anchored = w.anchored(model, state)
     # the height and cosine tests first: they are cheap and leave few nodes for the angles
-    xc = state.x[anchored]
-    xc = xc[np.abs(xc[:, 2] - cm[2]) <= half_z]
+    idx = np.flatnonzero(anchored)
+    xc = state.x[idx]
+    keep = np.abs(xc[:, 2] - cm[2]) <= half_z
+    idx, xc = idx[keep], xc[keep]
     near = _within_angle(xc, phi_cm, half_angle)
-    outside = bool(np.any(np.hypot(xc[near, 0], xc[near, 1]) > float(r_nodes.max())))
-    # is there casing at the fragment's angle and height at all? A sector's cut edges
-    # end the model: past them the rest of the ring is missing, not broken
-    x0 = w.x0[np.abs(w.x0[:, 2] - cm[2]) <= size]
-    covered = bool(np.any(_within_angle(x0, phi_cm, size / r_casing)))
-    return {
-        "fragment_speed_m_per_s": float(np.linalg.norm(v_cm)),
-        "fragment_radial_velocity_m_per_s": float(radial),
-        "fragment_cm_radius_m": float(r_cm),
-        "fragment_max_radius_m": float(r_nodes.max()),
-        "fragment_min_radius_m": float(r_nodes.min()),
-        "intact_casing_outside": int(outside),
-        "fragment_beyond_casing": int(not covered),
-        "outer_layer_bulge_m": outer_layer_bulge(model, state, anchored),
-    }
+    return {"x": x, "cm": cm, "v_cm": v_cm, "r_nodes": r_nodes, "phi_cm": phi_cm,
+            "anchored": anchored, "window": idx[near],
+            "r_window": np.hypot(xc[near, 0], xc[near, 1])}
+
+
+def layer_columns(n_layers: int) -> tuple[str, ...]:
+    """The per-layer history columns of a casing of ``n_layers`` layers
+    (:func:`layer_row`), appended after :data:`CASING_ENERGY_COLUMNS`: every layer's
+    absorbed energy, then every layer's intact-outside flag, innermost layer first."""
+    return (tuple(f"casing_layer{k}_absorbed_energy_part_J" for k in range(n_layers))
+            + tuple(f"casing_layer{k}_intact_outside" for k in range(n_layers)))
+
+
+def layer_row(model, state, watch: CasingWatch | None = None) -> dict:
+    """Each casing layer's share of a history row (:func:`layer_columns`; layer 0 the
+    innermost, the inner shell of a hybrid casing):
+
+    - ``casing_layer{k}_absorbed_energy_part_J``: the contact work layer k's nodes received
+      so far (J, modelled part), :func:`layer_absorbed_energies` of the row: the summary's
+      ``absorbed_energy_per_layer_J`` at the end, and summed over the layers the row's
+      ``casing_absorbed_energy_part_J`` (the layers share no node; within round-off);
+    - ``casing_layer{k}_intact_outside``: 1 if a node of layer k joined to the casing's
+      supports through live elements lies in the fragment's path window at a larger
+      radius than the fragment's outermost node — ``intact_casing_outside`` of
+      :func:`fragment_row` asked of that layer alone (the row's flag is 1 exactly when one
+      of the layers' is). A layer is *perforated* from the first row it reads 0
+      (:func:`layer_perforation_times`).
+    """
+    w = CasingWatch(model) if watch is None else watch
+    k = _path_window(model, state, w)
+    r_max = float(k["r_nodes"].max())
+    layer = w.node_layer[k["window"]]
+    out_layers = np.unique(layer[k["r_window"] > r_max])
+    n = len(w.nodes_of_layer)
+    row = {f"casing_layer{j}_absorbed_energy_part_J": float(np.sum(state.contact_work[nodes]))
+           for j, nodes in enumerate(w.nodes_of_layer)}
+    row.update({f"casing_layer{j}_intact_outside": int(j in out_layers) for j in range(n)})
+    return row
+
+
+def layer_perforation_times(h: dict, n_layers: int) -> list[float | None]:
+    """The time each casing layer was first perforated (s, innermost first; None for a
+    layer never perforated): the first history row at which no intact material of that
+    layer lies outside the fragment along its path (``casing_layer{k}_intact_outside``
+    = 0, :func:`layer_row`) — the geometric test the outcome rule makes of the whole
+    casing (``intact_casing_outside``), asked of each layer. A history without the
+    per-layer columns (an older run) gives None for every layer."""
+    t = np.asarray(h["time_s"], dtype=float)
+    out: list[float | None] = []
+    for k in range(n_layers):
+        flags = h.get(f"casing_layer{k}_intact_outside")
+        rows = np.flatnonzero(np.asarray(flags) == 0) if flags is not None else ()
+        out.append(float(t[rows[0]]) if len(rows) else None)
+    return out
+
+
+def outcome_decided_at(h: dict, inner_radius: float,
+                       outer_radius: float = math.inf) -> float | None:
+    """The time from which every history row has read the run's final outcome
+    (:func:`decided_since`), None when it is undecided."""
+    outcome, since = decided_since(h, inner_radius, outer_radius)
+    return None if outcome == "undecided" else since
 
 
 CONTAINMENT_COLUMNS = ("fragment_speed_m_per_s", "fragment_radial_velocity_m_per_s",
@@ -427,6 +504,9 @@ def casing_summary(model, state, h: dict) -> dict:
     absorbed = layer_absorbed_energies(model, state)
     return {
         **outcome,
+        "layer_perforated_at_s": layer_perforation_times(h, len(layers)),
+        "outcome_decided_at_s": outcome_decided_at(h, casing_inner_radius(model),
+                                                   casing_outer_radius(model)),
         "fragment_exit_speed_settled": exit_speed_settled(h, outcome["outcome"]),
         "fragment_mass_kg": float(model.node_mass[nodes].sum()),
         "fragment_initial_speed_m_per_s": float(h["fragment_speed_m_per_s"][0]),

@@ -125,6 +125,16 @@ def intact_material_ahead(model, state, b: int = 0) -> dict:
         ``intact_material_ahead``: 1 if some of it is ahead of the nose (max(s + h) ≥ 0),
         else 0.
     """
+    live, s, h, near = _material_near(model, state, b)
+    if not np.any(near):
+        return {"impactor_nose_ahead_of_intact_m": math.inf, "intact_material_ahead": 0}
+    lead = float(np.max(s[near] + h[near]))
+    return {"impactor_nose_ahead_of_intact_m": -lead, "intact_material_ahead": int(lead >= 0.0)}
+
+
+def _material_near(model, state, b: int = 0):
+    """The intact nodes (:func:`intact_material_ahead`), their coordinate s along the
+    travel from the nose tip, their offset h and whether each is within the body's reach."""
     d = travel_direction(model, state, b)
     live = np.flatnonzero(attached_nodes(model, state) & (state.node_active != 0))
     h = model.node_offset[live]
@@ -137,10 +147,87 @@ def intact_material_ahead(model, state, b: int = 0) -> dict:
         s = rel @ d
         rho = np.sqrt(np.maximum(np.sum(rel * rel, axis=1) - s * s, 0.0))
         near = rho <= impactor_radius(model, b) + h
-    if not np.any(near):
-        return {"impactor_nose_ahead_of_intact_m": math.inf, "intact_material_ahead": 0}
-    lead = float(np.max(s[near] + h[near]))
-    return {"impactor_nose_ahead_of_intact_m": -lead, "intact_material_ahead": int(lead >= 0.0)}
+    return live, s, h, near
+
+
+_PLY_CACHE: dict = {}
+
+
+def plies(model) -> tuple[np.ndarray, list[np.ndarray], np.ndarray]:
+    """The model's ply numbers (``np.unique(model.ply)``), each ply's nodes and each
+    node's ply (−1 for a node of no element), computed once per model (one entry is
+    kept, the model held by a weak reference)."""
+    ref = _PLY_CACHE.get("model")
+    if ref is not None and ref() is model:
+        return _PLY_CACHE["value"]
+    numbers = np.unique(model.ply)
+    nodes = [np.unique(model.quads[model.ply == p]) for p in numbers]
+    node_ply = np.full(model.n_nodes, -1, dtype=np.int64)
+    for p, n in zip(numbers, nodes):
+        node_ply[n] = p
+    _PLY_CACHE.clear()
+    _PLY_CACHE.update(model=weakref.ref(model), value=(numbers, nodes, node_ply))
+    return numbers, nodes, node_ply
+
+
+def ply_columns(model) -> tuple[str, ...]:
+    """The per-ply history columns of a plate impact (:func:`ply_row`): every ply's
+    contact work, then every ply's intact-ahead flag, in ply order."""
+    numbers = plies(model)[0]
+    return (tuple(f"ply{p}_contact_work_part_J" for p in numbers)
+            + tuple(f"ply{p}_intact_ahead" for p in numbers))
+
+
+def ply_row(model, state, b: int = 0) -> dict:
+    """Each ply's share of a plate impact's history row (:func:`ply_columns`):
+
+    - ``ply{p}_contact_work_part_J``: the work the contact forces did on ply p's nodes so
+      far (J, modelled part): :func:`ply_contact_work` of the row (× the symmetry factor
+      at the end: the summary's ``contact_work_per_ply_J``);
+    - ``ply{p}_intact_ahead``: 1 if some of ply p's intact material within the impactor's
+      reach lies ahead of its nose — ``intact_material_ahead`` of
+      :func:`intact_material_ahead` asked of that ply alone. A ply is *perforated* from
+      the first row it reads 0 (:func:`ply_perforation_times`).
+    """
+    numbers, nodes, node_ply = plies(model)
+    row = {f"ply{p}_contact_work_part_J": float(np.sum(state.contact_work[n]))
+           for p, n in zip(numbers, nodes)}
+    live, s, h, near = _material_near(model, state, b)
+    ahead = np.unique(node_ply[live[near & (s + h >= 0.0)]])
+    row.update({f"ply{p}_intact_ahead": int(p in ahead) for p in numbers})
+    return row
+
+
+def ply_perforation_times(h: dict) -> list[float | None]:
+    """The time each ply was first perforated (s, in ply order; None for a ply never
+    perforated): the first history row at which none of its intact material within the
+    impactor's reach lies ahead of the nose (``ply{p}_intact_ahead`` = 0, :func:`ply_row`),
+    the geometric test of the outcome rule asked of each ply. A history without the
+    per-ply columns gives []."""
+    t = np.asarray(h["time_s"], dtype=float)
+    names = sorted((c for c in h if c.startswith("ply") and c.endswith("_intact_ahead")),
+                   key=lambda c: int(c[3:-len("_intact_ahead")]))
+    out: list[float | None] = []
+    for c in names:
+        rows = np.flatnonzero(np.asarray(h[c]) == 0)
+        out.append(float(t[rows[0]]) if rows.size else None)
+    return out
+
+
+def outcome_decided_at(h: dict) -> float | None:
+    """The time from which :func:`residual_velocity` of the history up to every row has
+    read the run's final outcome (None when it ends undecided or without contact)."""
+    final = residual_velocity(h)["outcome"]
+    if final in ("undecided", "no contact"):
+        return None
+    t = np.asarray(h["time_s"], dtype=float)
+    since = t.size - 1
+    for i in range(t.size - 2, -1, -1):
+        prefix = {c: np.asarray(h[c])[:i + 1] for c in OUTCOME_COLUMNS}
+        if residual_velocity(prefix)["outcome"] != final:
+            break
+        since = i
+    return float(t[since])
 
 
 def _outcome(outcome: str, v_res: float, v_reb: float) -> dict:

@@ -369,13 +369,13 @@ def run_spec(
         summary["stopped_when_decided"] = decided
     summary["provenance"] = prov
     write_plots(out, spec.case.name, model, state, history.arrays(), summary)
-    from wovenimpact.io.pictures import write_pictures
-
-    write_pictures(out, history.arrays())
     # numpy scalars as Python numbers: a summary key computed with numpy must not end an
     # hour's run with a TypeError after its last step (it did: numpy's bool_)
     atomic_write_text(out / "summary.json",
                       json.dumps(summary, indent=2, default=_json_scalar) + "\n")
+    from wovenimpact.io.pictures import write_pictures
+
+    write_pictures(out, history.arrays())  # after summary.json: the page shows them
     write_run_report(out, spec=spec, model_digest=digest, **(source or {}))  # report.html
     return summary
 

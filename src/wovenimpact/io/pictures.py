@@ -51,7 +51,7 @@ from wovenimpact.io.fields import PVD_NAME, _frame_index, _part_name, read_pvd  
 PICTURES = "pictures"
 INDEX = "pictures.json"
 N_FRAMES = 4
-MAX_POLYGONS = 12000
+MAX_POLYGONS = 6000
 CASING_WINDOW_DEG = 30.0
 DAMAGE_MAP, STRAIN_MAP, BLADE_GREY = "YlOrRd", "viridis", (0.62, 0.62, 0.66, 1.0)
 

@@ -6,8 +6,9 @@ Poly3DCollection, the Agg backend: no display, nothing beyond matplotlib and mes
 which the package needs anyway). Eroded elements (cell data ``alive`` = 0) are not drawn.
 
 - **Which instants** (:func:`choose_frames`): up to four frames — the first written at
-  or after first contact (the first history row with contact work on the casing, or a
-  contact force on the impactor), the last, and two evenly spaced between them.
+  or after first contact (:func:`first_contact_time`: the first history row at which the
+  casing's absorbed energy, or the contact force on the impactor, exceeds 1 % of its
+  largest value), the last, and two evenly spaced between them.
 - **What is drawn** (:func:`frame_view`): a containment run's casing near the fragment —
   the casing elements within :data:`CASING_WINDOW_DEG` either side of the blade's
   outermost node, below the fragment's mid-height (a cut, so that every layer's edge
@@ -98,14 +99,20 @@ def frames_of(fields: str | Path) -> list[tuple[int, float, list[tuple[str, Path
     return [(k, t, parts) for k, (t, parts) in sorted(frames.items())]
 
 
+CONTACT_SHARE = 0.01  # "contact": above this share of the column's largest value
+
+
 def first_contact_time(h: dict) -> float | None:
-    """The time of the first history row with contact: energy absorbed by a casing, a
-    contact force on an impactor, or else any contact energy; None if none."""
+    """The time of the first history row with contact: the energy absorbed by a casing,
+    the contact force on an impactor, or else the contact energy, above
+    :data:`CONTACT_SHARE` of its largest value over the run (the layers' light contact
+    with each other before the fragment arrives is not it); None if none."""
     t = np.asarray(h["time_s"], dtype=float)
     for c in ("casing_absorbed_energy_part_J", "contact_force_full_N", "contact_energy_part_J"):
         if c in h:
-            rows = np.flatnonzero(np.asarray(h[c], dtype=float) != 0.0)
-            return float(t[rows[0]]) if rows.size else None
+            y = np.abs(np.asarray(h[c], dtype=float))
+            rows = np.flatnonzero((y > CONTACT_SHARE * y.max()) & (y > 0.0)) if y.size else []
+            return float(t[rows[0]]) if len(rows) else None
     return None
 
 
@@ -293,7 +300,7 @@ def draw(polygons: Polygons, view: View, path: str | Path, title: str) -> Poly3D
                      shrink=0.55, pad=0.0, label="fabric damage (largest of warp, fill)")
     if polygons.metal:
         fig.colorbar(plt.cm.ScalarMappable(Normalize(0.0, polygons.strain_max), STRAIN_MAP),
-                     ax=ax, shrink=0.55, pad=0.02, label="metal plastic strain ε̄p")
+                     ax=ax, shrink=0.55, pad=0.08, label="metal plastic strain ε̄p")
     fig.subplots_adjust(left=0.0, right=1.0, bottom=0.0, top=0.93)
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(Path(path)) as tmp:

@@ -23,13 +23,18 @@ RESIDUAL = "residual_velocity_m_per_s"
 EXIT = "fragment_exit_speed_m_per_s"  # a containment run's stand-in for the residual
 
 
-def _rows(results: Path) -> list[dict]:
+def finished_rows(results: Path) -> list[dict]:
+    """The rows of a sweep's results.csv whose run finished (``status`` done)."""
     text = read_text(results, "results file")
     try:
-        rows = [r for r in csv.DictReader(io.StringIO(text, newline=""))
+        return [r for r in csv.DictReader(io.StringIO(text, newline=""))
                 if r.get("status") == "done"]
     except csv.Error as err:
         raise InputError(f"{results}: not a readable CSV file ({err})") from None
+
+
+def _rows(results: Path) -> list[dict]:
+    rows = finished_rows(results)
     if not rows or not ({RESIDUAL, EXIT} & set(rows[0])):
         raise InputError(f"{results}: no finished runs with {RESIDUAL} (or {EXIT} for a "
                          "containment study): list it in the study's metrics")

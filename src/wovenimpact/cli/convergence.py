@@ -26,10 +26,12 @@ def study_triples(results: Path, metrics: list[str], key: str,
     """Per metric, the triples of :func:`studies.convergence.mesh_convergence` over the
     finished rows of ``results`` that match every ``where`` ("column=value", the cell's
     text as results.csv holds it), one row per element size in column ``key``."""
-    from wovenimpact.cli.ballistics import _column
+    from wovenimpact.cli.ballistics import _column, finished_rows
     from wovenimpact.studies.convergence import mesh_convergence
 
-    rows = _finished(results)
+    rows = finished_rows(results)
+    if not rows:
+        raise InputError(f"{results}: no finished runs")
     for cond in where:
         column, sep, value = cond.partition("=")
         if not sep:
@@ -53,23 +55,6 @@ def study_triples(results: Path, metrics: list[str], key: str,
                                  f"{v!r}, not a number") from None
         out[metric] = mesh_convergence(sizes, values)
     return out
-
-
-def _finished(results: Path) -> list[dict]:
-    import csv
-    import io
-
-    from wovenimpact.spec.fields import read_text
-
-    text = read_text(results, "results file")
-    try:
-        rows = [r for r in csv.DictReader(io.StringIO(text, newline=""))
-                if r.get("status") == "done"]
-    except csv.Error as err:
-        raise InputError(f"{results}: not a readable CSV file ({err})") from None
-    if not rows:
-        raise InputError(f"{results}: no finished runs")
-    return rows
 
 
 @app.command("convergence")

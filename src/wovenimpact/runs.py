@@ -73,6 +73,7 @@ from wovenimpact.results.mesh_verdict import SUMMARY_KEY as MESH_VERDICT_KEY
 from wovenimpact.results.mesh_verdict import mesh_verdict
 from wovenimpact.results.metal_state import has_metal, plastic_work
 from wovenimpact.results.quantities import (
+    REACTION_COLUMNS,
     impactor_row,
     intact_material_ahead,
     outcome_decided_at,
@@ -82,6 +83,7 @@ from wovenimpact.results.quantities import (
     ply_energies,
     ply_perforation_times,
     ply_row,
+    reaction_row,
     residual_velocity,
     symmetry_factor,
 )
@@ -142,12 +144,15 @@ def history_columns(model) -> tuple[str, ...]:
     columns before them keep their places): a containment model's
     ``casing_layer{k}_absorbed_energy_part_J`` and ``casing_layer{k}_intact_outside``
     (containment.layer_row), a plate impact's ``ply{p}_contact_work_part_J`` and
-    ``ply{p}_intact_ahead`` (quantities.ply_row)."""
+    ``ply{p}_intact_ahead`` (quantities.ply_row). After them, appended later still,
+    ``reaction_force_{x,y,z}_part_N``: the summed reaction force of the supports (nodes with
+    all three translations fixed) in global axes, the force whose work
+    ``reaction_work_part_J`` books (quantities.support_reaction)."""
     return (HISTORY_COLUMNS + (IMPACT_COLUMNS if model.body_params.shape[0] else ())
             + (METAL_COLUMNS if has_metal(model) else ())
             + (MASS_SCALING_COLUMNS if model.mass_scaling_fraction > 0.0 else ())
             + (CONTAINMENT_COLUMNS + CASING_ENERGY_COLUMNS if is_containment(model) else ())
-            + per_layer_columns(model))
+            + per_layer_columns(model) + REACTION_COLUMNS)
 
 
 def per_layer_columns(model) -> tuple[str, ...]:
@@ -184,6 +189,7 @@ def history_row(model, state: State, normaliser: float = 0.0,
         impact["plastic_work_part_J"] = plastic_work(model, state)
     if model.mass_scaling_fraction > 0.0:
         impact.update(mass_scaling_row(state))
+    impact.update(reaction_row(model, state))
     return {
         **impact,
         "time_s": float(state.t), "step": int(state.step), "dt_s": float(state.dt),

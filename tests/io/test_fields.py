@@ -235,3 +235,79 @@ def test_parts_are_blocks_of_each_frame_and_resume_by_frame(tmp_path, model):
         "step_000002_lower.vtu", "step_000002_upper.vtu"]
     with pytest.raises(InputError, match="lists 3 frames, the checkpoint counts 4"):
         FieldWriter.resume(tmp_path, model, frames=4, parts=parts)
+
+
+def test_von_mises_and_stress_of_a_stepped_metal_plate_and_zero_on_fabric(tmp_path, kevlar):
+    """A small aluminium (J2, 5 points through the thickness) and fabric plate struck at
+    its middle and stepped 40 times: each metal cell's ``von_mises_stress`` is
+    √(σxx² − σxxσyy + σyy² + 3σxy²) of its ``stress`` cell array, as read back from the VTU,
+    and the largest such value over the element's points computed here from State.mat (the
+    kernel's stress); the metal is loaded (some stress above 1 MPa); fabric cells have 0."""
+    from wovenimpact.solver import Workspace, step
+
+    mesh = plate_mesh(0.02, 0.005)
+    n = len(mesh.quads)
+    which = np.where(np.arange(n) % 5 == 0, "fabric", "al")
+    sections = {"al": Section(material=ALUMINIUM, thickness=1e-3),
+                "fabric": Section(material=kevlar, transverse_shear_modulus=3.28e9, points=3)}
+    fm = build_model(mesh.nodes, mesh.quads, sections, which)
+    s = initial_state(fm)
+    centre = np.argmin(np.sum(mesh.nodes[:, :2] ** 2, axis=1))
+    s.v[centre, 2] = 200.0
+    s.v[:, 0] = 20.0 * mesh.nodes[:, 0] / 0.02  # an in-plane stretch too
+    ws = Workspace.for_model(fm, s)
+    for _ in range(40):
+        step(fm, s, ws)
+    cd = {k: v[0] for k, v in meshio.read(FieldWriter(tmp_path, fm).write(s)).cell_data.items()}
+    sig, vm = cd["stress"], cd["von_mises_stress"]
+    assert sig.shape == (n, 3)
+    from_components = np.sqrt(sig[:, 0] ** 2 - sig[:, 0] * sig[:, 1] + sig[:, 1] ** 2
+                              + 3.0 * sig[:, 2] ** 2)
+    assert np.allclose(vm, from_components, rtol=1e-12, atol=0.0)
+    fabric = cd["fabric"] == 1
+    assert fabric.sum() == (which == "fabric").sum()
+    assert np.all(vm[fabric] == 0.0) and np.all(sig[fabric] == 0.0)
+    points = {e: s.mat[fm.mat_row[e]:fm.mat_row[e + 1], J.S_SIG:J.S_SIG + 3]
+              for e in np.flatnonzero(~fabric)}
+    largest = {e: max(np.sqrt(a * a - a * b + b * b + 3 * c * c) for a, b, c in p)
+               for e, p in points.items()}
+    for e, value in largest.items():
+        assert vm[e] == pytest.approx(value, rel=1e-12, abs=0.0)
+    assert vm[~fabric].max() > 1e6
+
+
+def test_element_sets_partition_the_cells_and_are_named_in_a_side_file(tmp_path, kevlar):
+    """Overlapping element sets (``all``, two plies, a patch across both): each cell's
+    ``element_set`` is its region (the sets it belongs to), the regions partition the
+    elements, each set is exactly the union of the regions element_sets.json lists for it,
+    and ``all`` (every element) is left out; a plate's plies alone are regions 0 and 1."""
+    import json
+
+    m = plate_mesh(0.02, 0.005, plies=2, spacing=1e-3)
+    n = len(m.quads)
+    sets = dict(m.elem_sets)
+    sets["patch"] = np.array([0, 1, n // 2, n // 2 + 1])
+    fm = build_model(m.nodes, m.quads, {"plate": Section(material=STEEL, thickness=1e-3)},
+                     np.zeros(n, dtype=np.int64), ply=m.ply, elem_sets=sets)
+    cd = {k: v[0] for k, v in meshio.read(FieldWriter(tmp_path, fm).write(initial_state(fm)))
+          .cell_data.items()}
+    ids = cd["element_set"]
+    info = json.loads((tmp_path / "element_sets.json").read_text())
+    assert info["cell_array"] == "element_set" and info["left_out"] == ["all"]
+    regions = info["regions"]
+    assert [r["element_set"] for r in regions] == list(range(len(regions)))
+    assert sum(r["elements"] for r in regions) == n  # a partition: each cell in one region
+    assert sorted(info["sets"]) == ["patch", "ply0", "ply1"]
+    for name, members in info["sets"].items():
+        assert np.array_equal(np.flatnonzero(np.isin(ids, members)), np.sort(sets[name]))
+        assert all(name in regions[i]["sets"] for i in members)
+    assert {tuple(r["sets"]) for r in regions} == {("ply0",), ("ply1",), ("patch", "ply0"),
+                                                   ("patch", "ply1")}
+
+    plain = build_model(m.nodes, m.quads, {"plate": Section(material=STEEL, thickness=1e-3)},
+                        np.zeros(n, dtype=np.int64), ply=m.ply, elem_sets=m.elem_sets)
+    FieldWriter(tmp_path / "plain", plain).write(initial_state(plain))
+    cd = meshio.read(tmp_path / "plain" / "step_000000.vtu").cell_data
+    assert np.array_equal(cd["element_set"][0], m.ply)
+    info = json.loads((tmp_path / "plain" / "element_sets.json").read_text())
+    assert [r["sets"] for r in info["regions"]] == [["ply0"], ["ply1"]]

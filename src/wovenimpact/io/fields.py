@@ -10,7 +10,14 @@ configuration ``State.x`` with
   which are 0 for elements that are not fabric, ``thickness_ratio`` t/t0 and
   ``plastic_strain`` (the largest ε̄p of the element's points), 1 and 0 for elements
   that are not metal (metal_state), and ``fabric`` (1 where the element's material is
-  a fabric, else 0).
+  a fabric, else 0);
+- cell data ``von_mises_stress`` (Pa) and ``stress`` (σ_xx, σ_yy, σ_xy; Pa) of metal (J2)
+  elements: of the element's points (in-plane and through the thickness), the one with
+  the largest von Mises stress, its Cauchy stress in the point's rotated frame
+  (metal_state.largest_von_mises); 0 for elements that are not J2;
+- cell data ``element_set``: the index of the element's region, the element sets it
+  belongs to (:func:`element_set_regions`), named in ``element_sets.json`` beside the
+  frames, so ParaView's Threshold on it picks out a layer, ply or part.
 
 Quads are written as VTK quads; an element whose quad repeats a node (a triangle)
 is written as a VTK triangle in a second cell block, so VTK filters never see a
@@ -27,6 +34,7 @@ multiblock series — a containment run's ``casing`` and ``blade`` (:func:`model
 
 from __future__ import annotations
 
+import json
 import xml.etree.ElementTree as ET
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
@@ -38,10 +46,15 @@ from wovenimpact.errors import InputError
 from wovenimpact.io.atomic import atomic_path, atomic_write_text
 from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels import shell_layout as SL
-from wovenimpact.results.metal_state import max_plastic_strain, thickness_ratio
+from wovenimpact.results.metal_state import (
+    largest_von_mises,
+    max_plastic_strain,
+    thickness_ratio,
+)
 from wovenimpact.state import State
 
 PVD_NAME = "fields.pvd"
+SETS_NAME = "element_sets.json"  # the names of the ``element_set`` cell array's indices
 
 
 def frame_name(k: int, part: str = "") -> str:
@@ -67,6 +80,45 @@ def fabric_elements(model) -> np.ndarray:
     """(n_elems,) True where the element's section material is a fabric."""
     mat = model.sections[model.elem_section, SL.C_MAT].astype(np.int64)
     return model.mat_kind[mat] == SL.MAT_FABRIC
+
+
+def element_set_regions(model) -> tuple[np.ndarray, list[list[str]]]:
+    """(n_elems,) region index of each element and, per index, the names of the element
+    sets its elements belong to (sorted by name).
+
+    Element sets may overlap (a plate's ``all`` and ``ply0``, a blade's ``blade`` and
+    ``fragment``), so one index per set cannot label the cells; a region is a distinct
+    combination of sets, so the regions partition the elements and each set is the union of
+    the regions that name it. A set holding every element (``all``) tells nothing and is left
+    out; elements in no set form a region with no name ([]), placed last. Regions are
+    numbered in order of their sets' names (the region of the first set first)."""
+    names = sorted(k for k, v in model.elem_sets.items()
+                   if 0 < np.unique(np.asarray(v, dtype=np.int64)).size < model.n_elems)
+    if not names:
+        return np.zeros(model.n_elems, dtype=np.int64), [[]]
+    member = np.zeros((model.n_elems, len(names)), dtype=bool)
+    for j, k in enumerate(names):
+        member[np.asarray(model.elem_sets[k], dtype=np.int64), j] = True
+    rows, inverse = np.unique(member, axis=0, return_inverse=True)
+    combos = [tuple(int(j) for j in np.flatnonzero(r)) for r in rows]
+    order = sorted(range(len(combos)), key=lambda i: (not combos[i], combos[i]))
+    rank = np.empty(len(order), dtype=np.int64)
+    rank[order] = np.arange(len(order))
+    return rank[np.asarray(inverse).ravel()], [[names[j] for j in combos[i]] for i in order]
+
+
+def element_sets_json(model, regions: list[list[str]], ids: np.ndarray) -> str:
+    """Text of ``element_sets.json``: each ``element_set`` index with its sets and element
+    count, each set with its indices, and the sets left out (holding every element)."""
+    sets = {k: sorted(i for i, r in enumerate(regions) if k in r) for r in regions for k in r}
+    counts = np.bincount(ids, minlength=len(regions))
+    return json.dumps({
+        "cell_array": "element_set",
+        "regions": [{"element_set": i, "sets": r, "elements": int(counts[i])}
+                    for i, r in enumerate(regions)],
+        "sets": dict(sorted(sets.items())),
+        "left_out": sorted(k for k in model.elem_sets if k not in sets),
+    }, indent=1) + "\n"
 
 
 def cell_blocks(quads: np.ndarray) -> list[tuple[str, np.ndarray, np.ndarray]]:
@@ -102,6 +154,7 @@ def element_fields(model, state: State, fabric: np.ndarray) -> dict[str, np.ndar
     out["thickness_ratio"] = thickness_ratio(model, state)
     out["plastic_strain"] = max_plastic_strain(model, state)
     out["fabric"] = np.asarray(fabric, dtype=np.int64)
+    out["von_mises_stress"], out["stress"] = largest_von_mises(model, state)
     return out
 
 
@@ -133,6 +186,9 @@ class FieldWriter:
             self._parts.append((name, elems, nodes, cell_blocks(local[model.quads[elems]])))
         self._names = [name for name, *_ in self._parts]
         self._fabric = fabric_elements(model)
+        self._sets, regions = element_set_regions(model)
+        atomic_write_text(self.directory / SETS_NAME,
+                          element_sets_json(model, regions, self._sets))
 
     @property
     def entries(self) -> tuple[tuple[float, str], ...]:
@@ -155,6 +211,7 @@ class FieldWriter:
                              f"({self._entries[-1][0]!r} s); times must not decrease")
         k = self._next_frame()
         per_elem = element_fields(self.model, state, self._fabric)
+        per_elem["element_set"] = self._sets
         paths = []
         for part in self._parts:
             path = self.directory / frame_name(k, part[0])

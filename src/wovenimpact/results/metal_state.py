@@ -17,6 +17,14 @@ value — the same quadrature the shell uses for its forces (docs/theory.md §7.
 - :func:`thickness_ratio` (—): t / t0 = Σ_k w_k λ3,k averaged over the in-plane points
   (λ3 = S_THICK, the thickness stretch from plastic incompressibility and the elastic
   plane-stress ε33, eq. J10); 1 for elements whose material is not J2.
+- :func:`largest_von_mises` (Pa): of each element's points, the one whose in-plane
+  Cauchy stress σ (S_SIG: σ_xx, σ_yy, σ_xy in the point's Green–Naghdi rotated frame,
+  the element's reference axes carried with the material's rotation; plane stress,
+  σ_zz = 0) has the largest von Mises stress √(σxx² − σxxσyy + σyy² + 3σxy²): that
+  stress and its three components, as LS-DYNA's shell output takes the largest over the
+  integration points; 0 for elements whose material is not J2. The stress is the point's
+  own (the kernel's, with damage and failure in it: a failed point's is 0), not
+  re-derived from strains.
 """
 
 from __future__ import annotations
@@ -90,3 +98,32 @@ def max_plastic_strain(model, state) -> np.ndarray:
     for elems, _, _, values in _j2_point_values(model, state, J.S_EPS_P):
         out[elems] = values.reshape(len(elems), -1).max(axis=1)
     return out
+
+
+def von_mises(sig: np.ndarray) -> np.ndarray:
+    """Plane-stress von Mises stress of (…, 3) σ_xx, σ_yy, σ_xy."""
+    sxx, syy, sxy = sig[..., 0], sig[..., 1], sig[..., 2]
+    return np.sqrt(sxx * sxx - sxx * syy + syy * syy + 3.0 * sxy * sxy)
+
+
+def largest_von_mises(model, state) -> tuple[np.ndarray, np.ndarray]:
+    """(n_elems,) the largest von Mises stress over each element's J2 points (Pa) and
+    (n_elems, 3) the stress σ_xx, σ_yy, σ_xy of that point (Pa; module docstring)."""
+    vm = np.zeros(model.n_elems)
+    sig = np.zeros((model.n_elems, 3))
+    for sec in range(model.sections.shape[0]):
+        row = model.sections[sec]
+        if model.mat_kind[int(row[SL.C_MAT])] != SL.MAT_J2:
+            continue
+        elems = np.flatnonzero(model.elem_section == sec)
+        if elems.size == 0:
+            continue
+        n = int(row[SL.C_POINTS]) * int(row[SL.C_INPLANE])
+        rows = model.mat_row[elems][:, None] + np.arange(n)
+        points = state.mat[rows, J.S_SIG:J.S_SIG + 3]  # (elements, points, 3)
+        per_point = von_mises(points)
+        best = np.argmax(per_point, axis=1)
+        take = np.arange(elems.size)
+        vm[elems] = per_point[take, best]
+        sig[elems] = points[take, best]
+    return vm, sig

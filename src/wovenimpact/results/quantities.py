@@ -13,8 +13,10 @@ import weakref
 import numpy as np
 
 from wovenimpact.errors import InputError
+from wovenimpact.kernels import integrate as IN
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as SL
+from wovenimpact.kernels.mass_scaling import node_masses
 from wovenimpact.model.model import flies_sideways, sideways_shadow, travel_of_row
 
 QUIET_TIME = 10e-6  # contact must have been light this long to call a perforation
@@ -335,3 +337,38 @@ def ply_deflections(model, state) -> list[float]:
         nodes = np.unique(model.quads[model.ply == p])
         out.append(float(np.sqrt(np.max(np.sum((state.x[nodes] - model.x0[nodes]) ** 2, axis=1)))))
     return out
+
+
+REACTION_COLUMNS = ("reaction_force_x_part_N", "reaction_force_y_part_N",
+                    "reaction_force_z_part_N")
+
+
+def supported_nodes(model) -> np.ndarray:
+    """Indices of the nodes held by a support: all three translations fixed (a clamped or
+    pinned edge, a casing's clamped ends). A symmetry plane's nodes (one translation fixed)
+    and nodes in prescribed or rotating motion are not supports."""
+    return np.flatnonzero(np.all(model.bc_code[:, :3] == IN.FIXED, axis=1))
+
+
+def support_reaction(model, state) -> np.ndarray:
+    """(3,) the sum of the reaction forces of the supports (:func:`supported_nodes`) at the
+    state's last whole step x^n, in global axes (N, modelled part).
+
+    It is the force whose work is booked in ``reaction_work_J``: the integrator writes a
+    constrained degree of freedom's ``State.f_ext`` as m (v_new − v_old)/Δt + f_int = load + R
+    (kernels/integrate.py, ``update_node``), the load being m g + the contact force, so
+    R = f_ext − m g − f_contact with m the node's mass with any added by mass scaling. It is
+    the force the supports exert on the structure (the structure pulls on them with −R)."""
+    nodes = supported_nodes(model)
+    if nodes.size == 0:
+        return np.zeros(3)
+    added = state.added_mass if state.added_mass.shape == (model.n_nodes,) else 0.0
+    mass, _ = node_masses(model.node_mass, model.node_inertia, added)
+    load = mass[nodes, None] * model.body_accel[nodes, :3] + state.f_contact[nodes]
+    active = (state.node_active[nodes] != 0)[:, None]
+    return np.sum(np.where(active, state.f_ext[nodes, :3] - load, 0.0), axis=0)
+
+
+def reaction_row(model, state) -> dict:
+    """The :data:`REACTION_COLUMNS` of a history row (:func:`support_reaction`)."""
+    return dict(zip(REACTION_COLUMNS, (float(r) for r in support_reaction(model, state))))

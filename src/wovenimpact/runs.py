@@ -422,6 +422,7 @@ def write_plots(out: Path, title: str, model, state: State, h: dict, summary: di
 
 
 OUTPUT_PATTERNS = ("checkpoints/checkpoint_*.npz", "fields/step_*.vtu", "fields/fields.pvd",
+                   "fields/element_sets.json",
                    "plots/*.png", "pictures/frame_*.png", "pictures/pictures.json",
                    "history.csv", "summary.json", "report.html",
                    "error.txt")  # error.txt: a failed run of a sweep or design search

@@ -569,12 +569,13 @@ def test_a_reused_output_directory_is_cleared_of_an_earlier_runs_outputs(tmp_pat
 
     out = tmp_path / "out"
     stale = [out / "fields" / "step_000099.vtu", out / "plots" / "impactor.png",
-             out / "checkpoints" / "checkpoint_000999999.npz", out / "summary.json"]
+             out / "checkpoints" / "checkpoint_000999999.npz", out / "summary.json",
+             out / "fields" / "element_sets.json"]
     for p in stale:
         p.parent.mkdir(parents=True, exist_ok=True)
         p.write_text("another case's output")
     (out / "notes.txt").write_text("mine")
-    with pytest.warns(InputWarning, match="removing 4 output files of an earlier run"):
+    with pytest.warns(InputWarning, match="removing 5 output files of an earlier run"):
         summary = run_case(write_case(tmp_path, end="8 us"), out)
     assert not any(p.exists() and p.read_text() == "another case's output" for p in stale)
     assert (out / "notes.txt").read_text() == "mine"

@@ -49,9 +49,9 @@ def simpson_weights(n_pts: int) -> np.ndarray:
     return w / (3.0 * (n_pts - 1))
 
 
-def _j2_point_values(model, state, column: int):
-    """For each J2 section: (elements, in-plane weights (m²), Simpson weights, values
-    (elements, in-plane points, levels)) of state column ``column``."""
+def _j2_sections(model):
+    """For each J2 section with elements: (elements, its points' rows in ``state.mat``
+    (elements, in-plane points × levels), levels, in-plane points)."""
     for sec in range(model.sections.shape[0]):
         row = model.sections[sec]
         if model.mat_kind[int(row[SL.C_MAT])] != SL.MAT_J2:
@@ -60,7 +60,13 @@ def _j2_point_values(model, state, column: int):
         if elems.size == 0:
             continue
         n_pts, n_in = int(row[SL.C_POINTS]), int(row[SL.C_INPLANE])
-        rows = model.mat_row[elems][:, None] + np.arange(n_in * n_pts)
+        yield elems, model.mat_row[elems][:, None] + np.arange(n_in * n_pts), n_pts, n_in
+
+
+def _j2_point_values(model, state, column: int):
+    """For each J2 section: (elements, in-plane weights (m²), Simpson weights, values
+    (elements, in-plane points, levels)) of state column ``column``."""
+    for elems, rows, n_pts, n_in in _j2_sections(model):
         values = state.mat[rows, column].reshape(len(elems), n_in, n_pts)  # that column only
         if n_in == 4:
             w_in = model.gauss_weight[elems]
@@ -111,15 +117,7 @@ def largest_von_mises(model, state) -> tuple[np.ndarray, np.ndarray]:
     (n_elems, 3) the stress σ_xx, σ_yy, σ_xy of that point (Pa; module docstring)."""
     vm = np.zeros(model.n_elems)
     sig = np.zeros((model.n_elems, 3))
-    for sec in range(model.sections.shape[0]):
-        row = model.sections[sec]
-        if model.mat_kind[int(row[SL.C_MAT])] != SL.MAT_J2:
-            continue
-        elems = np.flatnonzero(model.elem_section == sec)
-        if elems.size == 0:
-            continue
-        n = int(row[SL.C_POINTS]) * int(row[SL.C_INPLANE])
-        rows = model.mat_row[elems][:, None] + np.arange(n)
+    for elems, rows, _, _ in _j2_sections(model):
         points = state.mat[rows, J.S_SIG:J.S_SIG + 3]  # (elements, points, 3)
         per_point = von_mises(points)
         best = np.argmax(per_point, axis=1)

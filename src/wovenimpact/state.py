@@ -17,6 +17,7 @@ from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels import j2_layout as JL
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as SL
+from wovenimpact.kernels import solid_layout as HL
 
 # indices of State.energy (J)
 W_INT = 0  # work of the internal forces (membrane, bending, shear, hourglass)
@@ -73,6 +74,9 @@ class State:
             a segment or body of part b took out of the structure up to the last whole
             step, [1] the same of the last step's forces against the velocities after it,
             moved into [0] at the next step.
+        hex: (n_hexes, N_HEX_STATE) state of the hexahedra (solid_layout ``H_*``: the
+            rotated Kirchhoff stress, the stretch U, the hourglass forces, the Cauchy
+            stress, the stored and hourglass energies, the last element step, the volume).
     """
 
     t: float
@@ -94,6 +98,7 @@ class State:
     added_mass: np.ndarray = field(default_factory=lambda: np.zeros(0))
     contact_work: np.ndarray = field(default_factory=lambda: np.zeros(0))
     contact_books: np.ndarray = field(default_factory=lambda: np.zeros((2, 3, 0, 0)))
+    hex: np.ndarray = field(default_factory=lambda: np.zeros((0, HL.N_HEX_STATE)))
 
     def copy(self) -> State:
         return State(**{f.name: (getattr(self, f.name).copy() if isinstance(
@@ -184,7 +189,15 @@ def initial_state(model, velocity=None, angular_velocity=None) -> State:
                  f_int=np.zeros((n, 6)), f_ext=np.zeros((n, 6)),
                  node_active=np.ones(n, dtype=np.int8), energy=energy, bodies=bodies,
                  f_contact=np.zeros((n, 3)), mass_ratio=np.zeros(ne), added_mass=np.zeros(n),
-                 contact_work=np.zeros(n), contact_books=empty_books(model))
+                 contact_work=np.zeros(n), contact_books=empty_books(model),
+                 hex=initial_hex_rows(getattr(model, "n_hexes", 0)))
+
+
+def initial_hex_rows(n: int) -> np.ndarray:
+    """``State.hex`` at the start: n unstrained hexahedra (U = I, the rest zero)."""
+    rows = np.zeros((n, HL.N_HEX_STATE))
+    rows[:, HL.H_U:HL.H_U + 3] = 1.0
+    return rows
 
 
 def rigid_rotation_velocity(x: np.ndarray, omega, centre=(0.0, 0.0, 0.0)) -> np.ndarray:

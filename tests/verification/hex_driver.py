@@ -1,5 +1,6 @@
-"""A minimal explicit driver for the hexahedron kernels (tests only: the solver's Model /
-State / step does not take solids yet).
+"""A minimal explicit driver for the hexahedron kernels alone (tests only: the kernels
+checked without the solver's Model / State / step, which tests/verification/
+test_solid_solver.py runs them through).
 
 Central differences with the lumped mass ρ0 V0 / 8 per corner (the mass the element's
 stable step assumes): v^{n+1/2} = v^{n−1/2} + Δt M⁻¹ (f_ext − f_int^n − c M v^{n−1/2}),

@@ -23,6 +23,14 @@ Quads are written as VTK quads; an element whose quad repeats a node (a triangle
 is written as a VTK triangle in a second cell block, so VTK filters never see a
 degenerate quad; a model of triangles only (or a part with no quads) has just the
 triangle block. The ``element`` cell array maps cells back to Model elements.
+
+Hexahedra (solid elements, docs/solid.md) are written as VTK hexahedra in a block of their
+own, in the first part's files; their ``element`` is the Model's hexahedron index and
+``ply`` their solid section's index. In a model with hexahedra every cell also has
+``solid`` (1 for a hexahedron, 0 for a shell) and ``solid_stress`` (the hexahedron's
+Cauchy stress σ in global axes, Voigt order 11, 22, 33, 23, 13, 12; Pa; 0 on shells), and
+a hexahedron's ``von_mises_stress`` is that of σ; the other shell arrays are 0 there
+(``alive``, ``thickness_ratio`` 1; ``element_set`` −1, the element sets being the shells').
 After every file ``fields.pvd`` is rewritten atomically to list all files with
 their times; ParaView opens it as one time series.
 
@@ -46,6 +54,7 @@ from wovenimpact.errors import InputError
 from wovenimpact.io.atomic import atomic_path, atomic_write_text
 from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels import shell_layout as SL
+from wovenimpact.kernels import solid_layout as HL
 from wovenimpact.results.metal_state import (
     largest_von_mises,
     max_plastic_strain,
@@ -158,6 +167,27 @@ def element_fields(model, state: State, fabric: np.ndarray) -> dict[str, np.ndar
     return out
 
 
+def hex_fields(model, state: State, shell_fields: dict) -> dict[str, np.ndarray]:
+    """Per-hexahedron output arrays with the names and widths of ``shell_fields`` (module
+    docstring: 0 but for ``alive``, ``ply``, ``element``, ``thickness_ratio``, the
+    stresses and ``solid``)."""
+    n = model.n_hexes
+    out = {name: np.zeros((n,) + np.shape(a)[1:], dtype=np.asarray(a).dtype)
+           for name, a in shell_fields.items()}
+    sig = state.hex[:, HL.H_SIG:HL.H_SIG + 6]
+    out["alive"] = np.ones(n)
+    out["ply"] = np.asarray(model.solid.section, dtype=np.int64)
+    out["element"] = np.arange(n, dtype=np.int64)
+    out["thickness_ratio"] = np.ones(n)
+    out["element_set"] = np.full(n, -1, dtype=np.int64)
+    dev = sig[:, :3] - sig[:, :3].mean(axis=1, keepdims=True)
+    out["von_mises_stress"] = np.sqrt(1.5 * np.sum(dev**2, axis=1)
+                                      + 3.0 * np.sum(sig[:, 3:]**2, axis=1))
+    out["solid"] = np.ones(n, dtype=np.int64)
+    out["solid_stress"] = np.ascontiguousarray(sig)
+    return out
+
+
 class FieldWriter:
     """Writes the VTU series of a run and keeps ``fields.pvd`` up to date.
 
@@ -178,12 +208,16 @@ class FieldWriter:
         self.model = model
         self._entries: list[tuple[float, str]] = [(float(t), str(f)) for t, f in entries]
         self._parts = []
-        for name, elems in (model_parts(model) if parts is None else parts):
+        for k, (name, elems) in enumerate(model_parts(model) if parts is None else parts):
             elems = np.asarray(elems, dtype=np.int64)
-            nodes = np.unique(model.quads[elems])
+            hexes = model.solid.hexes if k == 0 else np.zeros((0, 8), dtype=np.int64)
+            nodes = np.unique(np.concatenate([model.quads[elems].ravel(), hexes.ravel()]))
             local = np.full(model.n_nodes, -1, dtype=np.int64)
             local[nodes] = np.arange(nodes.size)
-            self._parts.append((name, elems, nodes, cell_blocks(local[model.quads[elems]])))
+            blocks = cell_blocks(local[model.quads[elems]])
+            if len(hexes):
+                blocks.append(("hexahedron", np.arange(len(hexes)), local[hexes]))
+            self._parts.append((name, elems, nodes, blocks))
         self._names = [name for name, *_ in self._parts]
         self._fabric = fabric_elements(model)
         self._sets, regions = element_set_regions(model)
@@ -212,11 +246,17 @@ class FieldWriter:
         k = self._next_frame()
         per_elem = element_fields(self.model, state, self._fabric)
         per_elem["element_set"] = self._sets
+        per_hex = None
+        if self.model.n_hexes:
+            per_elem["solid"] = np.zeros(self.model.n_elems, dtype=np.int64)
+            per_elem["solid_stress"] = np.zeros((self.model.n_elems, 6))
+            per_hex = hex_fields(self.model, state, per_elem)
         paths = []
         for part in self._parts:
             path = self.directory / frame_name(k, part[0])
             with atomic_path(path) as tmp:
-                meshio.write(tmp, self._mesh(state, per_elem, part), file_format="vtu")
+                meshio.write(tmp, self._mesh(state, per_elem, part, per_hex),
+                             file_format="vtu")
             self._entries.append((t, path.name))
             paths.append(path)
         self._write_pvd()
@@ -256,15 +296,21 @@ class FieldWriter:
         frames = [_frame_index(name) for _, name in self._entries]
         return 1 + max((k for k in frames if k is not None), default=-1)
 
-    def _mesh(self, state: State, per_elem: dict, part) -> meshio.Mesh:
+    def _mesh(self, state: State, per_elem: dict, part, per_hex=None) -> meshio.Mesh:
         _, elems, nodes, blocks = part
+
+        def values(name, kind, idx):
+            if kind == "hexahedron":  # (idx: the hexahedra)
+                return np.ascontiguousarray(per_hex[name][idx])
+            return np.ascontiguousarray(per_elem[name][elems[idx]])
+
         return meshio.Mesh(
             points=np.ascontiguousarray(state.x[nodes], dtype=float),
             cells=[(kind, conn) for kind, _, conn in blocks],
             point_data={"displacement": state.x[nodes] - self.model.x0[nodes],
                         "velocity": np.ascontiguousarray(state.v[nodes], dtype=float)},
-            cell_data={name: [np.ascontiguousarray(a[elems[idx]]) for _, idx, _ in blocks]
-                       for name, a in per_elem.items()},
+            cell_data={name: [values(name, kind, idx) for kind, idx, _ in blocks]
+                       for name in per_elem},
         )
 
     def _write_pvd(self) -> None:

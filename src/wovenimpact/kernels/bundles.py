@@ -176,6 +176,17 @@ class HexResults(NamedTuple):
     status: np.ndarray  # (n_elems,) int32 EL_* codes
 
 
+class HexGather(NamedTuple):
+    """The hexahedra's corner forces as the node pass adds them to the shells'
+    (``integrate.gather_and_update``): the node → (hexahedron, corner) map in CSR form
+    (Model; all-zero ``node_ptr`` in a model without solids) and the force blocks."""
+
+    node_ptr: np.ndarray  # (n_nodes + 1,) int64
+    node_elem: np.ndarray  # int64 the hexahedron of each entry
+    node_corner: np.ndarray  # int64 its corner
+    blocks: np.ndarray  # (n_hexes, 8, 3) internal corner forces at x^n (HexResults.blocks)
+
+
 # Contact (issue 37): the bundles of the shell–shell contact (contact_broad, contact_update,
 # contact_narrow, contact_energy), built by its driver (``contact.ShellContact``), and of
 # the rigid bodies (contact_rigid, built by ``solver.contact_stage``). The contact kernels

@@ -15,8 +15,8 @@ for a linear system at constant Δt (the quantity central differences conserve);
 to (ωΔt/2)².
 
 ``gather_and_update`` is the explicit step's one pass over the nodes: each node
-gathers its internal force (``gather.node_force_sum``), then takes the update of
-``update_node``; it also counts nodes left at a non-finite position, so the
+gathers its internal force (``gather.node_force_sum``, then the corner forces of the
+hexahedra it belongs to), then takes the update of ``update_node``; it also counts nodes left at a non-finite position, so the
 caller checks one integer instead of scanning x.
 
 A node that loses its last live element either leaves the model with its kinetic
@@ -189,14 +189,17 @@ def update_node(
 
 
 @loop_kernel
-def gather_and_update(node_map, elements, nodes, f_con, amplitude, dt_old, dt_new, forces,
-                      motion, node_active, energies):
+def gather_and_update(node_map, elements, solids, nodes, f_con, amplitude, dt_old, dt_new,
+                      forces, motion, node_active, energies):
     """Gather the internal forces of every node and advance it by one step.
 
     Args:
         node_map: ``bundles.NodeMap`` (Model).
         elements: ``bundles.ElementResults`` of the element stage: its ``blocks``
             (n_elems, 4, 6) corner forces and moments at x^n and ``alive`` bytes are read.
+        solids: ``bundles.HexGather``: the hexahedra's corner forces at x^n, added after
+            the shells' in the map's order (each corner counts as a live element; a node
+            of shells only has no entry, so its sum is the shells' bitwise).
         nodes: ``bundles.NodeModel``: masses, rotary inertias, constraints, body loads,
             and what becomes of a node that loses its last element (``keep_free``).
         f_con: (n, 3) contact forces at x^n (external loads of the shells).
@@ -223,6 +226,10 @@ def gather_and_update(node_map, elements, nodes, f_con, amplitude, dt_old, dt_ne
     node_corner = node_map.node_corner
     blocks = elements.blocks
     alive = elements.alive
+    h_ptr = solids.node_ptr
+    h_elem = solids.node_elem
+    h_corner = solids.node_corner
+    h_blocks = solids.blocks
     mass = nodes.mass
     inertia = nodes.inertia
     bc_code = nodes.bc_code
@@ -248,6 +255,13 @@ def gather_and_update(node_map, elements, nodes, f_con, amplitude, dt_old, dt_ne
         f0, f1, f2, f3, f4, f5, live = node_force_sum(
             n, node_ptr, node_elem, node_corner, blocks, alive
         )
+        for k in range(h_ptr[n], h_ptr[n + 1]):
+            e = np.uint64(h_elem[k])
+            c = np.uint64(h_corner[k])
+            f0 += h_blocks[e, c, 0]
+            f1 += h_blocks[e, c, 1]
+            f2 += h_blocks[e, c, 2]
+            live += 1
         f_int[n, 0] = f0
         f_int[n, 1] = f1
         f_int[n, 2] = f2

@@ -1,11 +1,14 @@
-"""Read shell meshes from Abaqus input files (``.inp``) through meshio.
+"""Read shell and solid meshes from Abaqus input files (``.inp``) through meshio.
 
-Only the mesh is read: ``*NODE``, ``*ELEMENT`` (shell quads and triangles),
-``*NSET`` and ``*ELSET`` (including ``GENERATE``). meshio's reader maps every
+Only the mesh is read: ``*NODE``, ``*ELEMENT`` (shell quads and triangles, 8-node
+bricks), ``*NSET`` and ``*ELSET`` (including ``GENERATE``). meshio's reader maps every
 4-node quad type it knows (S4, S4R, CPS4, …) to "quad" and every 3-node triangle
 type (S3, S3R, CPS3, …) to "triangle"; both are accepted, a triangle is stored as a
-quad with its last node repeated. Line and vertex elements (beams, trusses) are
-skipped with a warning; any other element type is an :class:`InputError`.
+quad with its last node repeated. The 8-node bricks (C3D8, C3D8R, C3D8I, …: meshio's
+"hexahedron", whose corner order is Abaqus's) are the solids, ``Mesh.hexes``, numbered
+apart from the shells, their element sets in ``Mesh.hex_sets``. Line and vertex
+elements (beams, trusses) are skipped with a warning; any other element type is an
+:class:`InputError`.
 
 meshio reads a flat file only; the constructs it would misread silently are
 refused with a message instead (checked by :func:`_scan_keywords`): ``*PART``,
@@ -28,6 +31,7 @@ from wovenimpact.model.mesh import Mesh
 from wovenimpact.spec.fields import read_text
 
 SHELL_TYPES = ("quad", "triangle")
+SOLID_TYPES = ("hexahedron",)
 SKIPPED_TYPES = ("line", "line3", "vertex")
 
 
@@ -52,18 +56,31 @@ def read_inp(path: str | Path) -> Mesh:
         [_as_quads(b.data) for b, off in zip(raw.cells, offsets) if off is not None]
         or [np.zeros((0, 4), dtype=np.int64)]
     )
-    if not len(quads):
-        raise InputError(f"{path}: no shell elements (S4, S4R, S3, S3R) found")
+    hex_offsets = _block_offsets(path, raw.cells, SOLID_TYPES)
+    hexes = np.concatenate(
+        [np.asarray(b.data, dtype=np.int64) for b, off in zip(raw.cells, hex_offsets)
+         if off is not None] or [np.zeros((0, 8), dtype=np.int64)]
+    )
+    if not len(quads) and not len(hexes):
+        raise InputError(f"{path}: no shell elements (S4, S4R, S3, S3R) or 8-node bricks "
+                         "(C3D8R, C3D8) found")
     nodes = _xyz(path, raw.points)
     bad = np.flatnonzero(~np.all(np.isfinite(nodes), axis=1))
     if bad.size:
         raise InputError(f"{path}: node {bad[0] + 1} (in file order) has a non-finite "
                          f"coordinate {nodes[bad[0]].tolist()} (valid: finite numbers)")
     elem_sets = _elem_sets(raw, scan, offsets)
+    hex_sets = _elem_sets(raw, scan, hex_offsets)
+    if len(hexes):  # a set of solids only is not a (empty) set of shells
+        elem_sets = {k: v for k, v in elem_sets.items() if v.size or not hex_sets.get(
+            k, np.zeros(0)).size}
+        hex_sets = {k: v for k, v in hex_sets.items() if v.size or k not in elem_sets}
+    else:
+        hex_sets = {}
     node_sets = {name: np.unique(np.asarray(idx, dtype=np.int64))
                  for name, idx in raw.point_sets.items()}
     return Mesh(nodes=nodes, quads=quads, ply=np.zeros(len(quads), dtype=np.int64),
-                node_sets=node_sets, elem_sets=elem_sets)
+                node_sets=node_sets, elem_sets=elem_sets, hexes=hexes, hex_sets=hex_sets)
 
 
 def _meshio_read(path: Path) -> meshio.Mesh:
@@ -87,14 +104,19 @@ def _meshio_read(path: Path) -> meshio.Mesh:
         ) from None
 
 
-def _block_offsets(path: Path, cells) -> list[int | None]:
-    """Global index of each block's first element; None for skipped (line) blocks."""
+def _block_offsets(path: Path, cells, types=SHELL_TYPES) -> list[int | None]:
+    """Global index of each block's first element among the blocks of ``types`` (the
+    shells, or the solids); None for the other blocks."""
     offsets: list[int | None] = []
     n = 0
     for block in cells:
-        if block.type in SHELL_TYPES:
+        if block.type in types:
             offsets.append(n)
             n += len(block.data)
+        elif block.type in SHELL_TYPES + SOLID_TYPES:
+            offsets.append(None)
+        elif types is not SHELL_TYPES:
+            offsets.append(None)  # (told of by the shells' pass)
         elif block.type in SKIPPED_TYPES:
             warnings.warn(f"{path}: skipping {len(block.data)} {block.type!r} elements "
                           "(only shell quads and triangles are read)", InputWarning,
@@ -102,9 +124,10 @@ def _block_offsets(path: Path, cells) -> list[int | None]:
             offsets.append(None)
         else:
             raise InputError(
-                f"{path}: element type {block.type!r} (meshio's name) is not a shell; valid: "
-                "4-node quads (S4, S4R) and 3-node triangles (S3, S3R); line and vertex "
-                "elements are skipped"
+                f"{path}: element type {block.type!r} (meshio's name) is not a shell or an "
+                "8-node brick; valid: "
+                "4-node quads (S4, S4R), 3-node triangles (S3, S3R) and 8-node bricks "
+                "(C3D8R, C3D8); line and vertex elements are skipped"
             )
     return offsets
 

@@ -33,6 +33,9 @@ class Mesh:
         ply: (n_elems,) ply (part) index of each element.
         node_sets: name → sorted node indices.
         elem_sets: name → element indices.
+        hexes: (n_hexes, 8) node indices of the solid elements (8-node hexahedra, corners
+            in VTK/Abaqus C3D8 order; docs/solid.md), numbered apart from the shells.
+        hex_sets: name → hexahedron indices (the element sets of the solids).
     """
 
     nodes: np.ndarray
@@ -40,6 +43,8 @@ class Mesh:
     ply: np.ndarray
     node_sets: dict[str, np.ndarray] = field(default_factory=dict)
     elem_sets: dict[str, np.ndarray] = field(default_factory=dict)
+    hexes: np.ndarray = field(default_factory=lambda: np.zeros((0, 8), dtype=np.int64))
+    hex_sets: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         self.nodes = np.ascontiguousarray(self.nodes, dtype=float)
@@ -57,6 +62,10 @@ class Mesh:
         _check_indices("quads", self.quads, len(self.nodes), "node")
         self.node_sets = _index_sets("node set", self.node_sets, len(self.nodes), "node")
         self.elem_sets = _index_sets("element set", self.elem_sets, len(self.quads), "element")
+        self.hexes = np.ascontiguousarray(self.hexes, dtype=np.int64).reshape(-1, 8)
+        _check_indices("hexes", self.hexes, len(self.nodes), "node")
+        self.hex_sets = _index_sets("element set", self.hex_sets, len(self.hexes),
+                                    "hexahedron")
 
     @property
     def n_nodes(self) -> int:

@@ -28,6 +28,7 @@ from wovenimpact.materials.fabric import regularised_columns as fabric_regularis
 from wovenimpact.materials.metal import MetalParameters, j2_parameter_row
 from wovenimpact.materials.metal import initial_state as j2_initial_state
 from wovenimpact.materials.metal import regularised_columns as j2_regularised_columns
+from wovenimpact.model.solid import NO_SOLIDS, SolidPart
 
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 
@@ -347,6 +348,9 @@ class Model:
             (0, 1, 0), a body whose axis lies across its travel (RigidBody.axis). A
             Model built without it (empty) has every body nose first
             (:func:`flies_sideways`, :func:`travel_of_row`).
+        solid: the hexahedra (model.solid.SolidPart; ``NO_SOLIDS`` in a model of shells
+            only). Their lumped masses are in ``node_mass``; a node of solids only has no
+            rotations (its rotational degrees of freedom are held, ``bc_code`` FIXED).
         node_sets, elem_sets: named index arrays (outputs, BCs).
         shell_contact: parameters of the shell–shell contact between the surfaces
             (``ply`` labels the surfaces: plies, element sets or connected parts).
@@ -431,6 +435,7 @@ class Model:
     # rigid bodies' (Impactor.edge_radius) and a released blade's half thickness — read by
     # the mesh verdict only, so not in the digest
     striking_radius: float = math.inf
+    solid: SolidPart = NO_SOLIDS
 
     @property
     def n_nodes(self) -> int:
@@ -438,7 +443,12 @@ class Model:
 
     @property
     def n_elems(self) -> int:
+        """The shell elements (the hexahedra are ``n_hexes``)."""
         return self.quads.shape[0]
+
+    @property
+    def n_hexes(self) -> int:
+        return self.solid.n_hexes
 
     def digest(self) -> str:
         """SHA-256 of every array: a checkpoint is only resumed on the same Model."""
@@ -464,6 +474,8 @@ class Model:
         if any(flies_sideways(self, b) for b in range(self.body_params.shape[0])):
             h.update(b"body_travel" + np.ascontiguousarray(self.body_travel).tobytes())
         h.update(np.ascontiguousarray(self.release_elems).tobytes())
+        if self.solid.n_hexes:  # (a model of shells only keeps its digest)
+            self.solid.digest_into(h)
         return h.hexdigest()
 
 
@@ -713,6 +725,7 @@ def build_model(
     max_added_mass_fraction: float = 0.02,
     stable_step: str = "isotropic",
     eroded_nodes: str = "remove",
+    solid: SolidPart | None = None,
 ) -> Model:
     """Assemble a :class:`Model` from a mesh, named sections and constraints.
 
@@ -740,6 +753,8 @@ def build_model(
         eroded_nodes: "remove" (default here; a case's ``run.eroded_nodes`` defaults to
             "keep") or "keep": what becomes of a node that loses its last live element
             (theory §5, "Eroded nodes").
+        solid: the hexahedra on the same nodes (model.solid.solid_part); default none.
+            ``quads`` may then be empty.
     """
     x0 = np.ascontiguousarray(nodes, dtype=float)
     q = np.ascontiguousarray(quads, dtype=np.int64)
@@ -779,7 +794,7 @@ def build_model(
             mats.append(sec.material)
     rows = [sections[n].row(next(i for i, m in enumerate(mats) if m is sections[n].material), n)
             for n in names]
-    sec_table = np.array(rows)
+    sec_table = np.array(rows).reshape(-1, SL.N_SECTION)
     es = np.asarray(elem_section)
     if es.dtype.kind in "US":
         unknown = sorted(set(es.tolist()) - set(names))
@@ -803,17 +818,17 @@ def build_model(
             kinds.append(SL.MAT_ELASTIC)
             params.append(np.array([m.modulus, m.poisson, m.density]))
             states.append(np.zeros(0))
-    n_par = max(len(p) for p in params)
+    n_par = max((len(p) for p in params), default=0)
     mat_params = np.zeros((len(mats), n_par))
     for i, p in enumerate(params):
         mat_params[i, : len(p)] = p
     # per section: its points' state blocks side by side, each padded to the longest
     # state vector of the model's kinds (width of the table: the widest section)
-    point_width = max(len(st) for st in states)
+    point_width = max((len(st) for st in states), default=0)
     padded = [np.pad(st, (0, point_width - len(st))) for st in states]
     blocks = [np.tile(padded[int(r[SL.C_MAT])], int(r[SL.C_POINTS]) * int(r[SL.C_INPLANE]))
               if point_width else np.zeros(0) for r in sec_table]
-    section_state0 = np.zeros((len(blocks), max(1, max(len(b) for b in blocks))))
+    section_state0 = np.zeros((len(blocks), max(1, max((len(b) for b in blocks), default=0))))
     for i, b in enumerate(blocks):
         section_state0[i, : len(b)] = b
     # the material rows each element owns (``State.mat``, one row per point): packed, so
@@ -851,6 +866,18 @@ def build_model(
         raise InputError(f"boundary conditions are for {bcs.code.shape[0]} nodes, mesh has {len(x0)}")
     if bcs.ramp_time < 0.0:
         raise InputError(f"ramp_time = {bcs.ramp_time!r} s must be ≥ 0")
+    solid = NO_SOLIDS if solid is None else solid
+    bc_code = bcs.code.copy()
+    if solid.n_hexes:
+        if solid.node_ptr.shape != (len(x0) + 1,):
+            raise InputError(f"the solid part is for {solid.node_ptr.shape[0] - 1} nodes, the "
+                             f"mesh has {len(x0)}")
+        node_mass += solid.node_masses(len(x0))
+        # a node of solids only has no rotations: they are held (no rotary inertia)
+        in_shell = np.zeros(len(x0), dtype=bool)
+        in_shell[q.ravel()] = True
+        solid_only = np.flatnonzero(~in_shell & (np.diff(solid.node_ptr) > 0))
+        bc_code[solid_only, 3:] = FIXED
     ba = np.zeros((len(x0), 3)) if body_accel is None else np.broadcast_to(
         np.asarray(body_accel, dtype=float), (len(x0), 3)).copy()
     ptr, n_elem, n_corner = node_element_map(q, len(x0))
@@ -878,7 +905,7 @@ def build_model(
         section_state0=section_state0, point_width=int(point_width), mat_row=mat_row,
         ref_grad=ref_grad, area0=area0, gauss_grad=gauss_grad, gauss_weight=gauss_weight,
         node_mass=node_mass, node_inertia=node_inertia,
-        bc_code=bcs.code.copy(), bc_velocity=bcs.velocity.copy(), ramp_time=float(bcs.ramp_time),
+        bc_code=bc_code, bc_velocity=bcs.velocity.copy(), ramp_time=float(bcs.ramp_time),
         body_accel=ba, node_ptr=ptr, node_elem=n_elem, node_corner=n_corner, alpha=float(alpha),
         erode_dt_fraction=float(erode_dt_fraction),
         ply=np.zeros(len(q), dtype=np.int64) if ply is None else np.asarray(ply, dtype=np.int64),
@@ -893,5 +920,5 @@ def build_model(
         mass_scaling_fraction=float(mass_scaling_fraction),
         max_added_mass_fraction=float(max_added_mass_fraction), elem_mass=m_el,
         elem_rot_inertia=elem_rot_inertia, elem_length=elem_length, elem_failure=elem_failure,
-        stable_step=str(stable_step), eroded_nodes=str(eroded_nodes),
+        stable_step=str(stable_step), eroded_nodes=str(eroded_nodes), solid=solid,
     )

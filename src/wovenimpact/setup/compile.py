@@ -1,7 +1,7 @@
 """From a validated case (:class:`~wovenimpact.spec.case.CaseSpec`) to Model and initial State.
 
-Reads the material files, makes the mesh (structured plate or Abaqus ``.inp``),
-assigns sections, turns the ``[[boundary]]`` entries into per-DOF constraints and
+Reads the material files, makes the mesh (structured plate, a block of hexahedra or an
+Abaqus ``.inp``), assigns shell and solid sections (:func:`solid_sections`), turns the ``[[boundary]]`` entries into per-DOF constraints and
 the ``[[initial_velocity]]`` entries into the velocity field at t = 0. Errors name
 the case key that is wrong. Then, in order: the pre-run checks
 (:mod:`~wovenimpact.setup.sanity`), and for a spinning blade the spin-up
@@ -27,6 +27,13 @@ from wovenimpact.model.abaqus import read_inp
 from wovenimpact.model.casing import blade_mesh, casing_mesh, circumferential_directions, join
 from wovenimpact.model.gmsh import gmsh_hint, read_msh
 from wovenimpact.model.mesh import Mesh, node_set, plate_mesh
+from wovenimpact.model.solid import (
+    SolidPart,
+    SolidSection,
+    block_mesh,
+    is_solid_material,
+    solid_part,
+)
 from wovenimpact.model.model import (
     BoundaryConditions,
     Model,
@@ -42,6 +49,7 @@ from wovenimpact.spec.case import (
     DOFS,
     LARGE_MESH,
     SYMMETRY_AXIS,
+    BlockMeshSpec,
     CaseSpec,
     ContainmentMeshSpec,
     ImportedMeshSpec,
@@ -103,6 +111,8 @@ def make_mesh(spec: CaseSpec, base: Path, sections: dict | None = None
     surfaces (:func:`contact_surfaces`). A plate with ``ply_sections`` needs the
     sections (their thicknesses stack the plies when no spacing is given)."""
     m = spec.mesh
+    if isinstance(m, BlockMeshSpec):  # hexahedra only (solid_sections)
+        return block_mesh(m.size, m.elements, m.origin), []
     if isinstance(m, PlateMeshSpec):
         thick = None
         if m.ply_sections is not None and m.spacing is None:
@@ -129,7 +139,9 @@ def make_mesh(spec: CaseSpec, base: Path, sections: dict | None = None
                          "(--set run.allow_large_mesh=true) to build it all the same)")
     mesh.nodes *= m.length_unit
     names: list[str | None] = [None] * mesh.n_elems
-    for elset, section in m.sections.items():
+    shell_sets = [k for k, v in m.sections.items() if v not in spec.solid_sections]
+    for elset in shell_sets:
+        section = m.sections[elset]
         if elset not in mesh.elem_sets:
             raise InputError(f"mesh.sections: element set {elset!r} is not in {m.file}; "
                              f"sets there: {sorted(mesh.elem_sets)}{gmsh_hint(m.file)}")
@@ -146,8 +158,54 @@ def make_mesh(spec: CaseSpec, base: Path, sections: dict | None = None
     if missing:
         raise InputError(f"mesh.sections: {len(missing)} elements (first: {missing[0]}) are in "
                          "none of the listed element sets; every element needs a section")
-    mesh.ply = contact_surfaces(mesh, spec.contact.surfaces, list(m.sections))
+    mesh.ply = contact_surfaces(mesh, spec.contact.surfaces, shell_sets)
     return mesh, names  # type: ignore[return-value]
+
+
+def solid_sections(spec: CaseSpec, materials: dict, mesh: Mesh) -> SolidPart | None:
+    """The hexahedra of the mesh with their sections (``[solid_sections.NAME]``): all of
+    a block's its ``mesh.section``'s, an imported mesh's by the element sets of
+    ``mesh.sections`` that name a solid section. None for a mesh without hexahedra."""
+    sections = {}
+    for name, s in spec.solid_sections.items():
+        if not is_solid_material(materials[s.material]):
+            raise InputError(f"solid_sections.{name}.material: {s.material!r} is not a "
+                             "transversely isotropic material (valid: a material file of "
+                             "kind = 'transversely_isotropic')")
+        sections[name] = SolidSection(materials[s.material], hourglass=s.hourglass,
+                                      fibre_direction=s.fibre_direction,
+                                      second_direction=s.second_direction)
+    m = spec.mesh
+    n = mesh.hexes.shape[0]
+    if isinstance(m, BlockMeshSpec):
+        names: list[str | None] = [m.section] * n
+    elif isinstance(m, ImportedMeshSpec):
+        names = [None] * n
+        for elset, section in m.sections.items():
+            if section not in sections:
+                continue
+            if elset not in mesh.hex_sets or not len(mesh.hex_sets[elset]):
+                raise InputError(f"mesh.sections: element set {elset!r} of {m.file} holds no "
+                                 f"8-node brick (C3D8R, C3D8), so solid section {section!r} "
+                                 f"would be given to nothing; sets of bricks there: "
+                                 f"{sorted(k for k, v in mesh.hex_sets.items() if len(v))}")
+            for e in mesh.hex_sets[elset]:
+                if names[e] is not None and names[e] != section:
+                    raise InputError(f"mesh.sections: brick {e} is in two sets with different "
+                                     f"sections ({names[e]!r} and {section!r})")
+                names[e] = section
+        missing = [e for e, s in enumerate(names) if s is None]
+        if missing:
+            raise InputError(f"mesh.sections: {len(missing)} 8-node bricks (first: {missing[0]}) "
+                             "are in no element set given a solid section "
+                             "([solid_sections.NAME]); every element needs a section")
+    else:
+        return None
+    if not n:
+        return None
+    used = list(dict.fromkeys(names))
+    return solid_part(mesh.nodes, mesh.hexes, {k: sections[k] for k in used}, names,
+                      sets=mesh.hex_sets)
 
 
 def contact_surfaces(mesh: Mesh, how: str, elsets: list[str]) -> np.ndarray:
@@ -414,6 +472,11 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     """Build the Model and the State at t = 0 of a case (paths relative to ``base``)."""
     base = Path(base)
     materials = {n: load_case_material(base, n, ref) for n, ref in spec.materials.items()}
+    for name, s in spec.sections.items():
+        if is_solid_material(materials[s.material]):
+            raise InputError(f"sections.{name}.material: {s.material!r} is a transversely "
+                             "isotropic material, for solid sections (valid: a fabric or "
+                             "metal for a shell section, or [solid_sections.NAME])")
     sections = {
         name: Section(
             material=materials[s.material], thickness=s.thickness,
@@ -487,6 +550,7 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
                                 fraction=0.25 if quarter else 1.0, axial_only=quarter,
                                 axis=im.axis))
     used = {s: i for i, s in enumerate(dict.fromkeys(elem_sections))}
+    solid = solid_sections(spec, materials, mesh)
     model = build_model(
         mesh.nodes, mesh.quads, {s: sections[s] for s in used},
         np.array([used[s] for s in elem_sections], dtype=np.int64), bcs=bcs,
@@ -505,6 +569,7 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         max_added_mass_fraction=spec.run.max_added_mass_fraction,
         stable_step=spec.run.stable_step,
         eroded_nodes=spec.run.eroded_nodes,
+        solid=solid,
     )
     v = np.zeros((mesh.n_nodes, 3))
     w = np.zeros((mesh.n_nodes, 3))

@@ -57,18 +57,32 @@ def _text(seconds: float) -> str:
 
 def first_step(model, state) -> tuple[float, int]:
     """Δt₁ = α min_e L_e/c_e at the initial state and the governing element (one pass of
-    the element kernel; nothing in ``state`` changes)."""
+    the element kernels; nothing in ``state`` changes). The shells are elements 0 …
+    n_elems − 1; element n_elems + h is hexahedron h (:func:`element_name`)."""
+    from wovenimpact.kernels.solid_layout import H_DT
     from wovenimpact.solver.explicit import Workspace, element_steps, shell_forces
+    from wovenimpact.solver.solid_stage import solid_forces
 
     ws = Workspace.for_model(model, state)
     shell_forces(model, state, ws)
     dt_el = element_steps(ws.elem)
+    if model.n_hexes:
+        solid_forces(model, state, ws.hex, ws.solid)
+        dt_el = np.concatenate([dt_el, ws.hex[:, H_DT]])
     e = int(np.argmin(dt_el))
     return model.alpha * float(dt_el[e]), e
 
 
+def element_name(model, e: int) -> str:
+    """"element e" for a shell, "hexahedron h" for element n_elems + h (first_step)."""
+    return f"element {e}" if e < model.n_elems else f"hexahedron {e - model.n_elems}"
+
+
 def element_length(model, e: int) -> float:
-    """L_e = area / longest edge of element ``e`` at t = 0 (the kernel's length)."""
+    """L_e = area / longest edge of element ``e`` at t = 0 (the kernel's length); for a
+    hexahedron (e ≥ n_elems) its shortest edge."""
+    if e >= model.n_elems:
+        return float(_hex_edges(model, [e - model.n_elems]).min())
     p = model.x0[model.quads[e]]
     edges = np.linalg.norm(np.roll(p, -1, axis=0) - p, axis=1)
     return float(model.area0[e] / edges.max())
@@ -76,6 +90,15 @@ def element_length(model, e: int) -> float:
 
 def _section_text(model, e: int, spec) -> str:
     """The section and material of element ``e`` with the values that set its step."""
+    if e >= model.n_elems:
+        from wovenimpact.kernels import solid_layout as HL
+
+        s = model.solid
+        h = e - model.n_elems
+        p = s.params[s.mat[h]]
+        return (f"solid section {s.section_names[s.section[h]]!r} (material "
+                f"{s.material_names[s.mat[h]]!r}): E11 {p[HL.TI_E11]:.3g} Pa, E22 "
+                f"{p[HL.TI_E22]:.3g} Pa, density {p[HL.TI_RHO]:.3g} kg/m^3")
     sec = int(model.elem_section[e])
     row = model.sections[sec]
     name = model.section_names[sec] if sec < len(model.section_names) else str(sec)
@@ -96,7 +119,7 @@ def check_step_count(model, state, spec) -> float:
     if steps < 1.0:
         warnings.warn(
             f"run.end_time = {_text(end_time)} is shorter than the first step (Δt = {dt:.3g} s, "
-            f"element {e}): the run is one step", InputWarning, stacklevel=3)
+            f"{element_name(model, e)}): the run is one step", InputWarning, stacklevel=3)
     if steps <= max_steps:
         return dt
     length = element_length(model, e)
@@ -110,7 +133,8 @@ def check_step_count(model, state, spec) -> float:
                f"{speed:.3g} m/s): run.end_time = {_text(end_time)} is long for this model")
     raise InputError(
         f"run: the run would take {steps:.3g} steps (run.end_time = {_text(end_time)} / first "
-        f"Δt = {dt:.3g} s, governed by element {e}), more than run.max_steps = {max_steps:g}; "
+        f"Δt = {dt:.3g} s, governed by {element_name(model, e)}), more than run.max_steps = "
+        f"{max_steps:g}; "
         f"{why} (valid: fewer steps, or a larger run.max_steps if this is meant)")
 
 
@@ -215,9 +239,21 @@ def _edges(model, elems=slice(None)) -> np.ndarray:
     return edges[edges > 0]
 
 
+def _hex_edges(model, hexes=slice(None)) -> np.ndarray:
+    """The 12 reference edge lengths (m) of each of ``hexes`` (n, 12)."""
+    p = model.x0[model.solid.hexes[hexes]]  # (n, 8, 3): two faces of 4, 4 → 8 above
+    ring = np.linalg.norm(np.roll(p[:, :4], -1, axis=1) - p[:, :4], axis=2)
+    top = np.linalg.norm(np.roll(p[:, 4:], -1, axis=1) - p[:, 4:], axis=2)
+    up = np.linalg.norm(p[:, 4:] - p[:, :4], axis=2)
+    return np.concatenate([ring, top, up], axis=1)
+
+
 def smallest_edge(model) -> float:
-    """The smallest reference edge length of the model (m; 0 without elements)."""
+    """The smallest reference edge length of the model, shells and hexahedra (m; 0
+    without elements)."""
     edges = _edges(model)
+    if model.n_hexes:
+        edges = np.concatenate([edges, _hex_edges(model).ravel()])
     return float(edges.min()) if edges.size else 0.0
 
 
@@ -296,7 +332,9 @@ def check_impactor(spec, model, state) -> None:
             f"impactor.radius = {im.radius:.3g} m is more than {MAX_RADIUS_EXTENTS:g} times the "
             f"whole structure ({extent:.3g} m across) (valid: an impactor the mesh resolves)")
     p_face = model.x0[model.quads]
-    h = float(np.linalg.norm(np.roll(p_face, -1, axis=1) - p_face, axis=2).max())
+    h = float(np.linalg.norm(np.roll(p_face, -1, axis=1) - p_face, axis=2).max(initial=0.0))
+    if model.n_hexes:
+        h = max(h, float(_hex_edges(model).max()))
     if im.radius < MIN_RADIUS_ELEMENTS * h:
         raise InputError(
             f"impactor.radius = {im.radius:.3g} m is less than {MIN_RADIUS_ELEMENTS:g} of the "

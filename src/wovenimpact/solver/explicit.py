@@ -2,7 +2,8 @@
 
     1. element forces at x^n: corotational shells, material update F^{n−1} → F^n,
        bending/shear/hourglass rates over Δt^{n−1/2}; min_e L_e/c_e  (kernels.shell)
-    2. nodal forces gathered through the node → element map    (kernels.gather)
+       and the hexahedra's corner forces, their l_e/c_e            (solver.solid_stage)
+    2. nodal forces gathered through the node → element maps   (kernels.gather)
     3. stable step Δt^{n+1/2} = α min_e L_e / c_e               (eq. 4.8–4.11)
     4. central differences for v^{n+1/2}, x^{n+1}; reactions;   (kernels.integrate)
        work and kinetic energy
@@ -51,6 +52,12 @@ from wovenimpact.solver.contact_stage import (
     contact_forces,
 )
 from wovenimpact.solver.element_blocks import block_plan, block_scratch
+from wovenimpact.solver.solid_stage import (
+    SolidBuffers,
+    governing_hexahedron,
+    solid_energies,
+    solid_forces,
+)
 from wovenimpact.kernels.shell import internal_force_for_shells
 from wovenimpact.kernels.shell_blocks import internal_force_blocks
 from wovenimpact.state import (
@@ -66,6 +73,7 @@ from wovenimpact.state import (
     W_EXT,
     W_INT,
     State,
+    initial_hex_rows,
 )
 
 DT_COLLAPSE = 1e-3  # a step below this fraction of the first one stops the run
@@ -110,6 +118,8 @@ class Workspace:
     node_map: NodeMap = None  # the Model's node → (element, corner) map
     energies: NodeEnergies = None  # w_int, w_ext, ke, ke_eroded (above)
     contact: object = None  # solver.contact_stage.ContactBuffers
+    hex: np.ndarray = None  # the hexahedra's state at the end of the step (State.hex)
+    solid: object = None  # solver.solid_stage.SolidBuffers
     plan: object = None  # kernels.bundles.BlockPlan: the elements taken in blocks, or None
     scratch: object = None  # kernels.bundles.BlockScratch for the block stages
     dt_min: float = math.inf  # min_e L_e/c_e of the last element stage
@@ -133,6 +143,8 @@ class Workspace:
             state.mass_ratio = np.zeros(ne)
         if state.contact_work.shape != (n,):
             state.contact_work = np.zeros(n)
+        if state.hex.shape[0] != model.n_hexes:  # a State built by hand, without its solids
+            state.hex = initial_hex_rows(model.n_hexes)
         mass, inertia = node_masses(model.node_mass, model.node_inertia, state.added_mass)
         ws = cls(
             elem=state.elem.copy(), mat=state.mat.copy(),  # dead rows stay equal (shell_force)
@@ -142,7 +154,8 @@ class Workspace:
             f_ext=np.zeros((n, 6)), live=np.zeros(n, dtype=np.int64), w_int=np.zeros(n),
             w_ext=np.zeros(n), ke=np.zeros(n), ke_eroded=np.zeros(n),
             node_mass=mass, node_inertia=inertia, added_ke=np.zeros(n),
-            contact=ContactBuffers.for_model(model),
+            contact=ContactBuffers.for_model(model), hex=state.hex.copy(),
+            solid=SolidBuffers.for_model(model),
         )
         ws.mesh = ShellMesh(
             quads=model.quads, elem_section=model.elem_section, sections=model.sections,
@@ -233,13 +246,24 @@ def stable_step(model, state: State, ws: Workspace, dt_cap: float) -> float:
     an error message.
     """
     scale_masses(model, state, ws)
-    dt = min(model.alpha * ws.dt_min, dt_cap)
+    dt = min(model.alpha * min(ws.dt_min, ws.solid.dt_min), dt_cap)
+    solid_governs = ws.solid.dt_min < ws.dt_min
     if not math.isfinite(dt) or dt <= 0.0:
-        dt_el = element_steps(ws.elem)
-        e = int(np.argmin(dt_el))
+        if solid_governs or not model.n_elems:
+            where = governing_hexahedron(model, ws.hex) if model.n_hexes else "no element"
+        else:
+            dt_el = element_steps(ws.elem)
+            e = int(np.argmin(dt_el))
+            where = f"element {e}: {dt_el[e]!r}"
         raise SimulationError(
-            f"no stable time step at t = {state.t:.6e} s (element {e}: {dt_el[e]!r}); "
+            f"no stable time step at t = {state.t:.6e} s ({where}); "
             "every element eroded, or a non-finite state"
+        )
+    if state.dt_first > 0.0 and dt < DT_COLLAPSE * state.dt_first and solid_governs:
+        raise SimulationError(
+            f"time step collapsed at t = {state.t:.6e} s: Δt = {dt:.3e} s is below "
+            f"{DT_COLLAPSE:g} of the first step ({state.dt_first:.3e} s), governed by "
+            f"{governing_hexahedron(model, ws.hex)}: it is nearly crushed or distorted"
         )
     if state.dt_first > 0.0 and dt < DT_COLLAPSE * state.dt_first:
         e = int(np.argmin(element_steps(ws.elem)))
@@ -281,8 +305,14 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     if state.t >= model.release_time:
         release(model, state)
     t0 = time.perf_counter()
-    shell_forces(model, state, ws)
-    t0 = ws.tick("shell forces", t0)
+    if model.n_elems or not model.n_hexes:
+        shell_forces(model, state, ws)
+        t0 = ws.tick("shell forces", t0)
+    else:  # hexahedra only
+        ws.dt_min, ws.n_eroded = math.inf, 0
+    if model.n_hexes:
+        solid_forces(model, state, ws.hex, ws.solid)
+        t0 = ws.tick("solid forces", t0)
     dt_new = stable_step(model, state, ws, dt_cap)
     t0 = ws.tick("stable step", t0)
     cb = ws.contact
@@ -296,7 +326,7 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
     t0 = ws.tick("contact", t0)
     amplitude = smooth_step(state.t + 0.5 * dt_new, model.ramp_time)
     n_bad = gather_and_update(
-        ws.node_map, ws.results,
+        ws.node_map, ws.results, ws.solid.gather,
         NodeModel(mass=ws.node_mass, inertia=ws.node_inertia, bc_code=model.bc_code,
                   bc_velocity=model.bc_velocity, body_accel=model.body_accel,
                   keep_free=model.eroded_nodes == "keep"),
@@ -345,6 +375,8 @@ def step(model, state: State, ws: Workspace, dt_cap: float = math.inf) -> None:
         ))
     state.elem, ws.elem = ws.elem, state.elem
     state.mat, ws.mat = ws.mat, state.mat
+    if model.n_hexes:
+        state.hex, ws.hex = ws.hex, state.hex
     state.f_int, ws.f_int = ws.f_int, state.f_int
     state.f_ext, ws.f_ext = ws.f_ext, state.f_ext
     if state.dt_first == 0.0:
@@ -428,7 +460,7 @@ def energy_balance(model, state: State) -> dict[str, float]:
     (:func:`error_fraction`: 0 while no energy has been put in).
 
     The internal work is split, each joule once: ``stored_J`` and ``hourglass_J`` are
-    held by live elements; an eroded element keeps its energies at erosion frozen in its
+    held by live elements (shells and hexahedra); an eroded element keeps its energies at erosion frozen in its
     state and they count only in ``eroded_internal_J`` (booked by ``step``), of which
     ``eroded_hourglass_J`` was hourglass energy. The rest of W_int was dissipated
     (broken yarns, damping of the contact's or the material's).
@@ -439,6 +471,10 @@ def energy_balance(model, state: State) -> dict[str, float]:
                             state.elem[:, SL.E_U_HG])
     stored = float(np.sum(np.where(live, u_memb + u_bend, 0.0)))
     hourglass = float(np.sum(np.where(live, u_hg, 0.0)))
+    if model.n_hexes:  # the hexahedra's, booked alike (docs/solid.md §4)
+        solid_stored, solid_hourglass = solid_energies(state)
+        stored += solid_stored
+        hourglass += solid_hourglass
     eroded_hg = float(np.sum(np.where(live, 0.0, u_hg)))
     external = en[W_EXT] - en[NODE_CONTACT_WORK]
     body = body_force_work(model, state)

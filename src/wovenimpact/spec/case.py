@@ -29,6 +29,8 @@ Schema (see README and examples/cases/)::
                       points? (1: resultant section; odd n ≥ 3: n Simpson points),
                       membrane? ("full": 2×2 in-plane points, fabric default;
                       "reduced": one point + hourglass springs, metal default)
+    [solid_sections.NAME]  material (transversely_isotropic), hourglass?,
+                      fibre_direction?, second_direction? (8-node hexahedra, docs/solid.md)
     [mesh]            kind = "plate": side, width? (a rectangle: side along x, width
                       along y), element_size, plies, spacing, quarter,
                       section, warp_direction   | kind = "abaqus" | "gmsh": file,
@@ -42,6 +44,8 @@ Schema (see README and examples/cases/)::
                       offset_layers), [mesh.blade] (section, root/crack/tip_radius,
                       root/tip_chord, angle, stagger, twist, tip_curve, element_size:
                       the blade's own, default mesh.element_size)
+                      | kind = "block": size, elements, origin?, section (a box of
+                      hexahedra; an imported mesh's C3D8R / C3D8 elements are solids too)
     [[boundary]]      nodes = SET, type = clamped | pinned | symmetry_x | symmetry_y |
                       symmetry_z | velocity (with dof and velocity)
     [spin]            rate, release_time, relaxation_tolerance (containment cases)
@@ -165,6 +169,35 @@ class SectionSpec(BaseModel):
     # in-plane membrane integration: "full" 2×2 Gauss points (default for fabric) or
     # "reduced" one point + hourglass springs (default for metals); theory §4.5
     membrane: Literal["full", "reduced"] | None = None
+
+
+class SolidSectionSpec(BaseModel):
+    """``[solid_sections.NAME]``: a solid section, 8-node hexahedra of a transversely
+    isotropic material (docs/solid.md) whose fibre axis a1 is ``fibre_direction`` and
+    second axis a2 ``second_direction`` projected off a1."""
+
+    model_config = STRICT
+    material: str = Field(min_length=1)
+    # r of the hourglass stiffness k = r G_hg V0 Σ b⁰·b⁰ (docs/solid.md §1.3)
+    hourglass: quantity("dimensionless", ge=0, lt=1, example="0.05") = 0.05
+    fibre_direction: Direction = (1.0, 0.0, 0.0)
+    # not given: the global axis least aligned with the fibre
+    second_direction: Direction | None = None
+
+
+class BlockMeshSpec(BaseModel):
+    """``[mesh] kind = "block"``: a box of 8-node hexahedra of one solid section, ``size``
+    along x, y and z from the corner ``origin``, ``elements`` along each edge. Node sets
+    ``all``, ``x_min``, ``x_max``, ``y_min``, ``y_max``, ``z_min``, ``z_max`` (its faces)."""
+
+    model_config = STRICT
+    kind: Literal["block"]
+    size: tuple[Length, Length, Length]
+    elements: tuple[integer(ge=1, example=10), integer(ge=1, example=2),
+                    integer(ge=1, example=2)]
+    origin: tuple[Coordinate, Coordinate, Coordinate] = (0.0, 0.0, 0.0)
+    # a solid section (solid_sections)
+    section: str = Field(min_length=1)
 
 
 class PlateMeshSpec(BaseModel):
@@ -564,8 +597,10 @@ class CaseSpec(BaseModel):
     model_config = STRICT
     case: CaseInfo
     materials: dict[str, str | MaterialRef] = Field(min_length=1)
-    sections: dict[str, SectionSpec] = Field(min_length=1)
-    mesh: PlateMeshSpec | ImportedMeshSpec | ContainmentMeshSpec = Field(discriminator="kind")
+    sections: dict[str, SectionSpec] = {}
+    solid_sections: dict[str, SolidSectionSpec] = {}
+    mesh: PlateMeshSpec | ImportedMeshSpec | ContainmentMeshSpec | BlockMeshSpec = Field(
+        discriminator="kind")
     boundary: list[BoundarySpec] = []
     amplitude: AmplitudeSpec = AmplitudeSpec()
     initial_velocity: list[InitialVelocitySpec] = []
@@ -584,6 +619,8 @@ def mesh_sections(mesh) -> list[tuple[str, str]]:
             (f"mesh.ply_sections[{k}]", s) for k, s in enumerate(mesh.ply_sections or ())]
     if isinstance(mesh, ImportedMeshSpec):
         return [("mesh.sections", s) for s in mesh.sections.values()]
+    if isinstance(mesh, BlockMeshSpec):
+        return [("mesh.section", mesh.section)]
     out = [("mesh.casing.layer_section", mesh.casing.layer_section),
            ("mesh.blade.section", mesh.blade.section)]
     if mesh.casing.inner_section is not None:
@@ -601,13 +638,29 @@ def is_containment_spec(spec: CaseSpec) -> bool:
 def check_references(spec: CaseSpec) -> list[Problem]:
     """Cross-references a schema cannot see: section → material, mesh → section."""
     problems = []
-    for name, sec in spec.sections.items():
-        if sec.material not in spec.materials:
-            problems.append(Problem(f"sections.{name}.material", "names no material",
-                                    sec.material, f"one of {sorted(spec.materials)}"))
+    if not spec.sections and not spec.solid_sections:
+        problems.append(Problem("sections", "is missing", valid="a [sections.NAME] table "
+                                "(shells) or a [solid_sections.NAME] table (hexahedra)"))
+    for table in ("sections", "solid_sections"):
+        for name, sec in getattr(spec, table).items():
+            if sec.material not in spec.materials:
+                problems.append(Problem(f"{table}.{name}.material", "names no material",
+                                        sec.material, f"one of {sorted(spec.materials)}"))
+    for name in sorted(set(spec.sections) & set(spec.solid_sections)):
+        problems.append(Problem(f"solid_sections.{name}", "has the name of a shell section",
+                                valid="a name not used in [sections]"))
+    known = sorted(set(spec.sections) | set(spec.solid_sections))
     for key, s in mesh_sections(spec.mesh):
-        if s not in spec.sections:
-            problems.append(Problem(key, "names no section", s, f"one of {sorted(spec.sections)}"))
+        if s not in known:
+            problems.append(Problem(key, "names no section", s, f"one of {known}"))
+    if isinstance(spec.mesh, BlockMeshSpec) and spec.mesh.section in spec.sections:
+        problems.append(Problem("mesh.section", "names a shell section", spec.mesh.section,
+                                f"a solid section, one of {sorted(spec.solid_sections)}"))
+    if not isinstance(spec.mesh, (BlockMeshSpec, ImportedMeshSpec)):
+        for key, s in mesh_sections(spec.mesh):
+            if s in spec.solid_sections:
+                problems.append(Problem(key, "names a solid section", s, "a shell section, "
+                                        f"one of {sorted(spec.sections)}"))
     if is_containment_spec(spec) and spec.spin is None:
         problems.append(Problem("spin", "is missing", valid="a [spin] table (rate, "
                                 "release_time) for a containment case"))
@@ -673,6 +726,15 @@ def check_mesh_size(m, allow_large: bool = False) -> list[Problem]:
         count = counts[0] * counts[1] * m.plies
         context = (f"side {m.side:g} m, {m.plies} plies" if m.width is None
                    else f"side {m.side:g} m, width {m.width:g} m, {m.plies} plies")
+    elif isinstance(m, BlockMeshSpec):
+        count = float(math.prod(m.elements))
+        if count > MAX_ELEMENTS or (count > LARGE_MESH and not allow_large):
+            limit = MAX_ELEMENTS if count > MAX_ELEMENTS else LARGE_MESH
+            return [Problem("mesh.elements", f"gives {count:.3g} hexahedra, more than "
+                            f"{limit:,}", list(m.elements), "fewer elements" + (
+                                "" if count > MAX_ELEMENTS else ", or run.allow_large_mesh "
+                                "= true to build them all the same"))]
+        return []
     elif isinstance(m, ContainmentMeshSpec):
         c, b = m.casing, m.blade
         fragment = b.tip_radius - b.crack_radius
@@ -774,7 +836,7 @@ def warn_missing_symmetry(spec: CaseSpec, source: str = "<dict>") -> None:
 
 def _without_mesh_kind(p: Problem) -> Problem:
     """``mesh.plate.side`` → ``mesh.side``: the kind selects the table, it is not a key."""
-    for kind in ("plate", "abaqus", "gmsh", "containment"):
+    for kind in ("plate", "abaqus", "gmsh", "containment", "block"):
         if p.path.startswith(f"mesh.{kind}."):
             return dataclasses.replace(p, path="mesh." + p.path[len(kind) + 6:])
     return p

@@ -3,7 +3,9 @@
 ``[material] kind = "woven_fabric"`` gives :class:`~wovenimpact.materials.fabric.FabricParameters`
 (docs/model.md §1, thesis Tables 5-1 and 7-2); ``kind = "j2_plastic"`` or ``"elastic"`` gives
 :class:`~wovenimpact.materials.metal.MetalParameters` (docs/model.md §5, thesis Tables 7-1,
-8-1, 8-2). Every dimensioned value carries its unit (``"96 GPa"``) and is converted
+8-1, 8-2); ``kind = "transversely_isotropic"`` gives
+:class:`~wovenimpact.materials.transverse_isotropic.TransverseIsotropicParameters`, the
+material of solid sections (docs/solid.md §2, thesis Table 5-2). Every dimensioned value carries its unit (``"96 GPa"``) and is converted
 to SI once, here. Unknown keys, missing units, wrong dimensions and unphysical
 values are errors; all problems of a file are reported together in one
 :class:`~wovenimpact.errors.InputError`, one line each::
@@ -30,6 +32,7 @@ from typing import Any, Literal
 import numpy as np
 from pydantic import BaseModel, Field, ValidationError
 
+from wovenimpact.errors import InputError
 from wovenimpact.kernels.fabric_layout import REG_ROWS_MAX
 from wovenimpact.kernels.j2_layout import FRAC_ROWS_MAX, N_HARD_MAX
 from wovenimpact.materials.crimp import crimp_amplitude, half_length_from_thread_count
@@ -45,6 +48,7 @@ from wovenimpact.materials.metal import (
     MetalParameters,
     RateParameters,
 )
+from wovenimpact.materials.transverse_isotropic import TransverseIsotropicParameters
 from wovenimpact.spec.fields import (
     STRICT,
     InputWarning,
@@ -249,6 +253,33 @@ class ElasticSpec(BaseModel):
     poisson: quantity("dimensionless", ge=0, lt=0.5, example="0.3")
 
 
+class TransverseIsotropicSpec(BaseModel):
+    """``[material]`` with ``kind = "transversely_isotropic"``: a linear elastic solid
+    stiff along its fibre axis a1 (the yarn of the 3-D crossover, thesis Table 5-2), for
+    solid sections (docs/solid.md §2)."""
+
+    model_config = STRICT
+    name: str = Field(min_length=1)
+    kind: Literal["transversely_isotropic"]
+    density: quantity("density", ge=MIN_DENSITY, le=MAX_DENSITY, example="1.44 g/cm^3")
+    # along the fibre axis a1
+    e11: quantity("pressure", gt=0, le=MAX_MODULUS, example="96 GPa")
+    # across it (E22 = E33)
+    e22: quantity("pressure", gt=0, le=MAX_MODULUS, example="3.28 GPa")
+    # axial shear modulus G12 = G13
+    g12: quantity("pressure", gt=0, le=MAX_MODULUS, example="3.28 GPa")
+    # transverse shear modulus; not given: E22 / (2 (1 + ν23)), isotropic across the fibre
+    g23: quantity("pressure", gt=0, le=MAX_MODULUS, example="3.28 GPa") | None = None
+    # ν12 = ν13: lateral strain −ν12 ε under a stress along a1
+    nu12: quantity("dimensionless", gt=-1, lt=1, example="0")
+    nu23: quantity("dimensionless", gt=-1, lt=1, example="0")
+
+
+class TransverseIsotropicFile(BaseModel):
+    model_config = STRICT
+    material: TransverseIsotropicSpec
+
+
 class J2File(BaseModel):
     model_config = STRICT
     material: J2Spec
@@ -263,12 +294,15 @@ _FILE_MODELS: dict[str, type[BaseModel]] = {
     "woven_fabric": FabricFile,
     "j2_plastic": J2File,
     "elastic": ElasticFile,
+    "transversely_isotropic": TransverseIsotropicFile,
 }
 
 # --- loading -------------------------------------------------------------------------
 
 
-def load_material(path: str | Path) -> FabricParameters | MetalParameters:
+def load_material(
+    path: str | Path,
+) -> FabricParameters | MetalParameters | TransverseIsotropicParameters:
     """Read a material TOML file and return its validated SI parameters.
 
     Raises:
@@ -280,7 +314,7 @@ def load_material(path: str | Path) -> FabricParameters | MetalParameters:
 
 def material_from_dict(
     d: dict[str, Any], source: str = "<dict>", *, collect_warnings: list[str] | None = None
-) -> FabricParameters | MetalParameters:
+) -> FabricParameters | MetalParameters | TransverseIsotropicParameters:
     """Validate a parsed material document ``{"material": {...}}`` and convert it to SI.
 
     Args:
@@ -308,6 +342,8 @@ def material_from_dict(
     notes: list[str] = []
     if isinstance(spec, FabricSpec):
         result = _fabric_parameters(spec, table, source, notes)
+    elif isinstance(spec, TransverseIsotropicSpec):
+        result = _transverse_isotropic_parameters(spec, source)
     else:
         result = _metal_parameters(spec, table, source)
     for note in notes:
@@ -316,6 +352,19 @@ def material_from_dict(
         else:
             warnings.warn(note, InputWarning, stacklevel=2)
     return result
+
+
+def _transverse_isotropic_parameters(spec: TransverseIsotropicSpec,
+                                     source: str) -> TransverseIsotropicParameters:
+    """The SI parameters; a stiffness that is not positive definite is an InputError
+    naming the file and the constant."""
+    g23 = spec.g23 if spec.g23 is not None else spec.e22 / (2.0 * (1.0 + spec.nu23))
+    try:
+        return TransverseIsotropicParameters(
+            e11=spec.e11, e22=spec.e22, g12=spec.g12, g23=g23, nu12=spec.nu12,
+            nu23=spec.nu23, density=spec.density, name=spec.name)
+    except InputError as err:
+        raise InputError(f"{source}: {err}") from None
 
 
 def _raw(table: dict, *keys: str | int) -> Any:

@@ -9,7 +9,8 @@ same function, so that both give bitwise the same angle.
 ``atan2_upper`` is Cephes' ``atan`` (S. L. Moshier, atan.c): reduction to
 |z| ≤ tan(π/8) and a rational P(z²)/Q(z²), every branch a select. Against libm's
 ``atan2`` over 200 000 angles in (0, π): at most 1.00 ulp, mean 0.20 ulp
-(``python benchmarks/simd_atan2_prototype.py``; a test in tests/unit/test_vecmath.py).
+(measured by a benchmark prototype since removed, see docs/notes/2026-11-element-stage-
+performance.md; tests/unit/test_shell_blocks.py checks the bound).
 """
 
 from __future__ import annotations

@@ -191,47 +191,13 @@ def fracture(
     each mesh's scale s makes it fracture at the finest mesh's elongation. Writes
     MATERIAL_regularised.toml (the file with the fitted [material.regularisation]),
     MATERIAL_fracture.csv and MATERIAL_fracture.png into --out."""
-    from wovenimpact.calibration.fracture_regularisation import (
-        DEFAULT_SIZES,
-        Coupon,
-        calibrate,
-        calibration_rows,
-        shipped_table,
-        write_calibration,
-    )
+    from wovenimpact.calibration.fracture_regularisation import calibrate, write_calibration
     from wovenimpact.io.outdir import prepare_output_dir, write_failure
     from wovenimpact.jit import capped_threads, set_threads
-    from wovenimpact.materials.metal import MetalParameters
-    from wovenimpact.spec.material import load_material
-    from wovenimpact.units import to_si
 
     try:
-        t = to_si(thickness, "length", "--thickness", gt=0.0, example="1 mm")
-        v = to_si(speed, "velocity", "--speed", gt=0.0, example="10 m/s")
-        if sizes is None:
-            hs = [k * t for k in DEFAULT_SIZES]
-        else:
-            hs = [to_si(s.strip(), "length", "--sizes", gt=0.0, example="0.5 mm")
-                  for s in sizes.split(",") if s.strip()]
-        l_ref = (None if reference_length is None else
-                 to_si(reference_length, "length", "--reference-length", gt=0.0))
-        u_f = (0.0 if failure_displacement is None else
-               to_si(failure_displacement, "length", "--failure-displacement", gt=0.0))
-        mat = load_material(material)
-        if not isinstance(mat, MetalParameters) or mat.kind != "j2_plastic":
-            raise InputError(f"{material}: a fracture calibration needs a j2_plastic material")
-        if mat.fracture_strain is None and mat.damage is None:
-            raise InputError(f"{material}: the material has no fracture strain and no "
-                             "[material.damage] table: there is no fracture to regularise")
-        coupon = Coupon(mat, thickness=t, speed=v)
-        if len(hs) < 2 or len(set(hs)) != len(hs):
-            raise InputError(f"--sizes: give at least two different element sizes (got "
-                             f"{', '.join(f'{h * 1e3:g} mm' for h in hs)})")
-        for h in hs:
-            try:
-                coupon.check_size(h)
-            except InputError as err:
-                raise InputError(f"--sizes: {err}") from None
+        coupon, hs, l_ref, u_f = _fracture_inputs(material, sizes, thickness, speed,
+                                                  reference_length, failure_displacement)
         prepare_output_dir(out)
     except InputError as err:
         _fail_input(err)
@@ -248,9 +214,60 @@ def fracture(
         paths = write_calibration(cal, material, out, l_ref)
     except OSError as err:
         _fail_input(InputError(write_failure(err, "the calibration")))
+    result = _fracture_result(cal, l_ref, paths)
+    if as_json:
+        typer.echo(json.dumps(result))
+        return
+    emit({k: (str(v) if isinstance(v, list) else v) for k, v in result.items()}, False,
+         "Fracture regularisation, docs/theory.md §7.3")
+
+
+def _fracture_inputs(material: Path, sizes: str | None, thickness: str, speed: str,
+                     reference_length: str | None, failure_displacement: str | None):
+    """``calibrate fracture``'s options in SI and the coupon: (coupon, element sizes,
+    reference length or None, softening displacement); an InputError names the option."""
+    from wovenimpact.calibration.fracture_regularisation import DEFAULT_SIZES, Coupon
+    from wovenimpact.materials.metal import MetalParameters
+    from wovenimpact.spec.material import load_material
+    from wovenimpact.units import to_si
+
+    t = to_si(thickness, "length", "--thickness", gt=0.0, example="1 mm")
+    v = to_si(speed, "velocity", "--speed", gt=0.0, example="10 m/s")
+    if sizes is None:
+        hs = [k * t for k in DEFAULT_SIZES]
+    else:
+        hs = [to_si(s.strip(), "length", "--sizes", gt=0.0, example="0.5 mm")
+              for s in sizes.split(",") if s.strip()]
+    l_ref = (None if reference_length is None else
+             to_si(reference_length, "length", "--reference-length", gt=0.0))
+    u_f = (0.0 if failure_displacement is None else
+           to_si(failure_displacement, "length", "--failure-displacement", gt=0.0))
+    mat = load_material(material)
+    if not isinstance(mat, MetalParameters) or mat.kind != "j2_plastic":
+        raise InputError(f"{material}: a fracture calibration needs a j2_plastic material")
+    if mat.fracture_strain is None and mat.damage is None:
+        raise InputError(f"{material}: the material has no fracture strain and no "
+                         "[material.damage] table: there is no fracture to regularise")
+    coupon = Coupon(mat, thickness=t, speed=v)
+    if len(hs) < 2 or len(set(hs)) != len(hs):
+        raise InputError(f"--sizes: give at least two different element sizes (got "
+                         f"{', '.join(f'{h * 1e3:g} mm' for h in hs)})")
+    for h in hs:
+        try:
+            coupon.check_size(h)
+        except InputError as err:
+            raise InputError(f"--sizes: {err}") from None
+    return coupon, hs, l_ref, u_f
+
+
+def _fracture_result(cal, l_ref: float | None, paths: dict) -> dict:
+    """``calibrate fracture``'s answer (SI): the reference, the table as shipped, the
+    largest elongation errors before and after, the files written."""
+    from wovenimpact.calibration.fracture_regularisation import calibration_rows, shipped_table
+
     l_ship = cal.reference_size if l_ref is None else l_ref
     rows = calibration_rows(cal)
-    result = {
+    return {
         "reference_size_m": cal.reference_size,
         "reference_elongation_at_fracture_m": cal.reference.elongation_at_fracture,
         "reference_length_m": l_ship,
@@ -260,8 +277,3 @@ def fracture(
         "wall_s": cal.wall_s,
         **{f"{k}_file": str(p) for k, p in paths.items()},
     }
-    if as_json:
-        typer.echo(json.dumps(result))
-        return
-    emit({k: (str(v) if isinstance(v, list) else v) for k, v in result.items()}, False,
-         "Fracture regularisation, docs/theory.md §7.3")

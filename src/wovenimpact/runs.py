@@ -410,7 +410,8 @@ def write_plots(out: Path, title: str, model, state: State, h: dict, summary: di
         fragment_plot(h, plots / "fragment.png", title=title,
                       outcome=summary.get("outcome", ""), markers=markers)
     else:
-        deflection_plot(model, state, plots / "ply_deflection.png", title=title)
+        if model.n_elems:  # (a model of hexahedra has no plies)
+            deflection_plot(model, state, plots / "ply_deflection.png", title=title)
         numbers = np.unique(model.ply)
         names = [f"ply {p}" for p in numbers]
         markers = event_markers(summary.get("ply_perforated_at_s", []),
@@ -536,7 +537,7 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
     """
     model = compiled.model
     eb = energy_balance(model, state)
-    cycles = state.step * model.n_elems
+    cycles = state.step * (model.n_elems + model.n_hexes)
     error = error_fraction(np.max(np.abs(h["energy_drift_part_J"])),
                            h["energy_normaliser_part_J"][-1])
     factor = symmetry_factor(model)
@@ -569,7 +570,7 @@ def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) 
         "case": spec.case.name,
         "end_time_s": float(state.t),
         "steps": int(state.step),
-        "elements": int(model.n_elems),
+        "elements": int(model.n_elems + model.n_hexes),
         "nodes": int(model.n_nodes),
         "first_time_step_s": float(state.dt_first),
         "last_time_step_s": float(state.dt),
@@ -617,8 +618,12 @@ def element_sizes(spec, model) -> dict:
     sector's in a graded ring) and, for a containment case, ``blade_element_size_m``, the
     blade's (``mesh.blade.element_size``, else the casing's). An imported mesh has no
     such key: there each is the median √(element area) of the elements it stands for
-    (the casing layers' and the rest, the blade, in an imported containment mesh)."""
+    (the casing layers' and the rest, the blade, in an imported containment mesh), and a
+    mesh of hexahedra only (``mesh.kind = "block"`` or imported) has the median
+    ∛(hexahedron volume)."""
     mesh = spec.mesh
+    if model.n_hexes and not model.n_elems:
+        return {"element_size_m": float(np.median(np.cbrt(model.solid.vol0)))}
     if mesh.kind == "plate":
         return {"element_size_m": float(mesh.element_size)}
     if mesh.kind == "containment":

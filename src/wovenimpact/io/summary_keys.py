@@ -184,7 +184,8 @@ KEYS: dict[str, Key] = {
     "finished_utc": Key(_R, "finished (UTC)", meaning="when this summary was written"),
     "element_size_m": Key(_R, "element size", *MM,
                           meaning="mesh.element_size (a casing's fine sector); an imported "
-                                  "mesh: median √(element area)"),
+                                  "mesh: median √(element area); hexahedra only: median "
+                                  "∛(element volume)"),
     "blade_element_size_m": Key(_R, "blade element size", *MM,
                                 meaning="mesh.blade.element_size, else the casing's"),
     "mesh_verdict": Key(_R, "mesh verdict",
@@ -201,7 +202,7 @@ KEYS: dict[str, Key] = {
     "mass_scaled_elements": Key(_R, "mass-scaled elements", meaning="elements given mass"),
     "end_time_s": Key(_R, "end time", *MS, meaning="simulated time reached"),
     "steps": Key(_R, "steps", meaning="time steps taken"),
-    "elements": Key(_R, "elements", meaning="shell elements of the model"),
+    "elements": Key(_R, "elements", meaning="shell elements and hexahedra of the model"),
     "nodes": Key(_R, "nodes", meaning="nodes of the model"),
     "first_time_step_s": Key(_R, "first time step", *US, meaning="the stable step at the start"),
     "last_time_step_s": Key(_R, "last time step", *US, meaning="the step at the end"),

@@ -17,6 +17,7 @@ from hypothesis import strategies as st
 from wovenimpact.errors import InputError
 from wovenimpact.materials.fabric import FabricParameters
 from wovenimpact.materials.metal import MetalParameters
+from wovenimpact.materials.transverse_isotropic import TransverseIsotropicParameters
 from wovenimpact.spec import InputWarning, load_material, material_from_dict
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -99,7 +100,7 @@ def test_every_shipped_material_file_loads_without_warnings(path):
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         p = load_material(path)
-    assert isinstance(p, FabricParameters | MetalParameters)
+    assert isinstance(p, FabricParameters | MetalParameters | TransverseIsotropicParameters)
 
 
 @pytest.mark.parametrize(
@@ -452,3 +453,23 @@ def test_crimp_round_trips_as_fraction_or_percent(c, unit):
     p = material_from_dict(edited(kevlar_doc(), "fill.crimp", text), collect_warnings=[])
     assert p.fill.crimp == pytest.approx(c, rel=1e-13, abs=1e-300)
     assert math.isfinite(p.fill.h0) and p.fill.h0 >= 0.0
+
+
+def test_the_solid_yarn_file_holds_table_5_2_and_g23_defaults_to_the_isotropic_value():
+    """kind = "transversely_isotropic" (solid sections, docs/solid.md §4.1): thesis Table
+    5-2 in SI; without g23 the material is isotropic across its fibre; constants that
+    leave the stiffness indefinite are refused naming the file and the constant."""
+    p = load_material(MATERIALS / "kevlar_yarn_solid.toml")
+    assert (p.e11, p.e22, p.g12, p.g23, p.nu12, p.nu23, p.density) == (
+        96e9, 3.28e9, 3.28e9, 3.28e9, 0.0, 0.0, 1440.0)
+    doc = tomllib.loads((MATERIALS / "kevlar_yarn_solid.toml").read_text(encoding="utf-8"))
+    del doc["material"]["g23"]
+    doc["material"]["nu23"] = 0.25
+    p = material_from_dict(doc)
+    assert p.g23 == pytest.approx(3.28e9 / 2.5) and p.is_isotropic_across
+    doc["material"]["nu12"] = 4.0  # |ν12| < √((1 − ν23) E11 / (2 E22)) = 3.3
+    with pytest.raises(InputError, match=r"yarn\.toml: .*nu12"):
+        material_from_dict(doc, source="yarn.toml")
+    doc["material"]["e11"] = "96"
+    with pytest.raises(InputError, match="material.e11"):
+        material_from_dict(doc)

@@ -270,8 +270,10 @@ class TransverseIsotropicSpec(BaseModel):
     g12: quantity("pressure", gt=0, le=MAX_MODULUS, example="3.28 GPa")
     # transverse shear modulus; not given: E22 / (2 (1 + ν23)), isotropic across the fibre
     g23: quantity("pressure", gt=0, le=MAX_MODULUS, example="3.28 GPa") | None = None
-    # ν12 = ν13: lateral strain −ν12 ε under a stress along a1
-    nu12: quantity("dimensionless", gt=-1, lt=1, example="0")
+    # ν12 = ν13: lateral strain −ν12 ε under a stress along a1; with ν23 it must leave the
+    # stiffness positive definite, |ν12| < √((1 − ν23) E11 / (2 E22))
+    nu12: quantity("dimensionless", example="0")
+    # ν23, in the plane across the fibre
     nu23: quantity("dimensionless", gt=-1, lt=1, example="0")
 
 

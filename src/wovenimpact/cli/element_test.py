@@ -98,7 +98,7 @@ def element_test(
     strain rate until it fails (uniaxial: the lateral resultant solved to zero).
     """
     from wovenimpact.calibration.element_plots import plot_element_test, plot_metal_element_test
-    from wovenimpact.calibration.metal_element import METAL_TESTS, run_metal_element_test
+    from wovenimpact.calibration.metal_element import run_metal_element_test
     from wovenimpact.calibration.metal_element import write_history_csv as write_metal_csv
     from wovenimpact.calibration.single_element import run_element_test, write_history_csv
     from wovenimpact.materials.fabric import FabricParameters
@@ -118,27 +118,10 @@ def element_test(
                              "be > 0 and < 1 (e.g. 0.01)")
         params = load_material(material)
         if isinstance(params, MetalParameters):
-            fabric_only = dict(displacement=displacement, homogenisation=homogenisation,
-                               shear_law=shear_law, frame=frame, failure=failure,
-                               softening_strain=softening_strain)
-            given = [k.replace("_", "-") for k, v in fabric_only.items() if v is not None]
-            if given:
-                raise InputError(
-                    f"--{', --'.join(given)}: fabric options, not valid with the metal "
-                    f"{material} (use --strain, --strain-rate, --thickness)"
-                )
-            if params.kind != "j2_plastic":
-                raise InputError(
-                    f"--material {material}: kind {params.kind!r} has no plasticity to test; "
-                    "element tests need woven_fabric or j2_plastic"
-                )
-            if test.value not in METAL_TESTS:
-                raise InputError(
-                    f"test {test.value!r} is not valid for a metal: choose one of "
-                    f"{', '.join(METAL_TESTS)}"
-                )
-            if strain is not None and not strain > 0.0:
-                raise InputError(f"--strain = {strain} is not valid: it must be > 0")
+            _check_metal_options(params, material, test, strain, dict(
+                displacement=displacement, homogenisation=homogenisation,
+                shear_law=shear_law, frame=frame, failure=failure,
+                softening_strain=softening_strain))
             metal = run_metal_element_test(
                 params,
                 test.value,
@@ -158,41 +141,73 @@ def element_test(
             raise InputError(f"--material {material}: element tests need a woven_fabric material")
         if strain is not None:
             raise InputError("--strain is a metal option: give --displacement or --angle")
-        displacement = "0.06 mm" if displacement is None else displacement
         steps = 600 if steps is None else steps
-        overrides = {
-            k: (v.value if isinstance(v, Enum) else v)
-            for k, v in dict(
-                homogenisation=homogenisation,
-                shear=shear_law,
-                frame=frame,
-                failure=failure,
-                softening_strain=softening_strain,
-            ).items()
-            if v is not None
-        }
-        if overrides:
-            opts = dataclasses.replace(params.options, **overrides)
-            if opts.failure == "progressive" and not opts.softening_strain > 0.0:
-                raise InputError(
-                    "--failure progressive needs --softening-strain > 0 "
-                    f"(got {opts.softening_strain})"
-                )
-            params = dataclasses.replace(params, options=opts)
-        if test.value in ("shear", "picture-frame"):
-            amplitude = angle_si
-        else:
-            amplitude = to_si(displacement, "length", "--displacement", gt=0)
-            cell = 2.0 * min(params.warp.half_length, params.fill.half_length)
-            if amplitude > cell:
-                raise InputError(f"--displacement = {displacement!r} is more than the unit "
-                                 f"cell's side 2ℓ0 = {cell * 1e3:.4g} mm (100 % strain; the "
-                                 f"yarns break near 2 %) (valid: up to {cell * 1e3:.4g} mm)")
+        params = _with_overrides(params, dict(homogenisation=homogenisation, shear=shear_law,
+                                              frame=frame, failure=failure,
+                                              softening_strain=softening_strain))
+        amplitude = (angle_si if test.value in ("shear", "picture-frame") else
+                     _extension_amplitude(params, displacement))
         result = run_element_test(params, test.value, amplitude=amplitude, n_steps=steps)
     except (InputError, ValueError, MaterialPointError) as err:
         fail(str(err))
         return
     _write_outputs(out, result, write_history_csv, plot_element_test, test, as_json)
+
+
+def _check_metal_options(params, material: Path, test: Test, strain, fabric_only: dict) -> None:
+    """A metal element test's options: no fabric option given, a j2_plastic material, a
+    metal test, a positive strain (InputError naming the flag otherwise)."""
+    from wovenimpact.calibration.metal_element import METAL_TESTS
+
+    given = [k.replace("_", "-") for k, v in fabric_only.items() if v is not None]
+    if given:
+        raise InputError(
+            f"--{', --'.join(given)}: fabric options, not valid with the metal "
+            f"{material} (use --strain, --strain-rate, --thickness)"
+        )
+    if params.kind != "j2_plastic":
+        raise InputError(
+            f"--material {material}: kind {params.kind!r} has no plasticity to test; "
+            "element tests need woven_fabric or j2_plastic"
+        )
+    if test.value not in METAL_TESTS:
+        raise InputError(
+            f"test {test.value!r} is not valid for a metal: choose one of "
+            f"{', '.join(METAL_TESTS)}"
+        )
+    if strain is not None and not strain > 0.0:
+        raise InputError(f"--strain = {strain} is not valid: it must be > 0")
+
+
+def _with_overrides(params, options: dict):
+    """The fabric's parameters with the options given on the command line (None: the
+    material's own); progressive failure needs a softening strain > 0."""
+    overrides = {k: (v.value if isinstance(v, Enum) else v)
+                 for k, v in options.items() if v is not None}
+    if not overrides:
+        return params
+    opts = dataclasses.replace(params.options, **overrides)
+    if opts.failure == "progressive" and not opts.softening_strain > 0.0:
+        raise InputError(
+            "--failure progressive needs --softening-strain > 0 "
+            f"(got {opts.softening_strain})"
+        )
+    return dataclasses.replace(params, options=opts)
+
+
+def _extension_amplitude(params, displacement: str | None) -> float:
+    """The extension tests' largest edge displacement (SI; default 0.06 mm), at most the
+    unit cell's side 2ℓ0."""
+    from wovenimpact.units import to_si
+
+    displacement = "0.06 mm" if displacement is None else displacement
+    amplitude = to_si(displacement, "length", "--displacement", gt=0)
+    cell = 2.0 * min(params.warp.half_length, params.fill.half_length)
+    if amplitude > cell:
+        raise InputError(f"--displacement = {displacement!r} is more than the unit "
+                         f"cell's side 2ℓ0 = {cell * 1e3:.4g} mm (100 % strain; the "
+                         f"yarns break near 2 %) (valid: up to {cell * 1e3:.4g} mm)")
+    return amplitude
 
 
 def _write_outputs(out: Path, result, write_csv, plot, test: Test, as_json: bool) -> None:

@@ -26,6 +26,7 @@ from wovenimpact.kernels.contact_rigid import rigid_contact_forces
 from wovenimpact.model.abaqus import read_inp
 from wovenimpact.model.casing import blade_mesh, casing_mesh, circumferential_directions, join
 from wovenimpact.model.gmsh import gmsh_hint, read_msh
+from wovenimpact.model.lsdyna import read_deck, section_thicknesses
 from wovenimpact.model.mesh import Mesh, node_set, plate_mesh
 from wovenimpact.model.solid import (
     SolidPart,
@@ -131,7 +132,9 @@ def make_mesh(spec: CaseSpec, base: Path, sections: dict | None = None
     path = (base / m.file).resolve()
     if not path.is_file():
         raise InputError(f"mesh.file: {m.file!r} not found (looked for {path})")
-    mesh = read_inp(path) if m.kind == "abaqus" else read_msh(path)
+    deck = read_deck(path) if m.kind == "lsdyna" else None
+    mesh = (deck.mesh if deck is not None
+            else read_inp(path) if m.kind == "abaqus" else read_msh(path))
     if mesh.n_elems > LARGE_MESH and not spec.run.allow_large_mesh:  # spec.case.check_mesh_size
         raise InputError(f"mesh.file: {m.file!r} holds {mesh.n_elems:,} elements, more than "
                          f"{LARGE_MESH:,}: a model that takes minutes to build and run on two "
@@ -158,6 +161,8 @@ def make_mesh(spec: CaseSpec, base: Path, sections: dict | None = None
     if missing:
         raise InputError(f"mesh.sections: {len(missing)} elements (first: {missing[0]}) are in "
                          "none of the listed element sets; every element needs a section")
+    if deck is not None and sections is not None:  # the deck's shell thickness
+        sections.update(section_thicknesses(deck, names, sections, m.length_unit, m.file))
     mesh.ply = contact_surfaces(mesh, spec.contact.surfaces, shell_sets)
     return mesh, names  # type: ignore[return-value]
 

@@ -33,7 +33,7 @@ Schema (see README and examples/cases/)::
                       fibre_direction?, second_direction? (8-node hexahedra, docs/solid.md)
     [mesh]            kind = "plate": side, width? (a rectangle: side along x, width
                       along y), element_size, plies, spacing, quarter,
-                      section, warp_direction   | kind = "abaqus" | "gmsh": file,
+                      section, warp_direction   | kind = "abaqus" | "gmsh" | "lsdyna": file,
                       sections = {ELSET = SECTION}, length_unit?, warp_direction?
                       (vector | "circumferential"), axis?, [mesh.containment]? (blade,
                       root, release, fragment, casing_layers: the file's sets of a
@@ -239,18 +239,21 @@ class ContainmentSetsSpec(BaseModel):
 
 class ImportedMeshSpec(BaseModel):
     """``[mesh] kind = "abaqus"`` (an ``.inp`` file) or ``"gmsh"`` (a ``.msh`` file):
-    nodes, shell elements and sets read through meshio. ``length_unit`` is the length
-    of one coordinate unit of the file ("1 mm" for a mesh drawn in millimetres; default
-    1 m). ``warp_direction`` is a vector projected on each element, or
-    ``"circumferential"``: the hoop direction about ``axis`` (through the origin), the
-    warp of a fabric wrapped on a cylinder (a casing). Not given, it is
+    nodes, shell elements and sets read through meshio; or ``"lsdyna"`` (a keyword deck,
+    ``.k``): nodes, shells, parts (element sets ``PART_<PID>``), sets (``SET_SHELL_<SID>``,
+    ``SET_NODE_<SID>``) and the shells' thickness, which a section without ``thickness``
+    takes (model/lsdyna.py). ``length_unit`` is the length of one coordinate unit of the
+    file ("1 mm" for a mesh drawn in millimetres; default 1 m). ``warp_direction`` is a
+    vector projected on each element, or ``"circumferential"``: the hoop direction about
+    ``axis`` (through the origin), the warp of a fabric wrapped on a cylinder (a casing).
+    Not given, it is
     ``"circumferential"`` for a containment model and x = (1, 0, 0) otherwise.
     ``[mesh.containment]`` names the sets of a containment model
     (:class:`ContainmentSetsSpec`), whose blade spins about the z axis: its ``axis`` is
     z (``check_references``)."""
 
     model_config = STRICT
-    kind: Literal["abaqus", "gmsh"]
+    kind: Literal["abaqus", "gmsh", "lsdyna"]
     file: str = Field(min_length=1)
     sections: dict[str, str] = Field(min_length=1)  # element set → section name
     length_unit: quantity("length", gt=0, example="1 mm") = 1.0
@@ -836,7 +839,7 @@ def warn_missing_symmetry(spec: CaseSpec, source: str = "<dict>") -> None:
 
 def _without_mesh_kind(p: Problem) -> Problem:
     """``mesh.plate.side`` → ``mesh.side``: the kind selects the table, it is not a key."""
-    for kind in ("plate", "abaqus", "gmsh", "containment", "block"):
+    for kind in ("plate", "abaqus", "gmsh", "lsdyna", "containment", "block"):
         if p.path.startswith(f"mesh.{kind}."):
             return dataclasses.replace(p, path="mesh." + p.path[len(kind) + 6:])
     return p

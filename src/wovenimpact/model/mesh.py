@@ -36,6 +36,9 @@ class Mesh:
         hexes: (n_hexes, 8) node indices of the solid elements (8-node hexahedra, corners
             in VTK/Abaqus C3D8 order; docs/solid.md), numbered apart from the shells.
         hex_sets: name → hexahedron indices (the element sets of the solids).
+        hex_frames: (n_hexes, 3, 3) material axes of the hexahedra (rows a1, a2, a3) that
+            replace their solid sections' (a generated yarn's, following its centreline),
+            or None.
     """
 
     nodes: np.ndarray
@@ -45,6 +48,7 @@ class Mesh:
     elem_sets: dict[str, np.ndarray] = field(default_factory=dict)
     hexes: np.ndarray = field(default_factory=lambda: np.zeros((0, 8), dtype=np.int64))
     hex_sets: dict[str, np.ndarray] = field(default_factory=dict)
+    hex_frames: np.ndarray | None = None
 
     def __post_init__(self) -> None:
         self.nodes = np.ascontiguousarray(self.nodes, dtype=float)
@@ -66,6 +70,11 @@ class Mesh:
         _check_indices("hexes", self.hexes, len(self.nodes), "node")
         self.hex_sets = _index_sets("element set", self.hex_sets, len(self.hexes),
                                     "hexahedron")
+        if self.hex_frames is not None:
+            self.hex_frames = np.ascontiguousarray(self.hex_frames, dtype=float)
+            if self.hex_frames.shape != (len(self.hexes), 3, 3):
+                raise InputError(f"mesh hex_frames must be an ({len(self.hexes)}, 3, 3) array, "
+                                 f"got shape {self.hex_frames.shape}")
 
     @property
     def n_nodes(self) -> int:

@@ -25,6 +25,7 @@ from wovenimpact.kernels.bundles import BodyContact, BodyContactOut, ContactNode
 from wovenimpact.kernels.contact_rigid import rigid_contact_forces
 from wovenimpact.model.abaqus import read_inp
 from wovenimpact.model.casing import blade_mesh, casing_mesh, circumferential_directions, join
+from wovenimpact.model.crossover_cell import crossover_cell
 from wovenimpact.model.gmsh import gmsh_hint, read_msh
 from wovenimpact.model.lsdyna import read_deck, section_thicknesses
 from wovenimpact.model.mesh import Mesh, node_set, plate_mesh
@@ -52,10 +53,12 @@ from wovenimpact.spec.case import (
     SYMMETRY_AXIS,
     BlockMeshSpec,
     CaseSpec,
+    CrossoverMeshSpec,
     ContainmentMeshSpec,
     ImportedMeshSpec,
     PlateMeshSpec,
 )
+from wovenimpact.spec.crossover import load_geometry
 from wovenimpact.spec.fields import read_toml
 from wovenimpact.spec.material import load_material, material_from_dict
 from wovenimpact.state import State, initial_state, rigid_rotation_velocity
@@ -114,6 +117,11 @@ def make_mesh(spec: CaseSpec, base: Path, sections: dict | None = None
     m = spec.mesh
     if isinstance(m, BlockMeshSpec):  # hexahedra only (solid_sections)
         return block_mesh(m.size, m.elements, m.origin), []
+    if isinstance(m, CrossoverMeshSpec):  # the two yarns of a crossover cell
+        path = (base / m.file).resolve()
+        if not path.is_file():
+            raise InputError(f"mesh.file: {m.file!r} not found (looked for {path})")
+        return crossover_cell(load_geometry(path)).mesh, []
     if isinstance(m, PlateMeshSpec):
         thick = None
         if m.ply_sections is not None and m.spacing is None:
@@ -169,8 +177,11 @@ def make_mesh(spec: CaseSpec, base: Path, sections: dict | None = None
 
 def solid_sections(spec: CaseSpec, materials: dict, mesh: Mesh) -> SolidPart | None:
     """The hexahedra of the mesh with their sections (``[solid_sections.NAME]``): all of
-    a block's its ``mesh.section``'s, an imported mesh's by the element sets of
-    ``mesh.sections`` that name a solid section. None for a mesh without hexahedra."""
+    a block's its ``mesh.section``'s, a crossover cell's warp and fill their
+    ``mesh.warp_section`` and ``mesh.fill_section``, an imported mesh's by the element
+    sets of ``mesh.sections`` that name a solid section; the material axes the mesh gives
+    (a crossover cell's, along its yarns) replace the sections'. None for a mesh without
+    hexahedra."""
     sections = {}
     for name, s in spec.solid_sections.items():
         if not is_solid_material(materials[s.material]):
@@ -184,6 +195,10 @@ def solid_sections(spec: CaseSpec, materials: dict, mesh: Mesh) -> SolidPart | N
     n = mesh.hexes.shape[0]
     if isinstance(m, BlockMeshSpec):
         names: list[str | None] = [m.section] * n
+    elif isinstance(m, CrossoverMeshSpec):
+        names = [m.warp_section] * n
+        for e in mesh.hex_sets["fill"]:
+            names[e] = m.fill_section or m.warp_section
     elif isinstance(m, ImportedMeshSpec):
         names = [None] * n
         for elset, section in m.sections.items():
@@ -210,7 +225,7 @@ def solid_sections(spec: CaseSpec, materials: dict, mesh: Mesh) -> SolidPart | N
         return None
     used = list(dict.fromkeys(names))
     return solid_part(mesh.nodes, mesh.hexes, {k: sections[k] for k in used}, names,
-                      sets=mesh.hex_sets)
+                      frames=mesh.hex_frames, sets=mesh.hex_sets)
 
 
 def contact_surfaces(mesh: Mesh, how: str, elsets: list[str]) -> np.ndarray:

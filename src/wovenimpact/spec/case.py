@@ -46,6 +46,8 @@ Schema (see README and examples/cases/)::
                       the blade's own, default mesh.element_size)
                       | kind = "block": size, elements, origin?, section (a box of
                       hexahedra; an imported mesh's C3D8R / C3D8 elements are solids too)
+                      | kind = "crossover": file (a geometry file), warp_section,
+                      fill_section? (the crossover cell of hexahedra, docs/solid.md §5)
     [[boundary]]      nodes = SET, type = clamped | pinned | symmetry_x | symmetry_y |
                       symmetry_z | velocity (with dof and velocity)
     [spin]            rate, release_time, relaxation_tolerance (containment cases)
@@ -198,6 +200,24 @@ class BlockMeshSpec(BaseModel):
     origin: tuple[Coordinate, Coordinate, Coordinate] = (0.0, 0.0, 0.0)
     # a solid section (solid_sections)
     section: str = Field(min_length=1)
+
+
+class CrossoverMeshSpec(BaseModel):
+    """``[mesh] kind = "crossover"``: the plain-weave crossover cell of a geometry file
+    (``wovenimpact crossover-cell``, docs/solid.md §5), two yarns of hexahedra whose
+    material axes follow their centrelines (the solid sections' ``fibre_direction`` and
+    ``second_direction`` are not used). Node sets ``warp``, ``fill``, ``warp.x_min``,
+    ``warp.x_max``, ``fill.y_min``, ``fill.y_max``, ``warp.top``, ``warp.bottom``,
+    ``fill.top``, ``fill.bottom``, ``all``."""
+
+    model_config = STRICT
+    kind: Literal["crossover"]
+    # the geometry file, relative to the case file
+    file: str = Field(min_length=1)
+    # a solid section for the warp's hexahedra
+    warp_section: str = Field(min_length=1)
+    # not given: the warp's
+    fill_section: str | None = None
 
 
 class PlateMeshSpec(BaseModel):
@@ -602,8 +622,8 @@ class CaseSpec(BaseModel):
     materials: dict[str, str | MaterialRef] = Field(min_length=1)
     sections: dict[str, SectionSpec] = {}
     solid_sections: dict[str, SolidSectionSpec] = {}
-    mesh: PlateMeshSpec | ImportedMeshSpec | ContainmentMeshSpec | BlockMeshSpec = Field(
-        discriminator="kind")
+    mesh: (PlateMeshSpec | ImportedMeshSpec | ContainmentMeshSpec | BlockMeshSpec
+           | CrossoverMeshSpec) = Field(discriminator="kind")
     boundary: list[BoundarySpec] = []
     amplitude: AmplitudeSpec = AmplitudeSpec()
     initial_velocity: list[InitialVelocitySpec] = []
@@ -624,6 +644,9 @@ def mesh_sections(mesh) -> list[tuple[str, str]]:
         return [("mesh.sections", s) for s in mesh.sections.values()]
     if isinstance(mesh, BlockMeshSpec):
         return [("mesh.section", mesh.section)]
+    if isinstance(mesh, CrossoverMeshSpec):
+        return [("mesh.warp_section", mesh.warp_section)] + (
+            [] if mesh.fill_section is None else [("mesh.fill_section", mesh.fill_section)])
     out = [("mesh.casing.layer_section", mesh.casing.layer_section),
            ("mesh.blade.section", mesh.blade.section)]
     if mesh.casing.inner_section is not None:
@@ -656,10 +679,12 @@ def check_references(spec: CaseSpec) -> list[Problem]:
     for key, s in mesh_sections(spec.mesh):
         if s not in known:
             problems.append(Problem(key, "names no section", s, f"one of {known}"))
-    if isinstance(spec.mesh, BlockMeshSpec) and spec.mesh.section in spec.sections:
-        problems.append(Problem("mesh.section", "names a shell section", spec.mesh.section,
-                                f"a solid section, one of {sorted(spec.solid_sections)}"))
-    if not isinstance(spec.mesh, (BlockMeshSpec, ImportedMeshSpec)):
+    if isinstance(spec.mesh, (BlockMeshSpec, CrossoverMeshSpec)):
+        for key, s in mesh_sections(spec.mesh):
+            if s in spec.sections:
+                problems.append(Problem(key, "names a shell section", s, "a solid section, "
+                                        f"one of {sorted(spec.solid_sections)}"))
+    if not isinstance(spec.mesh, (BlockMeshSpec, CrossoverMeshSpec, ImportedMeshSpec)):
         for key, s in mesh_sections(spec.mesh):
             if s in spec.solid_sections:
                 problems.append(Problem(key, "names a solid section", s, "a shell section, "
@@ -839,7 +864,7 @@ def warn_missing_symmetry(spec: CaseSpec, source: str = "<dict>") -> None:
 
 def _without_mesh_kind(p: Problem) -> Problem:
     """``mesh.plate.side`` → ``mesh.side``: the kind selects the table, it is not a key."""
-    for kind in ("plate", "abaqus", "gmsh", "lsdyna", "containment", "block"):
+    for kind in ("plate", "abaqus", "gmsh", "lsdyna", "containment", "block", "crossover"):
         if p.path.startswith(f"mesh.{kind}."):
             return dataclasses.replace(p, path="mesh." + p.path[len(kind) + 6:])
     return p

@@ -467,7 +467,8 @@ def _set_block(block: _Block, kind: str, generate: bool, title: bool, sets: dict
     if not cards:
         raise InputError(f"{block.where()}: no set id card (SID ...)")
     head = cards[0]
-    f = _fields(head, block, [10] * 6, ["SID", "DA1", "DA2", "DA3", "DA4", "SOLVER"])
+    f = _fields(head, block, [10] * 8, ["SID", "DA1", "DA2", "DA3", "DA4", "SOLVER", "ITS",
+                                        "(unused)"])
     sid = _int(f[0], head, block, "SID")
     if sid in sets:
         raise InputError(f"{head.where()}: *{block.name}: {kind} set {sid} is defined again "
@@ -574,9 +575,9 @@ def _assemble(path, node_ids, coords, elems, parts, sections, node_sets, shell_s
     titles = {f"PART_{pid}": p[1] for pid, p in parts.items()}
     titles.update({f"SET_SHELL_{sid}": s[3] for sid, s in shell_sets.items() if s[3]})
     titles.update({f"SET_NODE_{sid}": s[3] for sid, s in node_sets.items() if s[3]})
-    for sid, (entries, generate, where, _) in shell_sets.items():
+    for sid, (entries, generate, _, _) in shell_sets.items():
         elem_sets[f"SET_SHELL_{sid}"] = _members(entries, generate, eindex, np.sort(eids),
-                                                 "element", sid, "*SET_SHELL", where)
+                                                 "element", sid, "*SET_SHELL")
     nodes = np.asarray(coords, dtype=float).reshape(-1, 3)
     sorted_ids = np.array(sorted(index), dtype=np.int64)
     node_id_of = np.zeros(len(nodes), dtype=np.int64)
@@ -584,8 +585,8 @@ def _assemble(path, node_ids, coords, elems, parts, sections, node_sets, shell_s
         node_id_of[i] = nid
     node_set_arrays = {
         f"SET_NODE_{sid}": _members(entries, generate, index, sorted_ids, "node", sid,
-                                    "*SET_NODE", where)
-        for sid, (entries, generate, where, _) in node_sets.items()}
+                                    "*SET_NODE")
+        for sid, (entries, generate, _, _) in node_sets.items()}
     for name, idx in elem_sets.items():
         node_set_arrays[name] = np.unique(quads[idx])
     used = np.unique(quads)
@@ -618,7 +619,7 @@ def _element_thickness(eid, own, where, section: _Section, pid) -> float:
     return float(t[0])
 
 
-def _members(entries, generate, index, ids_sorted, what, sid, keyword, where) -> np.ndarray:
+def _members(entries, generate, index, ids_sorted, what, sid, keyword) -> np.ndarray:
     out: list[int] = []
     for b, e, card in entries:
         if generate:

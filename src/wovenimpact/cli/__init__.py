@@ -5,6 +5,7 @@ from wovenimpact.cli import (  # noqa: F401  (register commands)
     bench,
     calibrate,
     convergence,
+    crossover_cell,
     design,
     element_test,
     run,

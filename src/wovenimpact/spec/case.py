@@ -259,7 +259,8 @@ class ContainmentSetsSpec(BaseModel):
 
 class ImportedMeshSpec(BaseModel):
     """``[mesh] kind = "abaqus"`` (an ``.inp`` file) or ``"gmsh"`` (a ``.msh`` file):
-    nodes, shell elements and sets read through meshio; or ``"lsdyna"`` (a keyword deck,
+    nodes, shell elements (and an ``.inp`` file's 8-node bricks, C3D8R / C3D8: hexahedra
+    for solid sections) and sets read through meshio; or ``"lsdyna"`` (a keyword deck,
     ``.k``): nodes, shells, parts (element sets ``PART_<PID>``), sets (``SET_SHELL_<SID>``,
     ``SET_NODE_<SID>``) and the shells' thickness, which a section without ``thickness``
     takes (model/lsdyna.py). ``length_unit`` is the length of one coordinate unit of the

@@ -4,7 +4,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 
-.PHONY: venv run test docs bench bench-containment bench-flagship corpus clean
+.PHONY: venv run test browser docs bench bench-containment bench-flagship corpus clean
 
 venv: $(STAMP)
 
@@ -27,8 +27,20 @@ run: venv
 
 # One pytest worker per core (pytest-xdist): on a fresh clone most of the suite's time is Numba
 # compiling the kernels into the cache, which two workers share; the slowest tests are listed.
-test: venv
+# The browser test (tests/io/test_report_browser.py) opens a report.html in headless Chromium:
+# run as root with apt-get (as CI is), `make test` first installs Debian's chromium-headless-shell
+# if no Chromium is on the PATH (~100 MB, ~20 s, once); elsewhere that test is skipped.
+test: venv browser
 	$(BIN)/python -m pytest -q -n auto --durations=15
+
+browser:
+	@if ! command -v chromium >/dev/null 2>&1 && ! command -v chromium-headless-shell >/dev/null 2>&1 \
+	    && [ "$$(id -u)" = 0 ] && command -v apt-get >/dev/null 2>&1; then \
+	  echo "make: installing chromium-headless-shell (Debian) for the browser test"; \
+	  { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq \
+	      --no-install-recommends chromium-headless-shell >/dev/null; } \
+	  || echo "make: chromium-headless-shell not installed: the browser test will be skipped"; \
+	fi
 
 # docs/case_keys.md, the key reference generated from the input schemas (a test checks it is
 # current).

@@ -20,6 +20,7 @@ import os
 import re
 import shutil
 import subprocess
+import tempfile
 from pathlib import Path
 
 NAMES = ("chromium", "chromium-headless-shell", "chromium-browser", "google-chrome",
@@ -90,8 +91,8 @@ def open_in_browser(page: Path, scratch: Path, chromium: str, window=WINDOW,
     copy = scratch / "report.html"
     copy.write_text(text.replace("</body>", CHECK_JS + "</body>", 1), encoding="utf-8")
     done = subprocess.run(
-        [*chromium_args(chromium, window), "--virtual-time-budget=10000", "--dump-dom",
-         copy.resolve().as_uri()],
+        [*chromium_args(chromium, window), f"--user-data-dir={scratch.resolve() / 'profile'}",
+         "--virtual-time-budget=10000", "--dump-dom", copy.resolve().as_uri()],
         capture_output=True, text=True, timeout=timeout, check=False)
     found = RESULT.search(done.stdout)
     assert found, (f"Chromium ran ({done.returncode}) but the page's check did not: "
@@ -104,7 +105,8 @@ def screenshot(page: Path, png: Path, chromium: str, window=WINDOW,
     """The top of ``page`` as a window of ``window`` pixels would show it, as a PNG."""
     png = Path(png).resolve()
     png.parent.mkdir(parents=True, exist_ok=True)
-    subprocess.run([*chromium_args(chromium, window), f"--screenshot={png}",
-                    Path(page).resolve().as_uri()],
-                   capture_output=True, timeout=timeout, check=True)
+    with tempfile.TemporaryDirectory() as profile:
+        subprocess.run([*chromium_args(chromium, window), f"--screenshot={png}",
+                        f"--user-data-dir={profile}", Path(page).resolve().as_uri()],
+                       capture_output=True, timeout=timeout, check=True)
     return png

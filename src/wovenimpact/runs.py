@@ -23,6 +23,11 @@ studies reuse a finished run, and ``energy_check``: a run whose energy balance f
 ``run.energy_tolerance`` still writes every output; the CLI then exits with code 4.
 A checkpoint also records the history rows and field frames written so far, which a
 restart checks against history.csv and fields.pvd (:func:`resume`).
+
+This module is the loop, its checkpoints and restart, and the clearing of an earlier
+run's outputs; what it writes is computed elsewhere: history.csv's columns and rows in
+:mod:`wovenimpact.results.history_rows`, summary.json's numbers in
+:mod:`wovenimpact.results.summary`, the plots in :func:`wovenimpact.io.plots.write_run_plots`.
 """
 
 from __future__ import annotations
@@ -37,7 +42,6 @@ from pathlib import Path
 import numpy as np
 
 from wovenimpact.errors import InputError, InputWarning, SimulationError
-from wovenimpact.interfaces import booked_totals, interface_energies
 from wovenimpact.io.atomic import atomic_write_text
 from wovenimpact.io.checkpoint import (
     checkpoint_meta,
@@ -48,175 +52,24 @@ from wovenimpact.io.checkpoint import (
 from wovenimpact.io.fields import FieldWriter
 from wovenimpact.io.history import History
 from wovenimpact.io.report import write_run_report
-from wovenimpact.kernels import shell_layout as SL
-from wovenimpact.kernels.contact_energy import DAMPING, FRICTION
 from wovenimpact.provenance import changed_parts, digest_of, provenance, restart_parts
 from wovenimpact.results.containment import (
-    CASING_ENERGY_COLUMNS,
     CONTAINMENT_COLUMNS,
     CasingWatch,
-    casing_energy_row,
     casing_inner_radius,
     casing_outer_radius,
-    casing_summary,
     decided_since,
-    fragment_row,
     is_containment,
-    layer_columns,
-    layer_elements,
-    layer_materials,
-    layer_row,
-    layer_sets,
     speed_settled,
 )
-from wovenimpact.results.mesh_verdict import SUMMARY_KEY as MESH_VERDICT_KEY
-from wovenimpact.results.mesh_verdict import mesh_verdict
-from wovenimpact.results.metal_state import has_metal, plastic_work
-from wovenimpact.results.quantities import (
-    REACTION_COLUMNS,
-    impactor_row,
-    intact_material_ahead,
-    outcome_decided_at,
-    ply_columns,
-    ply_contact_work,
-    ply_deflections,
-    ply_energies,
-    ply_perforation_times,
-    ply_row,
-    reaction_row,
-    residual_velocity,
-    symmetry_factor,
-)
-from wovenimpact.setup.compile import CompiledCase, compile_case
-from wovenimpact.solver import Workspace, energy_balance, step
-from wovenimpact.solver.explicit import error_fraction
+from wovenimpact.results.history_rows import history_columns, history_row
+from wovenimpact.results.summary import SUMMARY_VERSION, summarise
+from wovenimpact.setup.compile import compile_case
+from wovenimpact.solver import Workspace, step
 from wovenimpact.spec.case import load_case
-from wovenimpact.state import KINETIC0, MASS_SCALING, State
+from wovenimpact.state import State
 
-HISTORY_COLUMNS = (
-    "time_s", "step", "dt_s", "structure_kinetic_energy_part_J", "internal_work_part_J",
-    "stored_energy_part_J", "hourglass_energy_part_J", "external_work_part_J",
-    "eroded_kinetic_energy_part_J", "eroded_internal_energy_part_J", "contact_energy_part_J",
-    "contact_dissipated_part_J", "contact_damping_energy_part_J",
-    "contact_friction_energy_part_J", "body_force_work_part_J", "reaction_work_part_J",
-    "energy_drift_part_J", "energy_error_fraction", "energy_normaliser_part_J",
-    "max_displacement_m", "eroded_elements",
-)
-IMPACT_COLUMNS = ("impactor_velocity_m_per_s", "impactor_displacement_m", "contact_force_full_N",
-                  "impactor_nose_ahead_of_intact_m", "intact_material_ahead",
-                  "impactor_kinetic_energy_part_J")
-METAL_COLUMNS = ("plastic_work_part_J",)  # models with a J2 (metal) section
-MASS_SCALING_COLUMNS = ("added_mass_part_kg", "mass_scaling_energy_part_J", "mass_scaled_elements")
-SUMMARY_VERSION = 4  # 2: issue 9's outcome rule and energy keys; 3: issue 12's energy
-#                     normalisation and provenance; 4: a casing layer's absorbed energy is
-#                     the contact work it received (held_energy_per_layer_J the old
-#                     figure); older summaries are re-run
 DEFAULT_OUTPUTS = {"history": 1000, "field": 20, "checkpoint": 10}  # per run, if not given
-
-
-def history_columns(model) -> tuple[str, ...]:
-    """history.csv columns: energies etc., plus the impactor's if there is one.
-
-    Scope in the name: ``*_part_J`` is of the modelled part (a quarter of the problem
-    in a quarter model; × ``symmetry_factor`` of summary.json gives the whole), ``*_full_*``
-    of the whole problem; velocities, displacements, fractions and counts need neither.
-    ``energy_drift_part_J`` is the balance's drift (solver.explicit.energy_balance),
-    ``energy_normaliser_part_J`` the largest energy put into the model so far (the running
-    maximum of its ``scale_J`` over the rows up to this one) and ``energy_error_fraction``
-    = |drift| / normaliser (0 while the normaliser is 0: no energy put in); summary.json's
-    figure is the largest |drift| over the last (largest) normaliser.
-    ``body_force_work_part_J`` and ``reaction_work_part_J`` (supports and prescribed
-    motions) are the two parts of ``external_work_part_J``.
-    ``contact_energy_part_J`` is −(work of the contact forces): the penalty springs' energy
-    plus ``contact_dissipated_part_J``, what contact dashpots and friction dissipated;
-    of it, ``contact_damping_energy_part_J`` and ``contact_friction_energy_part_J`` are
-    the dashpots' and friction's own work, booked pair by pair (wovenimpact.interfaces;
-    the rest is the penalty's discretisation: k follows Δt, docs/theory.md §6).
-    ``plastic_work_part_J`` (models with a metal section): the plastic work of the J2
-    points (metal_state.plastic_work), a part of the internal work. With mass scaling
-    (``run.mass_scaling_fraction``): ``added_mass_part_kg``, ``mass_scaling_energy_part_J``
-    (the kinetic energy the added mass brought, an input of the balance) and
-    ``mass_scaled_elements``. A containment model's rows add the fragment's and the
-    casing's columns (containment.fragment_row, containment.casing_energy_row: the
-    fragment's kinetic energy and the casing's kinetic, element and absorbed energies).
-
-    Last come the columns of each layer or ply (appended after all the others, so the
-    columns before them keep their places): a containment model's
-    ``casing_layer{k}_absorbed_energy_part_J`` and ``casing_layer{k}_intact_outside``
-    (containment.layer_row), a plate impact's ``ply{p}_contact_work_part_J`` and
-    ``ply{p}_intact_ahead`` (quantities.ply_row). After them, appended later still,
-    ``reaction_force_{x,y,z}_part_N``: the summed reaction force of the supports (nodes with
-    all three translations fixed) in global axes, the force whose work
-    ``reaction_work_part_J`` books (quantities.support_reaction)."""
-    return (HISTORY_COLUMNS + (IMPACT_COLUMNS if model.body_params.shape[0] else ())
-            + (METAL_COLUMNS if has_metal(model) else ())
-            + (MASS_SCALING_COLUMNS if model.mass_scaling_fraction > 0.0 else ())
-            + (CONTAINMENT_COLUMNS + CASING_ENERGY_COLUMNS if is_containment(model) else ())
-            + per_layer_columns(model) + REACTION_COLUMNS)
-
-
-def per_layer_columns(model) -> tuple[str, ...]:
-    """The layer or ply columns ending a history row (:func:`history_columns`)."""
-    if is_containment(model):
-        return layer_columns(len(layer_sets(model)))
-    if model.body_params.shape[0]:
-        return ply_columns(model)
-    return ()
-
-
-def history_row(model, state: State, normaliser: float = 0.0,
-                watch: CasingWatch | None = None) -> dict:
-    """One history.csv row of ``state`` (columns :func:`history_columns`); ``normaliser``
-    is the previous row's ``energy_normaliser_part_J`` (0 for the first row); ``watch``
-    the run's :class:`~wovenimpact.results.containment.CasingWatch` (containment models; made
-    for the row when not given)."""
-    eb = energy_balance(model, state)
-    booked = booked_totals(state.contact_books[0])
-    scale = max(normaliser, eb["scale_J"])
-    disp = np.sqrt(np.max(np.sum((state.x - model.x0) ** 2, axis=1)))
-    impact = {}
-    if model.body_params.shape[0]:
-        impact = {**impactor_row(model, state), **intact_material_ahead(model, state),
-                  "impactor_kinetic_energy_part_J": eb["impactor_kinetic_J"]}
-    if is_containment(model):
-        watch = CasingWatch(model) if watch is None else watch
-        impact.update(fragment_row(model, state, watch))
-        impact.update(casing_energy_row(model, state, watch))
-        impact.update(layer_row(model, state, watch))
-    elif model.body_params.shape[0]:
-        impact.update(ply_row(model, state))
-    if has_metal(model):
-        impact["plastic_work_part_J"] = plastic_work(model, state)
-    if model.mass_scaling_fraction > 0.0:
-        impact.update(mass_scaling_row(state))
-    impact.update(reaction_row(model, state))
-    return {
-        **impact,
-        "time_s": float(state.t), "step": int(state.step), "dt_s": float(state.dt),
-        "structure_kinetic_energy_part_J": eb["kinetic_J"],
-        "internal_work_part_J": eb["internal_work_J"], "stored_energy_part_J": eb["stored_J"],
-        "hourglass_energy_part_J": eb["hourglass_J"],
-        "external_work_part_J": eb["external_work_J"],
-        "eroded_kinetic_energy_part_J": eb["eroded_kinetic_J"],
-        "eroded_internal_energy_part_J": eb["eroded_internal_J"],
-        "contact_energy_part_J": eb["contact_energy_J"],
-        "contact_dissipated_part_J": eb["contact_dissipated_J"],
-        "contact_damping_energy_part_J": booked["damping"],
-        "contact_friction_energy_part_J": booked["friction"],
-        "body_force_work_part_J": eb["body_force_work_J"],
-        "reaction_work_part_J": eb["reaction_work_J"], "energy_drift_part_J": eb["drift_J"],
-        "energy_error_fraction": error_fraction(eb["drift_J"], scale),
-        "energy_normaliser_part_J": scale, "max_displacement_m": float(disp),
-        "eroded_elements": int(np.sum(state.elem[:, SL.E_ALIVE] == 0.0)),
-    }
-
-
-def mass_scaling_row(state: State) -> dict:
-    """Mass added by mass scaling so far (modelled part), the kinetic energy it brought
-    and the number of elements that carry some."""
-    return {"added_mass_part_kg": float(np.sum(state.added_mass)),
-            "mass_scaling_energy_part_J": float(state.energy[MASS_SCALING]),
-            "mass_scaled_elements": int(np.count_nonzero(state.mass_ratio))}
 
 
 class Schedule:
@@ -369,12 +222,14 @@ def run_spec(
     if progress is not None:
         progress(state, run.end_time)
     checkpoint()
-    summary = summarise(spec, compiled, state, meta["wall_time_s"], history.arrays())
+    summary = summarise(spec, model, state, meta["wall_time_s"], history.arrays())
     summary["restarted_from_step"] = meta["restarted_from_step"]
     if is_containment(model):  # the outcome that ended the run early (None: end_time)
         summary["stopped_when_decided"] = decided
     summary["provenance"] = prov
-    write_plots(out, spec.case.name, model, state, history.arrays(), summary)
+    from wovenimpact.io.plots import write_run_plots
+
+    write_run_plots(out, spec.case.name, model, state, history.arrays(), summary)
     # numpy scalars as Python numbers: a summary key computed with numpy must not end an
     # hour's run with a TypeError after its last step (it did: numpy's bool_)
     atomic_write_text(out / "summary.json",
@@ -384,42 +239,6 @@ def run_spec(
     write_pictures(out, history.arrays())  # after summary.json: the page shows them
     write_run_report(out, spec=spec, model_digest=digest, **(source or {}))  # report.html
     return summary
-
-
-def write_plots(out: Path, title: str, model, state: State, h: dict, summary: dict) -> None:
-    """The plots of a finished run in ``OUT/plots``: energies; a containment run's fragment
-    plot, a plate's deflection profile and impactor plot, each with the instants its
-    layers (plies) were first perforated and its outcome decided; the energy each layer
-    or ply absorbed over time."""
-    from wovenimpact.io.plots import (
-        deflection_plot,
-        energy_plot,
-        event_markers,
-        fragment_plot,
-        impactor_plot,
-        layer_energy_plot,
-    )
-
-    plots = out / "plots"
-    factor = symmetry_factor(model)
-    energy_plot(h, plots / "energy.png", title=title, symmetry_factor=factor)
-    if is_containment(model):  # a plate's deflection along y = 0 means nothing on a casing
-        names = [f"layer {k} ({m})" for k, m in enumerate(layer_materials(model))]
-        markers = event_markers(summary.get("layer_perforated_at_s", []),
-                                summary.get("outcome_decided_at_s"), names)
-        fragment_plot(h, plots / "fragment.png", title=title,
-                      outcome=summary.get("outcome", ""), markers=markers)
-    else:
-        if model.n_elems:  # (a model of hexahedra has no plies)
-            deflection_plot(model, state, plots / "ply_deflection.png", title=title)
-        numbers = np.unique(model.ply)
-        names = [f"ply {p}" for p in numbers]
-        markers = event_markers(summary.get("ply_perforated_at_s", []),
-                                summary.get("outcome_decided_at_s"), names)
-    if "impactor_velocity_m_per_s" in h:
-        impactor_plot(h, plots / "impactor.png", title=title, markers=markers)
-    layer_energy_plot(h, plots / "layer_energy.png", title=title, symmetry_factor=factor,
-                      names=names, markers=markers)
 
 
 OUTPUT_PATTERNS = ("checkpoints/checkpoint_*.npz", "fields/step_*.vtu", "fields/fields.pvd",
@@ -510,203 +329,6 @@ def resume(out: Path, model, digest: str, parts: dict, end_time: float):
                          f"first {n_rows}; it belongs to another run{hint}")
     fields = FieldWriter.resume(out / "fields", model, int(meta["field_frames"]))
     return state, history, fields, float(meta["wall_time_s"])
-
-
-def summarise(spec, compiled: CompiledCase, state: State, wall: float, h: dict) -> dict:
-    """The numbers a user wants from a finished run (summary.json). Energies here are
-    of the whole problem (the modelled part's × ``symmetry_factor``):
-
-    - ``structure_kinetic_energy_J`` (nodes), ``impactor_kinetic_energy_J`` (rigid
-      bodies) and ``total_kinetic_energy_J`` (both) at the end;
-      ``initial_total_kinetic_energy_J`` (both, t = 0) with its parts
-      ``initial_structure_kinetic_energy_J`` and ``initial_impactor_kinetic_energy_J``;
-    - ``internal_work_J`` = stored (live elements) + hourglass (live elements) + eroded
-      internal (energies of eroded elements at erosion) + dissipated, each joule once;
-    - ``hourglass_fraction`` = (``hourglass_energy_J`` of live elements +
-      ``eroded_hourglass_energy_J``, what eroded ones held at erosion) / internal work
-      (docs/theory.md §5), None while the internal work is not positive;
-    - ``energy_error_fraction``: the largest |drift| of the history over the largest
-      energy put into the model (its last ``energy_normaliser_part_J``), and ``energy_check``
-      "pass" if it is at most ``energy_tolerance`` (``run.energy_tolerance``), else "fail"
-      (the CLI then exits with code 4);
-    - ``contact_damping_energy_J`` and ``contact_friction_energy_J``: what the contact
-      dashpots and friction dissipated, and the same per interface
-      (``*_by_interface_J``, :func:`contact_damping_summary`);
-    - ``element_cycles``, ``wall_time_s`` and ``ns_per_element_cycle`` of every
-      invocation that made this result (a restarted run's included).
-    """
-    model = compiled.model
-    eb = energy_balance(model, state)
-    cycles = state.step * (model.n_elems + model.n_hexes)
-    error = error_fraction(np.max(np.abs(h["energy_drift_part_J"])),
-                           h["energy_normaliser_part_J"][-1])
-    factor = symmetry_factor(model)
-    impact = {}
-    if is_containment(model):
-        impact = casing_summary(model, state, h)
-    ke_body0 = 0.0
-    if model.body_params.shape[0]:
-        ke_body0 = factor * float(h["impactor_kinetic_energy_part_J"][0])
-        ke1 = factor * eb["impactor_kinetic_J"]
-        per_ply = ply_energies(model, state)
-        impact = {
-            **residual_velocity(h),
-            "ply_perforated_at_s": ply_perforation_times(h),
-            "outcome_decided_at_s": outcome_decided_at(h),
-            "initial_velocity_m_per_s": float(h["impactor_velocity_m_per_s"][0]),
-            "absorbed_energy_J": ke_body0 - ke1,
-            "absorbed_energy_per_ply_J": per_ply,
-            "contact_work_per_ply_J": ply_contact_work(model, state),
-            "max_deflection_m": max(ply_deflections(model, state)),
-            "max_deflection_per_ply_m": ply_deflections(model, state),
-            "peak_contact_force_N": float(np.max(h["contact_force_full_N"])),
-        }
-    w_int = eb["internal_work_J"]
-    hg_all = eb["hourglass_J"] + eb["eroded_hourglass_J"]
-    return {**impact,
-        "summary_version": SUMMARY_VERSION,
-        # when this summary was written (UTC): a report that reuses the run can say so
-        "finished_utc": time.strftime("%Y-%m-%dT%H:%M:%SZ", time.gmtime()),
-        "case": spec.case.name,
-        "end_time_s": float(state.t),
-        "steps": int(state.step),
-        "elements": int(model.n_elems + model.n_hexes),
-        "nodes": int(model.n_nodes),
-        "first_time_step_s": float(state.dt_first),
-        "last_time_step_s": float(state.dt),
-        "wall_time_s": wall,
-        "element_cycles": int(cycles),
-        "ns_per_element_cycle": wall / cycles * 1e9 if cycles else None,
-        "structure_kinetic_energy_J": factor * eb["kinetic_J"],
-        "impactor_kinetic_energy_J": factor * eb["impactor_kinetic_J"],
-        "total_kinetic_energy_J": factor * (eb["kinetic_J"] + eb["impactor_kinetic_J"]),
-        "initial_total_kinetic_energy_J": factor * float(state.energy[KINETIC0]),
-        "initial_structure_kinetic_energy_J": factor * float(state.energy[KINETIC0]) - ke_body0,
-        "initial_impactor_kinetic_energy_J": ke_body0,
-        "internal_work_J": factor * w_int,
-        "stored_energy_J": factor * eb["stored_J"],
-        "hourglass_energy_J": factor * eb["hourglass_J"],
-        "eroded_internal_energy_J": factor * eb["eroded_internal_J"],
-        "eroded_hourglass_energy_J": factor * eb["eroded_hourglass_J"],
-        "eroded_kinetic_energy_J": factor * eb["eroded_kinetic_J"],
-        **({"plastic_work_J": factor * plastic_work(model, state)} if has_metal(model) else {}),
-        **(mass_scaling_summary(model, state, factor) if model.mass_scaling_fraction > 0.0
-           else {}),
-        # undefined (None, "n/a" on the page) while no positive internal work was done,
-        # e.g. a spun blade that has only given back part of its pre-stress energy
-        "hourglass_fraction": hg_all / w_int if w_int > 0.0 else None,
-        "external_work_J": factor * eb["external_work_J"],
-        "body_force_work_J": factor * eb["body_force_work_J"],
-        "reaction_work_J": factor * eb["reaction_work_J"],
-        "contact_energy_J": factor * eb["contact_energy_J"],
-        **contact_damping_summary(model, state, factor),
-        "eroded_elements": int(np.sum(state.elem[:, SL.E_ALIVE] == 0.0)),
-        "energy_error_fraction": error,
-        "energy_tolerance": spec.run.energy_tolerance,
-        "energy_check": "pass" if error <= spec.run.energy_tolerance else "fail",
-        "symmetry_factor": factor,
-        # each failing material's element lengths against its calibrated range (theory §1.4)
-        MESH_VERDICT_KEY: mesh_verdict(model, state),
-        **element_sizes(spec, model),
-        "max_displacement_m": float(np.sqrt(np.max(np.sum((state.x - model.x0) ** 2, axis=1)))),
-    }
-
-
-def element_sizes(spec, model) -> dict:
-    """summary.json's element sizes (m), the first thing a reader of a result asks:
-    ``element_size_m``, the case's ``mesh.element_size`` (a containment casing's: the fine
-    sector's in a graded ring) and, for a containment case, ``blade_element_size_m``, the
-    blade's (``mesh.blade.element_size``, else the casing's). An imported mesh has no
-    such key: there each is the median √(element area) of the elements it stands for
-    (the casing layers' and the rest, the blade, in an imported containment mesh), and a
-    mesh of hexahedra only (``mesh.kind = "block"`` or imported) has the median
-    ∛(hexahedron volume)."""
-    mesh = spec.mesh
-    if model.n_hexes and not model.n_elems:
-        return {"element_size_m": float(np.median(np.cbrt(model.solid.vol0)))}
-    if mesh.kind == "plate":
-        return {"element_size_m": float(mesh.element_size)}
-    if mesh.kind == "containment":
-        return {"element_size_m": float(mesh.element_size),
-                "blade_element_size_m": float(mesh.blade_element_size)}
-
-    def median_size(elems) -> float | None:
-        return float(np.sqrt(np.median(model.area0[elems]))) if len(elems) else None
-
-    if not is_containment(model):
-        return {"element_size_m": median_size(np.arange(model.n_elems))}
-    casing = np.concatenate(layer_elements(model))
-    blade = np.setdiff1d(np.arange(model.n_elems), casing)
-    return {"element_size_m": median_size(casing), "blade_element_size_m": median_size(blade)}
-
-
-def contact_damping_summary(model, state: State, factor: float) -> dict:
-    """summary.json keys of the energy the contact dashpots and friction dissipated (J,
-    whole problem): in all and per interface, {"layer0-layer1": J, "ply0-impactor": J,
-    …} over the interfaces where contact acted (wovenimpact.interfaces; docs/theory.md
-    §6, "Contact energy per interface")."""
-    books = state.contact_books[0]
-    totals = booked_totals(books)
-    return {
-        "contact_damping_energy_J": factor * totals["damping"],
-        "contact_friction_energy_J": factor * totals["friction"],
-        "contact_damping_energy_by_interface_J": interface_energies(model, books, DAMPING,
-                                                                    factor),
-        "contact_friction_energy_by_interface_J": interface_energies(model, books, FRICTION,
-                                                                     factor),
-    }
-
-
-def mass_scaling_summary(model, state: State, factor: float) -> dict:
-    """summary.json keys of a run with mass scaling: the added mass (whole problem), its
-    fraction of the model's mass, the kinetic energy it brought and the elements scaled."""
-    row = mass_scaling_row(state)
-    return {"added_mass_kg": factor * row["added_mass_part_kg"],
-            "added_mass_fraction": row["added_mass_part_kg"] / float(np.sum(model.node_mass)),
-            "mass_scaling_energy_J": factor * row["mass_scaling_energy_part_J"],
-            "mass_scaled_elements": row["mass_scaled_elements"]}
-
-
-IMPACT_SUMMARY_KEYS = ("outcome", "perforated", "residual_velocity_m_per_s",
-                       "rebound_velocity_m_per_s", "ply_perforated_at_s",
-                       "outcome_decided_at_s", "initial_velocity_m_per_s",
-                       "absorbed_energy_J", "absorbed_energy_per_ply_J",
-                       "contact_work_per_ply_J", "max_deflection_m",
-                       "max_deflection_per_ply_m", "peak_contact_force_N")
-CONTAINMENT_SUMMARY_KEYS = ("outcome", "contained", "fragment_exit_speed_m_per_s",
-                            "fragment_speed_at_end_m_per_s", "fragment_exit_speed_settled", "fragment_mass_kg", "fragment_initial_speed_m_per_s", "max_bulge_m",
-                            "casing_mass_kg", "casing_mass_per_area_kg_per_m2", "casing_layers",
-                            "absorbed_energy_per_layer_J", "casing_absorbed_energy_J",
-                            "held_energy_per_layer_J",
-                            "absorbed_energy_per_material_J", "stopped_when_decided",
-                            "layer_perforated_at_s", "outcome_decided_at_s",
-                            "blade_element_size_m")
-COMMON_SUMMARY_KEYS = (
-    "summary_version", "case", "end_time_s", "steps", "elements", "nodes", "first_time_step_s",
-    "last_time_step_s", "wall_time_s", "element_cycles", "ns_per_element_cycle",
-    "structure_kinetic_energy_J", "impactor_kinetic_energy_J", "total_kinetic_energy_J",
-    "initial_total_kinetic_energy_J", "initial_structure_kinetic_energy_J",
-    "initial_impactor_kinetic_energy_J", "internal_work_J", "stored_energy_J",
-    "hourglass_energy_J", "eroded_internal_energy_J", "eroded_hourglass_energy_J",
-    "eroded_kinetic_energy_J", "hourglass_fraction", "external_work_J", "body_force_work_J",
-    "reaction_work_J", "contact_energy_J", "contact_damping_energy_J",
-    "contact_friction_energy_J", "contact_damping_energy_by_interface_J",
-    "contact_friction_energy_by_interface_J", "eroded_elements", "energy_error_fraction",
-    "energy_tolerance", "energy_check", "symmetry_factor", "max_displacement_m",
-    "restarted_from_step", "provenance", "finished_utc", "mesh_verdict", "element_size_m",
-    "plastic_work_J",  # runs with a metal section only
-    # runs with mass scaling only
-    "added_mass_kg", "added_mass_fraction", "mass_scaling_energy_J", "mass_scaled_elements",
-)
-
-
-def summary_keys(spec) -> tuple[str, ...]:
-    """The keys summary.json will have for a case (the metrics a study may ask for)."""
-    from wovenimpact.spec.case import is_containment_spec
-
-    extra = (CONTAINMENT_SUMMARY_KEYS if is_containment_spec(spec)
-             else IMPACT_SUMMARY_KEYS if spec.impactor is not None else ())
-    return tuple(dict.fromkeys(COMMON_SUMMARY_KEYS + extra))
 
 
 def reused_or_run(case_path: str | Path, out: str | Path, log=None, label: str = "case") -> dict:

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from wovenimpact.setup.compile import compile_case
-from wovenimpact.solver import Workspace, energy_balance, step
+from wovenimpact.results.energy import energy_balance
+from wovenimpact.solver import Workspace, step
 from wovenimpact.spec.case import load_case
 
 ROOT = Path(__file__).resolve().parents[2]

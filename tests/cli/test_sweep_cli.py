@@ -123,7 +123,7 @@ def fake_finished_runs(study: Path, out: Path, outcomes) -> list:
     """Write parameters.json and a summary.json (current version and provenance digest)
     for the variants of ``study`` as if they had run; returns the variants."""
     from wovenimpact.provenance import provenance
-    from wovenimpact.runs import SUMMARY_VERSION
+    from wovenimpact.results.summary import SUMMARY_VERSION
     from wovenimpact.spec.case import case_from_dict
     from wovenimpact.studies.sweep import load_study
 

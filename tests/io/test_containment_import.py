@@ -103,11 +103,11 @@ def test_an_imported_casing_and_blade_runs_as_the_generated_case(tmp_path):
         return np.linalg.norm((m[:, None] * st.v[frag]).sum(axis=0)) / m.sum()
 
     assert cm_speed(imp) == pytest.approx(cm_speed(gen), rel=1e-9)
-    # summary.json's element sizes (runs.element_sizes): the case's mesh.element_size (the
-    # blade's too, it has none of its own); the imported mesh has no such key, so the
-    # median √(element area) of its casing layers and of its blade: the same sizes, within
-    # the blade's taper and the ring's curvature
-    from wovenimpact.runs import element_sizes
+    # summary.json's element sizes (results.summary.element_sizes): the case's
+    # mesh.element_size (the blade's too, it has none of its own); the imported mesh has no
+    # such key, so the median √(element area) of its casing layers and of its blade: the
+    # same sizes, within the blade's taper and the ring's curvature
+    from wovenimpact.results.summary import element_sizes
 
     spec = case_from_dict(doc, source="generated")
     assert element_sizes(spec, gen_model) == {"element_size_m": pytest.approx(0.010),

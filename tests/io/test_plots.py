@@ -17,7 +17,7 @@ from wovenimpact.io.plots import (  # noqa: E402
     single_energy_figure,
 )
 from wovenimpact.results.containment import CASING_ENERGY_COLUMNS  # noqa: E402
-from wovenimpact.runs import HISTORY_COLUMNS  # noqa: E402
+from wovenimpact.results.history_rows import HISTORY_COLUMNS  # noqa: E402
 
 N = 41
 

@@ -264,10 +264,10 @@ def test_a_containment_run_shows_its_fragments_exit_speed_and_thresholds_in_the_
 
 
 def test_every_summary_key_the_code_writes_has_a_group_a_label_and_a_meaning():
-    """A key added to runs.py's lists without a line in io/summary_keys.py would land in
-    "other" with no meaning: this names it."""
+    """A key added to results/summary.py's lists without a line in io/summary_keys.py
+    would land in "other" with no meaning: this names it."""
     from wovenimpact.io.summary_keys import INTERNAL, KEYS
-    from wovenimpact.runs import (
+    from wovenimpact.results.summary import (
         COMMON_SUMMARY_KEYS,
         CONTAINMENT_SUMMARY_KEYS,
         IMPACT_SUMMARY_KEYS,

@@ -186,7 +186,7 @@ def test_containment_outputs_bulge_layer_and_material_energies_and_fragment_plot
     assert state.t == pytest.approx(summary["end_time_s"], rel=1e-12)
     # every key a study may ask of a containment case is there (stopped_when_decided:
     # None, the run reached its end time undecided)
-    from wovenimpact.runs import summary_keys
+    from wovenimpact.results.summary import summary_keys
 
     assert set(summary_keys(spec)) <= set(summary)
     assert summary["stopped_when_decided"] is None and summary["outcome"] == "undecided"
@@ -451,9 +451,13 @@ def test_an_escape_stops_the_run_only_once_the_fragments_speed_has_settled():
     the hold alone; undecided never stops."""
     from types import SimpleNamespace
 
-    from wovenimpact.results.containment import EXIT_SPEED_SETTLED, speed_settled
+    from wovenimpact.results.containment import (
+        CONTAINMENT_COLUMNS,
+        EXIT_SPEED_SETTLED,
+        speed_settled,
+    )
     from wovenimpact.io.history import History
-    from wovenimpact.runs import CONTAINMENT_COLUMNS, decision_watch
+    from wovenimpact.runs import decision_watch
 
     model, _ = coarse_two_ply_casing()
     watch = decision_watch(model, 500e-6)

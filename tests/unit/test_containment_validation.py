@@ -115,7 +115,8 @@ def test_validate_containment_writes_its_own_report(tmp_path, monkeypatch):
 
 
 def _run_dir(root, name, layers, materials, outcome, exit_speed, per_area, digest="abc"):
-    """A finished containment run's folder: its summary.json, as runs.summarise writes it."""
+    """A finished containment run's folder: its summary.json, as
+    results.summary.summarise writes it."""
     import json
 
     d = root / name

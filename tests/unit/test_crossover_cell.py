@@ -22,7 +22,8 @@ from wovenimpact.model.crossover_cell import (
 )
 from wovenimpact.model.solid import SolidSection, solid_part
 from wovenimpact.setup.compile import compile_case
-from wovenimpact.solver.explicit import Workspace, energy_balance, step
+from wovenimpact.results.energy import energy_balance
+from wovenimpact.solver.explicit import Workspace, step
 from wovenimpact.spec.case import load_case
 from wovenimpact.spec.crossover import geometry_from_dict, load_geometry
 from wovenimpact.spec.material import load_material

@@ -103,7 +103,7 @@ def test_a_summary_of_an_older_rule_is_not_taken_as_finished(tmp_path):
     import json
 
     from wovenimpact.provenance import provenance
-    from wovenimpact.runs import SUMMARY_VERSION
+    from wovenimpact.results.summary import SUMMARY_VERSION
     from wovenimpact.spec.case import case_from_dict
     from wovenimpact.spec.fields import read_toml
     from wovenimpact.studies.sweep import finished
@@ -130,7 +130,7 @@ def test_a_run_of_other_code_is_kept_only_when_asked_and_only_for_the_same_case(
     import json
 
     from wovenimpact.provenance import digest_of, provenance
-    from wovenimpact.runs import SUMMARY_VERSION
+    from wovenimpact.results.summary import SUMMARY_VERSION
     from wovenimpact.spec.case import case_from_dict
     from wovenimpact.spec.fields import read_toml
     from wovenimpact.studies.sweep import finished

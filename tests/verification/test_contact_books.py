@@ -13,8 +13,9 @@ from wovenimpact.kernels.contact_energy import DAMPING, FRICTION, SPRING
 from wovenimpact.model import Section, build_model
 from wovenimpact.model.mesh import plate_mesh
 from wovenimpact.model.model import RigidBody, ShellContactParams
-from wovenimpact.runs import contact_damping_summary
-from wovenimpact.solver import Workspace, energy_balance, step
+from wovenimpact.results.energy import energy_balance
+from wovenimpact.results.summary import contact_damping_summary
+from wovenimpact.solver import Workspace, step
 from wovenimpact.state import CONTACT_PENALTY, CONTACT_WORK, KINETIC0, initial_state
 from tests.verification.meshes import elastic
 

@@ -10,7 +10,8 @@ from wovenimpact.impactor import Impactor
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.model import Section, build_model
 from wovenimpact.model.model import RigidBody
-from wovenimpact.solver import Workspace, energy_balance, step
+from wovenimpact.results.energy import energy_balance
+from wovenimpact.solver import Workspace, step
 from wovenimpact.state import initial_state
 from wovenimpact.verification.strip_impact import StripImpact, smith_theory, strip_impact
 from tests.verification.meshes import elastic, rect_grid

@@ -1,4 +1,4 @@
-"""Energy bookkeeping (solver.explicit.energy_balance): each joule of the internal work
+"""Energy bookkeeping (results.energy.energy_balance): each joule of the internal work
 is booked once — stored and hourglass energy of live elements, the energies of an
 eroded element at its erosion, the rest dissipated (issue 9, point 4)."""
 
@@ -10,7 +10,8 @@ import pytest
 from tests.verification.meshes import elastic, rect_grid
 from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.model import BoundaryConditions, Section, build_model
-from wovenimpact.solver import Workspace, energy_balance, step
+from wovenimpact.results.energy import energy_balance
+from wovenimpact.solver import Workspace, step
 from wovenimpact.state import initial_state
 
 

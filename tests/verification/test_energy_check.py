@@ -143,7 +143,7 @@ def test_a_curved_mesh_at_rest_without_loads_has_error_0(tmp_path):
     (~1e-46 J) is not divided by a floor (was 1.75e254, a failed check). A tiny but
     non-zero input is still judged relative to itself."""
     from tests.io.test_gmsh import write_cylinder_sector
-    from wovenimpact.solver.explicit import error_fraction
+    from wovenimpact.results.energy import error_fraction
 
     write_cylinder_sector(tmp_path / "casing.msh")
     s, h = run(tmp_path, PLATE.split("[mesh]")[0] + """

@@ -22,7 +22,8 @@ from tests.verification.meshes import elastic, rect_grid
 from tests.verification.test_mixed_contact import hybrid_model, momentum_z
 from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.model import Section, build_model
-from wovenimpact.solver import Workspace, energy_balance, step
+from wovenimpact.results.energy import energy_balance
+from wovenimpact.solver import Workspace, step
 from wovenimpact.state import initial_state
 
 

@@ -14,7 +14,8 @@ from tests.verification.meshes import elastic, rect_grid
 from wovenimpact.errors import InputError, SimulationError
 from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.model import BoundaryConditions, Section, build_model
-from wovenimpact.solver import Workspace, energy_balance, step
+from wovenimpact.results.energy import energy_balance
+from wovenimpact.solver import Workspace, step
 from wovenimpact.state import MASS_SCALING, initial_state
 
 

@@ -11,7 +11,8 @@ from wovenimpact.kernels import j2_layout as J
 from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.results.metal_state import plastic_work, thickness_ratio
-from wovenimpact.solver import Workspace, energy_balance, step
+from wovenimpact.results.energy import energy_balance
+from wovenimpact.solver import Workspace, step
 from wovenimpact.spec import load_material
 from wovenimpact.state import initial_state
 from wovenimpact.verification.jones_plate import JonesPlate

@@ -23,7 +23,8 @@ from wovenimpact.model.mesh import plate_mesh
 from wovenimpact.model.model import RigidBody
 from wovenimpact.results.metal_state import plastic_work
 from wovenimpact.setup.compile import stack_plies
-from wovenimpact.solver import Workspace, energy_balance, step
+from wovenimpact.results.energy import energy_balance
+from wovenimpact.solver import Workspace, step
 from wovenimpact.spec import load_material
 from wovenimpact.state import initial_state
 

@@ -11,7 +11,8 @@ from tests.verification.meshes import elastic, rect_grid
 from wovenimpact.kernels import fabric_layout as FL
 from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.model import BoundaryConditions, Section, build_model
-from wovenimpact.solver import Workspace, energy_balance, step
+from wovenimpact.results.energy import energy_balance
+from wovenimpact.solver import Workspace, step
 from wovenimpact.solver.explicit import element_forces
 from wovenimpact.state import KINETIC0, initial_state
 

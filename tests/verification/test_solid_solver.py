@@ -30,7 +30,8 @@ from wovenimpact.materials.transverse_isotropic import update_points
 from wovenimpact.model.model import BoundaryConditions, build_model
 from wovenimpact.model.solid import SolidSection, block_mesh, solid_part
 from wovenimpact.setup.compile import compile_case
-from wovenimpact.solver.explicit import Workspace, energy_balance, step
+from wovenimpact.results.energy import energy_balance
+from wovenimpact.solver.explicit import Workspace, step
 from wovenimpact.spec.case import case_from_dict
 from wovenimpact.state import initial_state
 

@@ -119,7 +119,8 @@ def test_a_spun_blade_driven_at_its_root_keeps_turning_steadily():
     model, st = spun_driven_blade(mesh, t, poisson=0.0)
     x_spun = st.x.copy()
     sigma0 = st.elem[:, 4] / t
-    from wovenimpact.solver import Workspace, energy_balance, step
+    from wovenimpact.results.energy import energy_balance
+    from wovenimpact.solver import Workspace, step
 
     ws = Workspace.for_model(model, st)
     while st.t < 200e-6:

@@ -74,7 +74,7 @@ def test_reaction_of_a_clamped_end_balances_the_pull_of_the_other():
 def test_reaction_is_zero_without_supports_and_its_history_columns_come_last():
     """A strip held only in x at one end (one node also in y) has one support (the node
     with x, y and z held); the history row's last three columns are the reaction's."""
-    from wovenimpact.runs import history_columns, history_row
+    from wovenimpact.results.history_rows import history_columns, history_row
 
     _, _, model, st, _ = strip(clamped=False)
     assert supported_nodes(model).size == 1

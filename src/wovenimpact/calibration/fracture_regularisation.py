@@ -57,7 +57,8 @@ from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.materials.metal import FractureRegularisation, MetalParameters
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.results.metal_state import plastic_work
-from wovenimpact.solver import Workspace, energy_balance, step
+from wovenimpact.results.energy import energy_balance
+from wovenimpact.solver import Workspace, step
 from wovenimpact.state import initial_state
 
 DEFAULT_SIZES = (0.25, 0.5, 1.0, 2.0, 4.0)  # element sizes, multiples of the thickness

@@ -333,6 +333,36 @@ def deflection_plot(model, state, path: str | Path, title: str = "") -> Path:
     return path
 
 
+def write_run_plots(out: Path, title: str, model, state, h: dict, summary: dict) -> None:
+    """The plots of a finished run in ``OUT/plots``: energies; a containment run's fragment
+    plot, a plate's deflection profile and impactor plot, each with the instants its
+    layers (plies) were first perforated and its outcome decided; the energy each layer
+    or ply absorbed over time."""
+    from wovenimpact.results.containment import is_containment, layer_materials
+    from wovenimpact.results.quantities import symmetry_factor  # (the parameters' name)
+
+    plots = out / "plots"
+    factor = symmetry_factor(model)
+    energy_plot(h, plots / "energy.png", title=title, symmetry_factor=factor)
+    if is_containment(model):  # a plate's deflection along y = 0 means nothing on a casing
+        names = [f"layer {k} ({m})" for k, m in enumerate(layer_materials(model))]
+        markers = event_markers(summary.get("layer_perforated_at_s", []),
+                                summary.get("outcome_decided_at_s"), names)
+        fragment_plot(h, plots / "fragment.png", title=title,
+                      outcome=summary.get("outcome", ""), markers=markers)
+    else:
+        if model.n_elems:  # (a model of hexahedra has no plies)
+            deflection_plot(model, state, plots / "ply_deflection.png", title=title)
+        numbers = np.unique(model.ply)
+        names = [f"ply {p}" for p in numbers]
+        markers = event_markers(summary.get("ply_perforated_at_s", []),
+                                summary.get("outcome_decided_at_s"), names)
+    if "impactor_velocity_m_per_s" in h:
+        impactor_plot(h, plots / "impactor.png", title=title, markers=markers)
+    layer_energy_plot(h, plots / "layer_energy.png", title=title, symmetry_factor=factor,
+                      names=names, markers=markers)
+
+
 def _save(fig, path: Path) -> None:
     path.parent.mkdir(parents=True, exist_ok=True)
     with atomic_path(path) as tmp:

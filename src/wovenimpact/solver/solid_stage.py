@@ -75,13 +75,6 @@ def solid_forces(model, state, hex_out: np.ndarray, sb: SolidBuffers) -> None:
             + (f"; {bad.size} hexahedra in this state" if bad.size > 1 else ""))
 
 
-def solid_energies(state) -> tuple[float, float]:
-    """(stored, hourglass) energy of the hexahedra (J): Σ V0 W and Σ E_hg of their rows."""
-    if not state.hex.shape[0]:
-        return 0.0, 0.0
-    return float(np.sum(state.hex[:, HL.H_W])), float(np.sum(state.hex[:, HL.H_W_HG]))
-
-
 def governing_hexahedron(model, hex_state: np.ndarray) -> str:
     """Words naming the hexahedron of the smallest step in ``hex_state`` (for messages)."""
     e = int(np.argmin(hex_state[:, HL.H_DT]))

@@ -138,8 +138,9 @@ def load_study(path: str | Path, overrides=()) -> tuple[StudyInfo, list[Variant]
 
 def check_metrics(path: Path, metrics: list[str], variants: list[Variant]) -> None:
     """An :class:`InputError` naming every metric that no variant's summary will have
-    (runs.summary_keys of the variants that validate; all kinds of case if none does)."""
-    from wovenimpact.runs import (
+    (results.summary.summary_keys of the variants that validate; all kinds of case if
+    none does)."""
+    from wovenimpact.results.summary import (
         COMMON_SUMMARY_KEYS,
         CONTAINMENT_SUMMARY_KEYS,
         IMPACT_SUMMARY_KEYS,

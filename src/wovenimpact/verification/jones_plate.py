@@ -48,7 +48,8 @@ from wovenimpact.materials.metal import MetalParameters
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.model.mesh import plate_mesh
 from wovenimpact.results.metal_state import plastic_work
-from wovenimpact.solver import Workspace, energy_balance, step
+from wovenimpact.results.energy import energy_balance
+from wovenimpact.solver import Workspace, step
 from wovenimpact.state import initial_state
 
 

@@ -40,6 +40,7 @@ def casing_mesh(
     fine_sector: float | None = None,
     coarse_size: float | None = None,
     offset_layers: bool = False,
+    axial_size: float | None = None,
 ) -> Mesh:
     """Coaxial cylindrical layers about the z axis, z ∈ [−length/2, length/2].
 
@@ -54,7 +55,7 @@ def casing_mesh(
         fine_sector, coarse_size: a graded ring (:func:`graded_angles`): ``element_size``
             around the circumference within ``fine_sector`` degrees centred on
             ``centre_angle`` (the impact zone), growing by about 20 % per element
-            to ``coarse_size`` outside it; axially ``element_size`` everywhere. Both
+            to ``coarse_size`` outside it; axially the same size everywhere. Both
             or neither.
         offset_layers: on a full ring, every second layer's node columns sit half-way
             between those of the layer inside it (the angle of each column the mean of
@@ -62,6 +63,10 @@ def casing_mesh(
             element edge of the next instead of a corner shared by four of its elements
             (docs/theory.md §8, "Offset layers"). A sector keeps its cut edges radial:
             InputError.
+        axial_size: the element edge along z (m); None: ``element_size``. Elements
+            longer around than along the axis resolve the casing's axial bending (its
+            boundary layer under a radial load, 0.78 √(R t) long; docs/theory.md §8.8)
+            at a fraction of the elements of a uniformly fine ring.
 
     Elements are counter-clockwise about the outward normal (first edge along the
     circumference, second along +z). Node sets: ``ends`` (z = ±length/2, every layer),
@@ -79,7 +84,10 @@ def casing_mesh(
     full = sector >= 360.0 - 1e-9
     sector = 360.0 if full else sector
     span = math.radians(sector)
-    n_z = _divisions(length, element_size, "casing length")
+    if axial_size is None:
+        n_z = _divisions(length, element_size, "casing length")
+    else:
+        n_z = _divisions(length, axial_size, "casing length", "casing.axial_element_size")
     t0 = math.radians(centre_angle) - 0.5 * span
     if fine_sector is None and coarse_size is None:
         n_t = _divisions(radii[0] * span, element_size, "casing circumference")

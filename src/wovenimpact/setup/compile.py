@@ -369,7 +369,8 @@ def containment_mesh(m, sections) -> tuple[Mesh, list[str], np.ndarray]:
             radii, c.length, m.element_size, sector=math.degrees(c.sector),
             centre_angle=math.degrees(c.centre_angle),
             fine_sector=None if c.fine_sector is None else math.degrees(c.fine_sector),
-            coarse_size=c.coarse_element_size, offset_layers=c.offset_layers)
+            coarse_size=c.coarse_element_size, offset_layers=c.offset_layers,
+            axial_size=c.axial_element_size)
     except InputError as err:
         raise InputError(f"mesh: {err}") from None
     try:  # the blade's own size (mesh.blade.element_size), else the casing's

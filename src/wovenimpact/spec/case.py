@@ -334,6 +334,10 @@ class CasingSpec(BaseModel):
     # every second layer turned by half an element about the axis (full ring only): a
     # node faces an element edge of the next layer, not a corner of four (theory §8)
     offset_layers: boolean() = False
+    # the element edge along the axis (z); not given: mesh.element_size. The axial size is
+    # the one a casing's answer depends on (theory §8.8): a cylinder's bending boundary
+    # layer under a radial load is 0.78 √(R t) long along its axis, long around it
+    axial_element_size: quantity("length", gt=0, example="2 mm") | None = None
 
     @model_validator(mode="after")
     def _grading_needs_both(self):
@@ -396,6 +400,13 @@ class ContainmentMeshSpec(BaseModel):
     element_size: Length  # the casing's (and the blade's, unless mesh.blade.element_size)
     casing: CasingSpec
     blade: BladeSpec
+
+    @property
+    def casing_axial_size(self) -> float:
+        """The casing's element edge along the axis: ``mesh.casing.axial_element_size``,
+        or ``element_size``."""
+        a = self.casing.axial_element_size
+        return self.element_size if a is None else a
 
     @property
     def blade_element_size(self) -> float:
@@ -767,12 +778,16 @@ def check_mesh_size(m, allow_large: bool = False) -> list[Problem]:
     elif isinstance(m, ContainmentMeshSpec):
         c, b = m.casing, m.blade
         fragment = b.tip_radius - b.crack_radius
-        if b.element_size is None:  # one size: the shorter of casing length and fragment
+        axial_key = "mesh.element_size"
+        if c.axial_element_size is None and b.element_size is None:
+            # one size: the shorter of casing length and fragment
             edges = [("mesh.element_size", m.element_size, min(c.length, fragment),
                       "the casing's length or the released fragment")]
         else:
-            edges = [("mesh.element_size", m.element_size, c.length, "the casing's length"),
-                     ("mesh.blade.element_size", b.element_size, fragment,
+            if c.axial_element_size is not None:
+                axial_key = "mesh.casing.axial_element_size"
+            edges = [(axial_key, m.casing_axial_size, c.length, "the casing's length"),
+                     (m.blade_size_key, m.blade_element_size, fragment,
                       "the released fragment")]
         few = [Problem(key, f"gives fewer than 2 elements along {where} ({edge:g} m)", h,
                        f"element_size ≤ {edge / 2.0:.4g} m")
@@ -787,7 +802,7 @@ def check_mesh_size(m, allow_large: bool = False) -> list[Problem]:
         blade = (b.tip_radius - b.root_radius) * max(b.root_chord, b.tip_chord)
         hb = m.blade_element_size
         # no underflow to 0 at 1e-300: each area over the size, then over it again
-        in_casing, in_blade = casing / m.element_size / m.element_size, blade / hb / hb
+        in_casing, in_blade = casing / m.element_size / m.casing_axial_size, blade / hb / hb
         count = in_casing + in_blade
         context = f"casing and blade, {c.layers} layers"
         if in_blade > in_casing and b.element_size is not None:

@@ -106,6 +106,32 @@ class SegmentBins:
             self._alloc(int(1.5 * n))
 
 
+# a solid's face reaches this fraction of its hexahedron's depth V0 / A_face behind it: a
+# node deeper than that is not pushed back out through it (the far faces of a body)
+SOLID_REACH = 0.5
+
+
+def solid_segments(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The solids' contact segments (docs/solid.md §6): (faces, body, reach) — the
+    exterior faces of the hexahedra (outward-ordered), the solid body of each (its
+    contact surface) and its reach D = SOLID_REACH V0 / A, A the face's area at x0."""
+    sp = model.solid
+    faces = np.ascontiguousarray(sp.faces, dtype=np.int64)
+    p = model.x0[faces]
+    area = np.linalg.norm(np.cross(p[:, 2] - p[:, 0], p[:, 3] - p[:, 1]), axis=1) * 0.5
+    reach = SOLID_REACH * sp.vol0[sp.face_hex] / np.maximum(area, 1e-300)
+    return faces, np.ascontiguousarray(sp.body[sp.face_hex]), reach
+
+
+def node_segment_map(quads: np.ndarray, n_nodes: int) -> tuple[np.ndarray, np.ndarray]:
+    """CSR map node → segments, in increasing order per node (the Model's node →
+    element map, over the shells' and the solids' segments)."""
+    order = np.argsort(quads.ravel(), kind="stable")
+    ptr = np.zeros(n_nodes + 1, dtype=np.int64)
+    np.cumsum(np.bincount(quads.ravel(), minlength=n_nodes), out=ptr[1:])
+    return ptr, (order // 4).astype(np.int64)
+
+
 def node_plies(node_ptr, node_elem, ply) -> np.ndarray:
     """(n_nodes,) the ply of all of a node's elements, −1 where they are of several plies
     or there are none (the broad phase's quick exclusion test)."""
@@ -246,8 +272,9 @@ class ShellContact:
         self.self_contact = bool(self_contact)
         self.margin = float(margin)
         quads = np.ascontiguousarray(model.quads, dtype=np.int64)
-        ne, nn = quads.shape[0], model.x0.shape[0]
-        part = np.zeros(ne, dtype=np.int8)
+        n_shells, nn = quads.shape[0], model.x0.shape[0]
+        part = np.zeros(n_shells, dtype=np.int8)
+        ne = n_shells
         if elements is not None:
             idx = np.asarray(elements, dtype=np.int64).ravel()
             if idx.size and (idx.min() < 0 or idx.max() >= ne):
@@ -263,13 +290,28 @@ class ShellContact:
             part[np.isin(model.ply, wanted)] = 1
         else:
             part[:] = 1
-        self.quads = quads
+        self.n_shells = n_shells
         self.ply = np.ascontiguousarray(model.ply, dtype=np.int64)
-        self.elem_part = part
         self.node_mass = np.ascontiguousarray(model.node_mass, dtype=float)
         self.node_ptr = np.ascontiguousarray(model.node_ptr, dtype=np.int64)
         self.node_elem = np.ascontiguousarray(model.node_elem, dtype=np.int64)
         self.h_seg = 0.5 * model.sections[model.elem_section, SL.C_THICK].astype(float)
+        self.one_sided = np.zeros(n_shells, dtype=np.int8)
+        if getattr(model, "n_hexes", 0):
+            # the solids' exterior faces after the shells: one-sided segments without
+            # offset, each body a surface labelled after the shells' plies
+            faces, body, reach = solid_segments(model)
+            first = int(self.ply.max()) + 1 if n_shells else 0
+            quads = np.concatenate([quads, faces])
+            self.ply = np.concatenate([self.ply, first + body])
+            self.h_seg = np.concatenate([self.h_seg, reach])
+            self.one_sided = np.concatenate([self.one_sided, np.ones(len(faces), np.int8)])
+            part = np.concatenate([part, np.ones(len(faces), np.int8)])
+            ne = quads.shape[0]
+            self.node_ptr, self.node_elem = node_segment_map(quads, nn)
+        self.quads = quads
+        self.elem_part = part
+        self.seg_alive = np.ones(ne, dtype=np.int8)  # shells' alive flags, then the faces'
         self.h_node = np.zeros(nn)
         on = part != 0
         for c in range(4):
@@ -279,7 +321,8 @@ class ShellContact:
         self.surfaces = ContactSurfaces(
             quads=self.quads, ply=self.ply, node_ply=self.node_ply, node_ptr=self.node_ptr,
             node_elem=self.node_elem, node_mass=self.node_mass, h_node=self.h_node,
-            h_seg=self.h_seg, margin=self.margin, self_contact=self.self_contact)
+            h_seg=self.h_seg, margin=self.margin, self_contact=self.self_contact,
+            one_sided=self.one_sided)
         self.law = ContactLaw(beta=self.beta, zeta=self.damping, mu=self.friction,
                               approach=self.approach)
         self.slots = np.zeros((nn, CANDIDATE_SLOTS), dtype=np.int64)
@@ -503,7 +546,8 @@ class ShellContact:
     def candidates(self, x, elem_alive=None, node_active=None) -> tuple[np.ndarray, np.ndarray]:
         """Candidate pairs (node, segment) at x, node-major (copies; for tests/diagnostics)."""
         ne, nn = self.quads.shape[0], self.node_part.shape[0]
-        alive = np.ones(ne, dtype=np.int8) if elem_alive is None else elem_alive
+        alive = (np.ones(ne, dtype=np.int8) if elem_alive is None
+                 else self.segments_alive(elem_alive))
         active = np.ones(nn, dtype=np.int8) if node_active is None else node_active
         contact_masks(alive, self.elem_part, active, self.node_part, self.seg_on, self.node_on)
         n = self._search(np.ascontiguousarray(x, dtype=float), self.no_skin)
@@ -522,8 +566,17 @@ class ShellContact:
         with numba.parallel_chunksize(CONTACT_CHUNK):
             return self._forces(x, v, dt, elem_alive, node_active, out_force, accumulate)
 
+    def segments_alive(self, elem_alive):
+        """The segments' alive flags: the shells' ``elem_alive``, then the solids' faces
+        (always live): ``elem_alive`` itself in a model of shells only."""
+        if self.quads.shape[0] == self.n_shells:
+            return elem_alive
+        self.seg_alive[:self.n_shells] = elem_alive
+        return self.seg_alive
+
     def _forces(self, x, v, dt, elem_alive, node_active, out_force, accumulate):
         """:meth:`forces` (its arguments checked)."""
+        elem_alive = self.segments_alive(elem_alive)
         contact_masks(elem_alive, self.elem_part, node_active, self.node_part,
                       self.seg_on, self.node_on)
         joined = self.searched and surfaces_joined(self.node_on, self.node_on_search,

@@ -21,32 +21,56 @@ from wovenimpact.kernels.contact_energy import DAMPING, FRICTION, N_KINDS, SPRIN
 MAX_SURFACES = 64
 
 
+def solid_body_count(model) -> int:
+    """The model's connected solid bodies (each a contact surface; docs/solid.md §6)."""
+    solid = getattr(model, "solid", None)
+    return solid.n_bodies if solid is not None and solid.n_hexes else 0
+
+
 def surface_labels(model) -> tuple[np.ndarray, int, bool]:
     """(elem_part, n_surfaces, lumped): each element's part, the rank of its
     ``Model.ply`` label among the model's labels, and the number of surface parts; with
     more than MAX_SURFACES labels (``lumped``) the ranks from MAX_SURFACES − 1 on share
-    the last part. The bodies follow the surfaces (:func:`n_parts`)."""
+    the last part. The solid bodies are surfaces after the shells' (:func:`hex_parts`);
+    the rigid bodies and the rigid plates follow the surfaces (:func:`n_parts`)."""
     labels, rank = np.unique(model.ply, return_inverse=True)
-    lumped = labels.size > MAX_SURFACES
+    n_labels = labels.size + solid_body_count(model)
+    lumped = n_labels > MAX_SURFACES
     return (np.minimum(rank, MAX_SURFACES - 1).astype(np.int64),
-            int(max(min(labels.size, MAX_SURFACES), 1)), bool(lumped))
+            int(max(min(n_labels, MAX_SURFACES), 1)), bool(lumped))
+
+
+def hex_parts(model) -> np.ndarray:
+    """(n_hexes,) the part of each hexahedron: its solid body's, after the shells'
+    surfaces."""
+    if not solid_body_count(model):
+        return np.zeros(0, dtype=np.int64)
+    first = np.unique(model.ply).size
+    return np.minimum(first + model.solid.body, MAX_SURFACES - 1).astype(np.int64)
 
 
 def n_parts(model) -> int:
-    """Parts of the books: the surfaces, then one per rigid body."""
-    return surface_labels(model)[1] + int(model.body_params.shape[0])
+    """Parts of the books: the surfaces, then one per rigid body, then one per rigid
+    plate."""
+    return (surface_labels(model)[1] + int(model.body_params.shape[0])
+            + len(getattr(model, "rigid_planes", ())))
 
 
 def part_arrays(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(node_part, elem_part, body_part): the part of each node (the lowest of its
-    elements'; 0 for a node without elements), of each element and of each body."""
+    elements', shells' then hexahedra's; 0 for a node without elements), of each
+    element and of each body, then of each rigid plate (``body_part`` holds both)."""
     elem_part, n_surf, _ = surface_labels(model)
     n = model.n_nodes
     counts = np.diff(model.node_ptr)
     low = np.full(n, np.iinfo(np.int64).max)
     np.minimum.at(low, np.repeat(np.arange(n), counts), elem_part[model.node_elem])
+    if solid_body_count(model):
+        np.minimum.at(low, model.solid.hexes.ravel(), np.repeat(hex_parts(model), 8))
+        counts = counts + np.diff(model.solid.node_ptr)
     node_part = np.where(counts > 0, low, 0).astype(np.int64)
-    body_part = n_surf + np.arange(model.body_params.shape[0], dtype=np.int64)
+    n_rigid = int(model.body_params.shape[0]) + len(getattr(model, "rigid_planes", ()))
+    body_part = n_surf + np.arange(n_rigid, dtype=np.int64)
     return node_part, elem_part, body_part
 
 
@@ -75,6 +99,17 @@ def part_names(model) -> list[str]:
                        key=lambda name: (len(name), name))
         exact.append(found[0] if found else None)
     tails = [None if e is None else e.rsplit(".", 1)[-1] for e in exact]
+    n_shell_surf = np.unique(model.ply).size
+    hexp = hex_parts(model)
+    hex_sets = {name: np.sort(np.asarray(e, dtype=np.int64))
+                for name, e in getattr(getattr(model, "solid", None), "sets", {}).items()
+                if name != "all"}
+    for part in range(n_shell_surf, n_surf):  # the solid bodies: a hexahedron set's name
+        hexes = np.flatnonzero(hexp == part)
+        found = sorted((name for name, e in hex_sets.items() if np.array_equal(e, hexes)),
+                       key=lambda name: (len(name), name))
+        exact[part] = found[0] if found else None
+        tails[part] = exact[part]
     names = []
     for part, (full, tail) in enumerate(zip(exact, tails)):
         if lumped and part == n_surf - 1:
@@ -85,6 +120,7 @@ def part_names(model) -> list[str]:
             names.append(tail if tails.count(tail) == 1 else full)
     nb = int(model.body_params.shape[0])
     names += ["impactor"] if nb == 1 else [f"impactor{b}" for b in range(nb)]
+    names += [plane.name for plane in getattr(model, "rigid_planes", ())]
     return names
 
 

@@ -18,6 +18,7 @@ from wovenimpact.kernels import j2_layout as JL
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.kernels import solid_layout as HL
+from wovenimpact.kernels.contact_plane import N_PLANE_STATE, PL_X
 
 # indices of State.energy (J)
 W_INT = 0  # work of the internal forces (membrane, bending, shear, hourglass)
@@ -77,6 +78,9 @@ class State:
         hex: (n_hexes, N_HEX_STATE) state of the hexahedra (solid_layout ``H_*``: the
             rotated Kirchhoff stress, the stretch U, the hourglass forces, the Cauchy
             stress, the stored and hourglass energies, the last element step, the volume).
+        planes: (n_planes, N_PLANE_STATE) the rigid plates (kernels.contact_plane
+            ``PL_*``: position of the plane's point, its velocity of the last step, the
+            force of the nodes on it at x^n).
     """
 
     t: float
@@ -99,6 +103,7 @@ class State:
     contact_work: np.ndarray = field(default_factory=lambda: np.zeros(0))
     contact_books: np.ndarray = field(default_factory=lambda: np.zeros((2, 3, 0, 0)))
     hex: np.ndarray = field(default_factory=lambda: np.zeros((0, HL.N_HEX_STATE)))
+    planes: np.ndarray = field(default_factory=lambda: np.zeros((0, N_PLANE_STATE)))
 
     def copy(self) -> State:
         return State(**{f.name: (getattr(self, f.name).copy() if isinstance(
@@ -190,7 +195,17 @@ def initial_state(model, velocity=None, angular_velocity=None) -> State:
                  node_active=np.ones(n, dtype=np.int8), energy=energy, bodies=bodies,
                  f_contact=np.zeros((n, 3)), mass_ratio=np.zeros(ne), added_mass=np.zeros(n),
                  contact_work=np.zeros(n), contact_books=empty_books(model),
-                 hex=initial_hex_rows(getattr(model, "n_hexes", 0)))
+                 hex=initial_hex_rows(getattr(model, "n_hexes", 0)),
+                 planes=initial_plane_rows(model))
+
+
+def initial_plane_rows(model) -> np.ndarray:
+    """``State.planes`` at the start: each rigid plate at its point, at rest."""
+    planes = getattr(model, "rigid_planes", ())
+    rows = np.zeros((len(planes), N_PLANE_STATE))
+    for row, plane in zip(rows, planes):
+        row[PL_X:PL_X + 3] = plane.point
+    return rows
 
 
 def initial_hex_rows(n: int) -> np.ndarray:

@@ -224,7 +224,8 @@ class RawSearch:
         surfaces = ContactSurfaces(
             quads=m.quads, ply=m.ply, node_ply=self.node_ply, node_ptr=self.ptr,
             node_elem=self.elem, node_mass=np.ones(m.n_nodes), h_node=self.h_node,
-            h_seg=self.h_seg, margin=self.margin, self_contact=self.self_contact)
+            h_seg=self.h_seg, margin=self.margin, self_contact=self.self_contact,
+            one_sided=np.zeros(m.n_elems, np.int8))
         search = ContactSearch(x=x, sigma=sigma, seg_plane=self.seg_plane, edge=edge)
         args = (surfaces, search, node_on, bins, np.zeros(m.n_elems, np.int8), self.slots)
         n = query_candidates(*args, Candidates(ptr=self.pair_ptr, seg=self.pair_seg))

@@ -204,9 +204,10 @@ class ContactSurfaces(NamedTuple):
     node_elem: np.ndarray
     node_mass: np.ndarray  # (n_nodes,) lumped masses (kg)
     h_node: np.ndarray  # (n_nodes,) node offsets h_p (m)
-    h_seg: np.ndarray  # (n_elems,) segment offsets h_s (m)
+    h_seg: np.ndarray  # (n_elems,) segment offsets h_s (m); a solid's face: its reach D_s
     margin: float  # the search margin m (m)
     self_contact: bool  # pairs within a ply (unless the node's element shares a node)
+    one_sided: np.ndarray  # (n_segments,) int8: 1 for a solid's face (outward normal, no offset)
 
 
 class ContactSearch(NamedTuple):

@@ -221,8 +221,8 @@ def shape_functions(xi, eta):
 # arguments that loop's locals (a bundle written through in a parallel loop's body can lose its
 # writes: kernels/bundles.py)
 @block_kernel
-def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, seg_on, pair_ptr,
-                        pair_seg, geo, keep):
+def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, one_sided, margin, seg, seg_on,
+                        pair_ptr, pair_seg, geo, keep):
     """Project node p on each of its candidate segments and keep the closest per group.
 
     Writes, for k in pair_ptr[p] … pair_ptr[p + 1] − 1: keep[k] = 1 for the closest
@@ -268,7 +268,13 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, seg_on, pa
         dn = rx * sx + ry * sy + rz * sz
         side = 1.0 if dn >= 0.0 else -1.0
         d = math.sqrt(rx * rx + ry * ry + rz * rz)
-        if inside == 1 or not d > 0.0:  # the surface normal, turned toward the node
+        if one_sided[s] != 0:  # a solid's face: its outward normal, the signed distance
+            if inside == 0 or -dn > h_seg[s]:  # beyond its edges, or deeper than its reach
+                keep[k] = 0
+                continue
+            nx, ny, nz = sx, sy, sz
+            d = abs(dn)
+        elif inside == 1 or not d > 0.0:  # the surface normal, turned toward the node
             nx, ny, nz = side * sx, side * sy, side * sz
             d = abs(dn) if inside == 1 else d
         else:  # beyond an edge: along p − x_c
@@ -280,7 +286,9 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, seg_on, pa
         geo[k, GEO_N + 1] = ny
         geo[k, GEO_N + 2] = nz
         geo[k, GEO_SIDE] = side
-        keep[k] = PROJECTED_ABOVE if side > 0.0 else PROJECTED_BELOW
+        # a solid's faces form one group whatever the side: the closest face of a body
+        # decides whether the node is inside it (behind that face) or not
+        keep[k] = PROJECTED_ABOVE if side > 0.0 or one_sided[s] != 0 else PROJECTED_BELOW
     # the closest of each (ply, side) group, flagged CLOSEST in keep (its side code stays
     # readable for the comparisons of the candidates after it), then keep = 1 / 0
     for k in range(k0, k1):
@@ -349,6 +357,7 @@ def penalty_forces(x, v, dt, surfaces, law, overlap, seg, seg_on, node_on, candi
     node_mass = surfaces.node_mass
     h_node = surfaces.h_node
     h_seg = surfaces.h_seg
+    one_sided = surfaces.one_sided
     margin = surfaces.margin
     beta = law.beta
     zeta = law.zeta
@@ -373,13 +382,16 @@ def penalty_forces(x, v, dt, surfaces, law, overlap, seg, seg_on, node_on, candi
                 pair_on[k] = 0
             k1 = k0
         elif k1 > k0:
-            evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, seg_on,
-                                pair_ptr, pair_seg, geo, pair_on)
+            evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, one_sided, margin, seg,
+                                seg_on, pair_ptr, pair_seg, geo, pair_on)
         for k in range(k0, k1):
             if pair_on[k] == 0:
                 continue
             s = pair_seg[k]
-            g = geo[k, GEO_DIST] - (h_node[p] + h_seg[s] - overlap[p])
+            if one_sided[s] != 0:  # a solid's face: the signed distance along its normal
+                g = geo[k, GEO_SIDE] * geo[k, GEO_DIST] + overlap[p]
+            else:
+                g = geo[k, GEO_DIST] - (h_node[p] + h_seg[s] - overlap[p])
             if not g < 0.0:
                 pair_on[k] = 0
                 continue
@@ -451,6 +463,7 @@ def initial_overlap(x, surfaces, seg, seg_on, candidates, pairs, overlap):
     ply = surfaces.ply
     h_node = surfaces.h_node
     h_seg = surfaces.h_seg
+    one_sided = surfaces.one_sided
     margin = surfaces.margin
     pair_ptr = candidates.ptr
     pair_seg = candidates.seg
@@ -460,11 +473,16 @@ def initial_overlap(x, surfaces, seg, seg_on, candidates, pairs, overlap):
         o = 0.0
         k0, k1 = pair_ptr[p], pair_ptr[p + 1]
         if k1 > k0:
-            evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, margin, seg, seg_on,
-                                pair_ptr, pair_seg, geo, keep)
+            evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, one_sided, margin, seg,
+                                seg_on, pair_ptr, pair_seg, geo, keep)
             for k in range(k0, k1):
-                if keep[k] != 0:
-                    o = max(o, h_node[p] + h_seg[pair_seg[k]] - geo[k, GEO_DIST])
+                if keep[k] == 0:
+                    continue
+                s = pair_seg[k]
+                if one_sided[s] != 0:
+                    o = max(o, -geo[k, GEO_SIDE] * geo[k, GEO_DIST])
+                else:
+                    o = max(o, h_node[p] + h_seg[s] - geo[k, GEO_DIST])
         overlap[p] = o
 
 

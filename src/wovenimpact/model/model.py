@@ -436,6 +436,8 @@ class Model:
     # the mesh verdict only, so not in the digest
     striking_radius: float = math.inf
     solid: SolidPart = NO_SOLIDS
+    # rigid plates (model.rigid_plane.RigidPlane) that press or hold (docs/solid.md §6)
+    rigid_planes: tuple = ()
 
     @property
     def n_nodes(self) -> int:
@@ -476,6 +478,8 @@ class Model:
         h.update(np.ascontiguousarray(self.release_elems).tobytes())
         if self.solid.n_hexes:  # (a model of shells only keeps its digest)
             self.solid.digest_into(h)
+        for plane in self.rigid_planes:  # (likewise, a model without planes)
+            h.update(b"rigid_plane" + plane.digest_bytes(self.n_nodes))
         return h.hexdigest()
 
 
@@ -726,6 +730,7 @@ def build_model(
     stable_step: str = "isotropic",
     eroded_nodes: str = "remove",
     solid: SolidPart | None = None,
+    rigid_planes=(),
 ) -> Model:
     """Assemble a :class:`Model` from a mesh, named sections and constraints.
 
@@ -755,6 +760,7 @@ def build_model(
             (theory §5, "Eroded nodes").
         solid: the hexahedra on the same nodes (model.solid.solid_part); default none.
             ``quads`` may then be empty.
+        rigid_planes: rigid plates (model.rigid_plane.RigidPlane); default none.
     """
     x0 = np.ascontiguousarray(nodes, dtype=float)
     q = np.ascontiguousarray(quads, dtype=np.int64)
@@ -921,4 +927,5 @@ def build_model(
         max_added_mass_fraction=float(max_added_mass_fraction), elem_mass=m_el,
         elem_rot_inertia=elem_rot_inertia, elem_length=elem_length, elem_failure=elem_failure,
         stable_step=str(stable_step), eroded_nodes=str(eroded_nodes), solid=solid,
+        rigid_planes=tuple(rigid_planes or ()),
     )

@@ -92,6 +92,13 @@ class SolidPart:
             hexahedra in increasing order per node; node_ptr has n_nodes + 1 entries
             (empty for :data:`NO_SOLIDS`).
         sets: name → hexahedron indices (the solids' element sets).
+        faces: (n_faces, 4) the exterior faces (those of one hexahedron only), their
+            corners counter-clockwise seen from outside (x,ξ × x,η points out): the
+            contact segments of the solids (docs/solid.md §6).
+        face_hex: (n_faces,) the hexahedron of each exterior face.
+        body: (n_hexes,) the solid body of each hexahedron: the connected sets of
+            hexahedra (sharing a node), numbered in the order of their lowest
+            hexahedron: each body is a contact surface of its own.
     """
 
     hexes: np.ndarray = field(default_factory=lambda: _empty_int(0, 8))
@@ -110,6 +117,14 @@ class SolidPart:
     node_elem: np.ndarray = field(default_factory=lambda: _empty_int(0))
     node_corner: np.ndarray = field(default_factory=lambda: _empty_int(0))
     sets: dict = field(default_factory=dict)
+    faces: np.ndarray = field(default_factory=lambda: _empty_int(0, 4))
+    face_hex: np.ndarray = field(default_factory=lambda: _empty_int(0))
+    body: np.ndarray = field(default_factory=lambda: _empty_int(0))
+
+    @property
+    def n_bodies(self) -> int:
+        """The connected solid bodies (contact surfaces)."""
+        return int(self.body.max()) + 1 if self.body.size else 0
 
     @property
     def n_hexes(self) -> int:
@@ -147,6 +162,50 @@ def hex_node_map(hexes: np.ndarray, n_nodes: int):
     ptr = np.zeros(n_nodes + 1, dtype=np.int64)
     np.cumsum(np.bincount(flat, minlength=n_nodes), out=ptr[1:])
     return ptr, (order // 8).astype(np.int64), (order % 8).astype(np.int64)
+
+
+# the six faces of a hexahedron in VTK/Abaqus corner order, each counter-clockwise seen
+# from outside: ζ = −1, ζ = +1, η = −1, ξ = +1, η = +1, ξ = −1
+HEX_FACES = np.array([[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6],
+                      [3, 0, 4, 7]], dtype=np.int64)
+
+
+def exterior_faces(hexes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(faces, face_hex): the faces that belong to one hexahedron only (a face is known
+    by its sorted corners), outward-ordered (:data:`HEX_FACES`), in hexahedron and face
+    order."""
+    if not hexes.shape[0]:
+        return _empty_int(0, 4), _empty_int(0)
+    all_faces = hexes[:, HEX_FACES].reshape(-1, 4)
+    key = np.sort(all_faces, axis=1)
+    _, inverse, counts = np.unique(key, axis=0, return_inverse=True, return_counts=True)
+    once = np.flatnonzero(counts[inverse.ravel()] == 1)
+    return (np.ascontiguousarray(all_faces[once], dtype=np.int64),
+            (once // 6).astype(np.int64))
+
+
+def solid_bodies(hexes: np.ndarray, n_nodes: int) -> np.ndarray:
+    """(n_hexes,) the connected body of each hexahedron (hexahedra sharing a node are
+    one body), bodies numbered in the order of their lowest hexahedron."""
+    parent = np.arange(n_nodes)
+
+    def root(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for h in hexes:
+        r0 = root(h[0])
+        for c in h[1:]:
+            rc = root(c)
+            if rc != r0:
+                parent[max(rc, r0)] = min(rc, r0)
+                r0 = min(rc, r0)
+    roots = np.array([root(h[0]) for h in hexes], dtype=np.int64)
+    _, first, label = np.unique(roots, return_index=True, return_inverse=True)
+    rank = np.argsort(np.argsort(first))  # bodies in the order of their lowest hexahedron
+    return rank[label.ravel()].astype(np.int64)
 
 
 def solid_node_map(model) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -247,12 +306,14 @@ def solid_part(x0, hexes, sections: dict[str, SolidSection], hex_section, frames
             "corners must follow the C3D8 order (0–3 one face counter-clockwise seen from "
             "the opposite face 4–7, node 4 above node 0)")
     ptr, elem, corner = hex_node_map(h, len(x0))
+    faces, face_hex = exterior_faces(h)
     return SolidPart(
         hexes=h, section=sec, section_names=tuple(names), mat=mat, params=params,
         material_names=tuple(m.name for m in mats), hourglass=r, frame=frame,
         ref_grad=ref_grad, vol0=vol0, hg_stiffness=k, mass=params[mat, HL.TI_RHO] * vol0,
         node_ptr=ptr, node_elem=elem, node_corner=corner,
-        sets={str(k_): np.asarray(v, dtype=np.int64) for k_, v in (sets or {}).items()})
+        sets={str(k_): np.asarray(v, dtype=np.int64) for k_, v in (sets or {}).items()},
+        faces=faces, face_hex=face_hex, body=solid_bodies(h, len(x0)))
 
 
 def block_mesh(size, elements, origin=(0.0, 0.0, 0.0)) -> Mesh:

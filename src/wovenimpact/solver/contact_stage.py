@@ -1,4 +1,5 @@
-"""Contact stage of the step: impactors on shells, and shells on shells (docs/model.md §4).
+"""Contact stage of the step: impactors and rigid plates on shells and solids, and shells
+and solids on each other (docs/model.md §4, docs/solid.md §6).
 
 Called between the element stage and the node update. It fills ``ws.f_con`` (the
 contact forces on the nodes at x^n, external loads of the shells) and the resultant
@@ -14,14 +15,17 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from wovenimpact.interfaces import n_parts, part_arrays
+from wovenimpact.interfaces import hex_parts, n_parts, part_arrays, solid_body_count
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels.bundles import BodyContact, BodyContactOut, ContactNodes, EnergyBooks
 from wovenimpact.kernels.contact_energy import book_body_pairs
+from wovenimpact.kernels.contact_plane import PL_F, PL_V, PL_X, plane_contact_forces, plane_resultant
+from wovenimpact.kernels.integrate import smooth_step
 from wovenimpact.kernels.contact_rigid import add_body_forces, rigid_contact_forces
 from wovenimpact.kernels.gather import nodes_with_live_elements, node_sum
 from wovenimpact.kernels.rigid_body import advance_body
 from wovenimpact.model.model import flies_sideways
+from wovenimpact.state import W_EXT
 
 
 @dataclass
@@ -47,26 +51,47 @@ class ContactBuffers:
     body_parts: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 11)))
     body_list: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), dtype=np.int64))
     body_count: list = field(default_factory=list)
+    # the part of each contact segment (the shells' elem_part, then the solids' faces')
+    seg_part: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    # the rigid plates: which nodes each meets, the force on each at x^n (N), and as for
+    # a body the parts of its pairs, the list and count of its nodes in contact
+    plane_meets: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), dtype=np.int8))
+    plane_force: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
+    plane_parts: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 11)))
+    plane_list: np.ndarray = field(default_factory=lambda: np.zeros((0, 0), dtype=np.int64))
+    plane_count: list = field(default_factory=list)
 
     @classmethod
     def for_model(cls, model) -> ContactBuffers:
-        """Buffers and, when the model has two or more surfaces (``model.ply``) or
-        self-contact, the shell–shell contact of ``model.shell_contact``."""
+        """Buffers and, when the model has two or more surfaces (``model.ply`` and the
+        solid bodies) or self-contact, the contact of ``model.shell_contact`` between
+        them (the solids' exterior faces as one-sided segments; docs/solid.md §6)."""
         n = model.n_nodes
         shells = None
         p = model.shell_contact
-        if p.enabled and (np.unique(model.ply).size > 1 or p.self_contact):
+        n_surfaces = np.unique(model.ply).size + solid_body_count(model)
+        if p.enabled and (n_surfaces > 1 or p.self_contact):
             from wovenimpact.contact import ShellContact
 
             shells = ShellContact(model, beta=p.beta, damping=p.damping, friction=p.friction,
                                   damping_mode=p.damping_mode, self_contact=p.self_contact)
         nb = model.body_params.shape[0]
         node_part, elem_part, body_part = part_arrays(model)
+        seg_part = elem_part
+        if shells is not None and shells.quads.shape[0] > shells.n_shells:
+            seg_part = np.concatenate([elem_part, hex_parts(model)[model.solid.face_hex]])
+        planes = getattr(model, "rigid_planes", ())
+        npl = len(planes)
         return cls(np.zeros((n, 3)), np.zeros((n, 3)), np.zeros(n),
                    np.zeros(n, dtype=np.int8), shells, node_part=node_part,
                    elem_part=elem_part, body_part=body_part, n_parts=n_parts(model),
                    body_parts=np.zeros((nb, n, 11)),
-                   body_list=np.zeros((nb, n), dtype=np.int64), body_count=[0] * nb)
+                   body_list=np.zeros((nb, n), dtype=np.int64), body_count=[0] * nb,
+                   seg_part=seg_part,
+                   plane_meets=np.array([pl.node_mask(n) for pl in planes],
+                                        dtype=np.int8).reshape(npl, n),
+                   plane_force=np.zeros((npl, 3)), plane_parts=np.zeros((npl, n, 11)),
+                   plane_list=np.zeros((npl, n), dtype=np.int64), plane_count=[0] * npl)
 
 
 def body_frame(state_row, params):
@@ -138,6 +163,20 @@ def contact_forces(model, state, cb: ContactBuffers, dt: float, elem_alive,
         else:
             torque = np.array([tx, ty, tz])
         resultants.append((force, torque))
+    for j, plane in enumerate(getattr(model, "rigid_planes", ())):
+        row = state.planes[j]
+        nodes = ContactNodes(x=state.x, v=state.v, active=active, mass=model.node_mass,
+                             offset=model.node_offset)
+        out = BodyContactOut(force=cb.f_body, energy=cb.e_body, parts=cb.plane_parts[j],
+                             contact_list=cb.plane_list[j])
+        cb.plane_count[j] = plane_contact_forces(
+            nodes, np.ascontiguousarray(row[PL_X:PL_X + 3]), plane.unit_normal,
+            np.ascontiguousarray(row[PL_V:PL_V + 3]), cb.plane_meets[j], plane.beta,
+            plane.damping, plane.friction, dt, out)
+        cb.penalty_energy += node_sum(cb.e_body)
+        cb.plane_force[j] = plane_resultant(cb.f_body, cb.plane_list[j], cb.plane_count[j],
+                                            cb.f_con)
+        resultants.append((cb.plane_force[j], None))
     if cb.shells is not None:
         cb.shell_energy, cb.shell_pairs = cb.shells.forces(
             state.x, state.v, dt, elem_alive, active, cb.f_con, accumulate=True)
@@ -156,7 +195,7 @@ def book_contact_work(model, state, cb: ContactBuffers, w_before: float, books_b
     P, P each). Called once per step, after the bodies moved."""
     if cb.shells is not None:
         cb.shells.book(state.v, w_before, books_before, w_after, books_after, cb.node_part,
-                       cb.elem_part)
+                       cb.seg_part)
     books = EnergyBooks(w_before=float(w_before), before=books_before, w_after=float(w_after),
                         after=books_after)
     for b, count in enumerate(cb.body_count):
@@ -167,14 +206,42 @@ def book_contact_work(model, state, cb: ContactBuffers, w_before: float, books_b
                         cb.body_parts[b], cb.body_list[b], count,
                         model.body_params[b, RB.BP_FRICTION] > 0.0, cb.node_part,
                         int(cb.body_part[b]), books)
+    nb = model.body_params.shape[0]
+    for j, plane in enumerate(getattr(model, "rigid_planes", ())):
+        if cb.plane_count[j] == 0:
+            continue
+        # the plane's velocity after the node update (advance_bodies moved it on)
+        book_body_pairs(state.v, np.ascontiguousarray(state.planes[j, PL_V:PL_V + 3]),
+                        cb.plane_parts[j], cb.plane_list[j], cb.plane_count[j],
+                        plane.friction > 0.0, cb.node_part, int(cb.body_part[nb + j]), books)
 
 
 def advance_bodies(model, state, resultants, dt_old: float, dt_new: float) -> tuple[float, float]:
-    """Advance every body; returns (their kinetic energy at t^n, the work of the contact
-    forces on them over [t^{n−1}, t^n], trapezoid rule)."""
+    """Advance every body, then every rigid plate; returns (the bodies' kinetic energy at
+    t^n, the work of the contact forces on bodies and plates over [t^{n−1}, t^n],
+    trapezoid rule). ``resultants``: the bodies' (force, torque), then the plates'
+    (force, None), of :func:`contact_forces`.
+
+    A plate moves at its prescribed velocity V^{n+1/2} = a(t^n + ½ Δt^{n+1/2}) V (a the
+    case's smooth-step amplitude, as a prescribed nodal velocity), c^{n+1} = c^n +
+    Δt^{n+1/2} V^{n+1/2}. What its driver puts in is the opposite of the work of the
+    contact forces on it: it is booked as external work (``W_EXT``, the reaction work of
+    a prescribed motion) beside the contact work, so the balance counts it as an input
+    and the contact energy holds the springs, dashpots and friction only."""
     ke = 0.0
     work = 0.0
-    for b, (force, torque) in enumerate(resultants):
+    nb = model.body_params.shape[0]
+    for j, plane in enumerate(getattr(model, "rigid_planes", ())):
+        row = state.planes[j]
+        force = resultants[nb + j][0]
+        w = 0.5 * float((row[PL_F:PL_F + 3] + force) @ (dt_old * row[PL_V:PL_V + 3]))
+        work += w
+        state.energy[W_EXT] -= w
+        row[PL_F:PL_F + 3] = force
+        amplitude = smooth_step(state.t + 0.5 * dt_new, model.ramp_time)
+        row[PL_V:PL_V + 3] = amplitude * np.asarray(plane.velocity, dtype=float)
+        row[PL_X:PL_X + 3] += dt_new * row[PL_V:PL_V + 3]
+    for b, (force, torque) in enumerate(resultants[:nb]):
         p = model.body_params[b]
         row = state.bodies[b]
         du = dt_old * row[RB.B_V:RB.B_V + 3]

@@ -1,0 +1,222 @@
+"""Contact of solids (docs/solid.md §6): the hexahedra's exterior faces as one-sided
+segments of the contact stage, and rigid plates (``RigidPlane``) that press or hold.
+
+- two blocks of the yarn pressed together by a plate, the lower one held at its base:
+  the force crosses the interface (plate, interface and support agree), the upper block
+  does not sink into the lower beyond the penalty's overlap, the energy balances and the
+  books by interface add up to the contact energy;
+- a block squeezed between two plates, across its fibre: the force against the block's
+  own shortening is E22 A / L;
+- a block dropped on another (no plate, no damping): it bounces off and the energy
+  balance holds (a node beside a face it is not behind takes no force from it);
+- the coarse crossover cell squeezed between plates: the yarns press on each other and
+  do not pass through each other.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from tests.verification.hex_driver import THESIS_YARN
+from wovenimpact.interfaces import booked_totals, part_names
+from wovenimpact.kernels.contact_plane import PL_F, PL_X
+from wovenimpact.kernels.integrate import PRESCRIBED
+from wovenimpact.model.model import BoundaryConditions, ShellContactParams, build_model
+from wovenimpact.model.rigid_plane import RigidPlane
+from wovenimpact.model.solid import SolidSection, block_mesh, solid_part
+from wovenimpact.results.energy import energy_balance
+from wovenimpact.solver.explicit import Workspace, step
+from wovenimpact.state import initial_state
+
+ROOT = Path(__file__).resolve().parents[2]
+MM = 1e-3
+NO_SHELLS = np.zeros((0, 4), dtype=np.int64)
+ACROSS = SolidSection(THESIS_YARN)  # fibre along x: loads along z are across it (E22)
+
+
+def solids(blocks, bcs_of=None, planes=(), contact=None):
+    """A model of hexahedral blocks (block_mesh meshes) and their node offsets."""
+    offsets = np.cumsum([0] + [len(b.nodes) for b in blocks])
+    nodes = np.vstack([b.nodes for b in blocks])
+    hexes = np.vstack([b.hexes + o for b, o in zip(blocks, offsets)])
+    part = solid_part(nodes, hexes, {"yarn": ACROSS}, np.zeros(len(hexes), dtype=np.int64))
+    bcs = BoundaryConditions(len(nodes))
+    if bcs_of is not None:
+        bcs_of(bcs, offsets)
+    model = build_model(nodes, NO_SHELLS, {}, np.zeros(0, dtype=np.int64), bcs=bcs,
+                        solid=part, rigid_planes=planes,
+                        shell_contact=contact or ShellContactParams())
+    return model, offsets
+
+
+def run(model, steps, velocity=None):
+    state = initial_state(model, velocity=velocity)
+    ws = Workspace.for_model(model, state)
+    for _ in range(steps):
+        step(model, state, ws)
+    return state, ws
+
+
+def test_two_blocks_pressed_together():
+    """A 0.5 mm cube on a 1 × 1 × 0.5 mm block held at its base, pressed by a plate moving
+    down at 0.5 m/s (ramped over 2 µs) for 11 µs: the plate's force, the contact force on
+    the lower block and the support's reaction agree within 2 % (quasi-static
+    equilibrium); the upper block's base is at most 3 times the penalty's mean overlap
+    F / (n k) below the lower block's top; energy error < 1e-4; the books' sum is the
+    contact energy, split over the two blocks' interface and the plate's."""
+    lower = block_mesh((1 * MM, 1 * MM, 0.5 * MM), (4, 4, 2))
+    upper = block_mesh((0.5 * MM, 0.5 * MM, 0.5 * MM), (2, 2, 2),
+                       origin=(0.25 * MM, 0.25 * MM, 0.5 * MM))
+
+    def held(bcs, offsets):
+        bcs.code[lower.node_sets["z_min"], :3] = PRESCRIBED
+        bcs.ramp_time = 2e-6
+
+    plate = RigidPlane(point=(0.0, 0.0, 1 * MM), normal=(0.0, 0.0, -1.0),
+                       velocity=(0.0, 0.0, -0.5), name="plate")
+    model, off = solids([lower, upper], held, planes=[plate])
+    state, ws = run(model, 400)
+    cb = ws.contact
+    f_plate = state.planes[0, PL_F + 2]
+    f_interface = -cb.f_con[:off[1], 2].sum()  # the upper block's push on the lower
+    f_support = state.f_ext[lower.node_sets["z_min"], 2].sum()
+    assert f_plate > 1.0  # N: pressed
+    assert abs(f_interface - f_plate) < 0.02 * f_plate
+    assert abs(f_support - f_plate) < 0.02 * f_plate
+    # the overlap: k = β m / Δt² per pair (the nodes' masses), F shared by the pairs
+    contact = cb.shells
+    base = upper.node_sets["z_min"] + off[1]
+    k_pair = contact.beta * model.node_mass[base].mean() / max(state.dt, state.dt_first) ** 2
+    mean_overlap = f_plate / (contact.n_active * k_pair)
+    # the upper block's base nodes start on the lower block's top nodes: the overlap of
+    # each such pair now (the lower block's own shortening left out)
+    top = lower.node_sets["z_max"]
+    x0 = model.x0
+    under = np.array([top[np.argmin(np.linalg.norm(x0[top, :2] - x0[b, :2], axis=1))]
+                      for b in base])
+    assert np.allclose(x0[under], x0[base])
+    sink = state.x[under, 2] - state.x[base, 2]
+    assert 0.0 < sink.max() < 3.0 * mean_overlap, (sink.max(), mean_overlap)
+    balance = energy_balance(model, state)
+    assert balance["error_fraction"] < 1e-4
+    totals = booked_totals(state.contact_books[0])
+    assert abs(sum(totals.values()) - balance["contact_energy_J"]) < 1e-9 * balance["scale_J"]
+    names = part_names(model)
+    assert names[-1] == "plate" and len(names) == 3
+
+
+def test_block_between_plates_gives_e22():
+    """A 1 mm cube (2 × 2 × 4 hexahedra) between a held plate under it and one moving
+    down at 0.5 m/s (ramped over 5 µs), frictionless: from 12 µs to 20 µs the plate's
+    force against the block's own shortening (its top and bottom nodes) has the slope
+    E22 A / L of uniaxial stress across the fibre within 3 %."""
+    side = 1 * MM
+    block = block_mesh((side, side, side), (2, 2, 4))
+
+    def ramp(bcs, offsets):
+        bcs.ramp_time = 5e-6
+
+    planes = [RigidPlane(point=(0.0, 0.0, 0.0), normal=(0.0, 0.0, 1.0), name="base"),
+              RigidPlane(point=(0.0, 0.0, side), normal=(0.0, 0.0, -1.0),
+                         velocity=(0.0, 0.0, -0.5), name="press")]
+    model, _ = solids([block], ramp, planes=planes)
+    state = initial_state(model)
+    ws = Workspace.for_model(model, state)
+    top, bottom = block.node_sets["z_max"], block.node_sets["z_min"]
+    force, shortening = [], []
+    while state.t < 20e-6:
+        step(model, state, ws)
+        if state.t > 12e-6:
+            force.append(state.planes[1, PL_F + 2])
+            shortening.append(side - (state.x[top, 2].mean() - state.x[bottom, 2].mean()))
+    slope = np.polyfit(shortening, force, 1)[0]
+    expected = THESIS_YARN.e22 * side * side / side
+    assert abs(slope / expected - 1.0) < 0.03, slope / expected
+    assert state.planes[1, PL_X + 2] < side  # the press moved
+    assert energy_balance(model, state)["error_fraction"] < 1e-3
+
+
+def test_block_dropped_on_a_block_bounces():
+    """A cube falling at 5 m/s on a wider free block, offset so that no nodes coincide,
+    frictionless and without dashpot: they part again, the energy balance holds to 1e-6,
+    and after the bounce no pair acts (a node beside a face it is not behind takes no
+    force from it: the closest face of a body decides)."""
+    lower = block_mesh((1 * MM, 1 * MM, 0.5 * MM), (2, 2, 1))
+    upper = block_mesh((0.4 * MM, 0.4 * MM, 0.5 * MM), (1, 1, 1),
+                       origin=(0.13 * MM, 0.17 * MM, 0.501 * MM))
+    model, off = solids([lower, upper], contact=ShellContactParams(damping=0.0))
+    v = np.zeros((model.n_nodes, 3))
+    v[off[1]:, 2] = -5.0
+    state, ws = run(model, 300, velocity=v)
+    assert state.v[off[1]:, 2].mean() > 0.0  # bounced
+    assert ws.contact.shell_pairs == 0
+    assert energy_balance(model, state)["error_fraction"] < 1e-6
+
+
+COARSE_CELL = {"cell": {"name": "coarse thesis cell"},
+               "warp": {"thread_count": "27 1/in", "crimp": 0.0421, "width": "0.9407 mm",
+                        "thickness": "0.2499 mm", "h0": "0.12495 mm"},
+               "section": {"shape": "lenticular", "trim": 0.2},
+               "mesh": {"along": 6, "across": 4, "through": 1}}
+
+
+def cell_between_plates(speed=2.0, ramp=2e-6, cell_doc=COARSE_CELL):
+    """The crossover cell of ``cell_doc`` (the thesis's, coarse) between a held plate
+    under it and one moving down at ``speed`` (m/s) over it; the yarns' end faces held
+    along their yarn (the periodic cell's symmetry planes); frictionless."""
+    from wovenimpact.kernels.integrate import FIXED
+    from wovenimpact.model.crossover_cell import crossover_cell
+    from wovenimpact.spec.crossover import geometry_from_dict
+
+    cell = crossover_cell(geometry_from_dict(cell_doc))
+    mesh = cell.mesh
+    part = solid_part(mesh.nodes, mesh.hexes, {"yarn": SolidSection(THESIS_YARN)},
+                      np.zeros(len(mesh.hexes), dtype=np.int64), frames=cell.frames,
+                      sets=mesh.hex_sets)
+    bcs = BoundaryConditions(len(mesh.nodes))
+    for name, dof in (("warp.x_min", 0), ("warp.x_max", 0), ("fill.y_min", 1),
+                      ("fill.y_max", 1)):
+        bcs.code[mesh.node_sets[name], dof] = FIXED
+    bcs.ramp_time = ramp
+    z = mesh.nodes[:, 2]
+    planes = [RigidPlane(point=(0.0, 0.0, z.min()), normal=(0.0, 0.0, 1.0), name="base"),
+              RigidPlane(point=(0.0, 0.0, z.max()), normal=(0.0, 0.0, -1.0),
+                         velocity=(0.0, 0.0, -speed), name="press")]
+    model = build_model(mesh.nodes, NO_SHELLS, {}, np.zeros(0, dtype=np.int64), bcs=bcs,
+                        solid=part, rigid_planes=planes, node_sets=mesh.node_sets)
+    return cell, model
+
+
+def test_crossover_cell_between_plates():
+    """The coarse cell (6 × 4 × 1 hexahedra per yarn) squeezed at 1 m/s (ramped over
+    5 µs) for 30 µs, 27 µm (5 % of its thickness): the press touches the warp only and
+    the base the fill only, so the force crosses from yarn to yarn: the two plates'
+    forces averaged over the last 10 µs agree within 3 %; no node is deeper in the other
+    yarn than 2 % of the yarn's thickness; the interface is booked as "warp-fill";
+    energy error < 1 %."""
+    cell, model = cell_between_plates(speed=1.0, ramp=5e-6)
+    state = initial_state(model)
+    ws = Workspace.for_model(model, state)
+    forces = []
+    while state.t < 30e-6:
+        step(model, state, ws)
+        if state.t > 20e-6:
+            forces.append((-state.planes[0, PL_F + 2], state.planes[1, PL_F + 2]))
+    f_base, f_press = np.mean(forces, axis=0)
+    assert f_press > 0.5  # N
+    assert abs(f_base - f_press) < 0.03 * f_press, (f_base, f_press)
+    contact = ws.contact.shells
+    assert contact.n_active > 0
+    k = contact.active[:contact.n_active, 1]
+    p = contact.active[:contact.n_active, 0]
+    from wovenimpact.kernels.contact_narrow import GEO_DIST, GEO_SIDE
+    gap = contact.geo[k, GEO_SIDE] * contact.geo[k, GEO_DIST] + contact.overlap[p]
+    thickness = cell.yarns["warp"].thickness
+    assert -gap.min() < 0.02 * thickness, -gap.min() / thickness
+    names = part_names(model)
+    assert names[:2] == ["warp", "fill"]
+    books = state.contact_books[0]
+    assert np.any(books[:, 0, 1] != 0.0) or np.any(books[:, 1, 0] != 0.0)
+    assert energy_balance(model, state)["error_fraction"] < 0.01

@@ -220,3 +220,46 @@ def test_crossover_cell_between_plates():
     books = state.contact_books[0]
     assert np.any(books[:, 0, 1] != 0.0) or np.any(books[:, 1, 0] != 0.0)
     assert energy_balance(model, state)["error_fraction"] < 0.01
+
+
+def plates_case(**press):
+    """A 1 mm cube of the yarn between two ``[[rigid_plane]]`` tables of a case."""
+    from wovenimpact.spec.case import case_from_dict
+
+    doc = {
+        "case": {"name": "cube between plates"},
+        "materials": {"yarn": (ROOT / "examples/materials/kevlar_yarn_solid.toml").as_posix()},
+        "solid_sections": {"yarn": {"material": "yarn"}},
+        "mesh": {"kind": "block", "size": ["1 mm", "1 mm", "1 mm"], "elements": [2, 2, 2],
+                 "section": "yarn"},
+        "amplitude": {"ramp_time": "2 us"},
+        "rigid_plane": [{"point": ["0 mm", "0 mm", "0 mm"], "normal": [0, 0, 1],
+                         "nodes": "z_min", "name": "base"},
+                        {"point": ["0 mm", "0 mm", "1 mm"], "normal": [0, 0, -1],
+                         "velocity": ["0 m/s", "0 m/s", "-0.5 m/s"], **press}],
+        "run": {"end_time": "10 us"},
+    }
+    return case_from_dict(doc)
+
+
+def test_rigid_planes_from_a_case():
+    """``[[rigid_plane]]`` tables compile to the Model's plates (names, node sets, law) and
+    press the cube; a plate that starts with nodes behind it, or a wrong key, is refused
+    naming the key."""
+    import pytest
+
+    from wovenimpact.errors import InputError
+    from wovenimpact.setup.compile import compile_case
+
+    model = compile_case(plates_case(friction=0.1), ROOT).model
+    base, press = model.rigid_planes
+    assert (base.name, press.name) == ("base", "plane1")
+    assert base.node_mask(model.n_nodes).sum() == 9 and press.nodes is None
+    assert press.friction == 0.1 and press.beta == 0.3
+    state, ws = run(model, 60)
+    assert state.planes[1, PL_F + 2] > 0.0 and state.planes[1, PL_X + 2] < 1 * MM
+    assert part_names(model)[-2:] == ["base", "plane1"]
+    with pytest.raises(InputError, match=r"rigid_plane\[1\]\.point"):
+        compile_case(plates_case(point=["0 mm", "0 mm", "0.9 mm"]), ROOT)
+    with pytest.raises(InputError, match=r"rigid_plane"):
+        plates_case(stiffness=0.2)

@@ -20,6 +20,7 @@ import numpy as np
 
 from wovenimpact.errors import InputError
 from wovenimpact.impactor import Impactor
+from wovenimpact.model.rigid_plane import RigidPlane
 from wovenimpact.kernels import rigid_body as RB
 from wovenimpact.kernels.bundles import BodyContact, BodyContactOut, ContactNodes
 from wovenimpact.kernels.contact_rigid import rigid_contact_forces
@@ -489,6 +490,37 @@ def containment_sets(mesh: Mesh, sets, file: str) -> None:
             mesh.elem_sets[f"casing.layer{k}"] = np.asarray(mesh.elem_sets[name], dtype=np.int64)
 
 
+def rigid_planes(spec, mesh) -> list[RigidPlane]:
+    """The case's ``[[rigid_plane]]`` tables as RigidPlane (docs/solid.md §6)."""
+    planes = []
+    for i, p in enumerate(spec.rigid_plane):
+        nodes = node_set(mesh, p.nodes, f"rigid_plane[{i}].nodes")
+        if nodes.size == 0:
+            raise InputError(f"rigid_plane[{i}].nodes: node set {p.nodes!r} holds no node "
+                             "(valid: a set that holds nodes)")
+        try:
+            planes.append(RigidPlane(point=p.point, normal=p.normal, velocity=p.velocity,
+                                     nodes=None if p.nodes == "all" else nodes,
+                                     beta=p.contact_stiffness, damping=p.contact_damping,
+                                     friction=p.friction, name=p.name or f"plane{i}"))
+        except InputError as err:
+            raise InputError(f"rigid_plane[{i}]: {err}") from None
+    return planes
+
+
+def check_plane_start(model, plane, i: int) -> None:
+    """Every node a plane meets must start on its side, at least its contact offset
+    from it (a node behind it would be thrown out at t = 0)."""
+    meets = np.flatnonzero(plane.node_mask(model.n_nodes))
+    side = (model.x0[meets] - np.asarray(plane.point, dtype=float)) @ plane.unit_normal
+    behind = meets[side < model.node_offset[meets] - 1e-9 * max(1.0, float(np.ptp(model.x0)))]
+    if behind.size:
+        raise InputError(
+            f"rigid_plane[{i}].point: {behind.size} node(s) it meets start behind the plane "
+            f"(node {int(behind[0])} at {model.x0[behind[0]].tolist()} m; valid: every node "
+            "of rigid_plane.nodes on the side its normal points to)")
+
+
 def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     """Build the Model and the State at t = 0 of a case (paths relative to ``base``)."""
     base = Path(base)
@@ -570,6 +602,7 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
                                 damping=im.contact_damping, friction=im.friction,
                                 fraction=0.25 if quarter else 1.0, axial_only=quarter,
                                 axis=im.axis))
+    planes = rigid_planes(spec, mesh)
     used = {s: i for i, s in enumerate(dict.fromkeys(elem_sections))}
     solid = solid_sections(spec, materials, mesh)
     model = build_model(
@@ -591,7 +624,10 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         stable_step=spec.run.stable_step,
         eroded_nodes=spec.run.eroded_nodes,
         solid=solid,
+        rigid_planes=planes,
     )
+    for i, plane in enumerate(planes):
+        check_plane_start(model, plane, i)
     v = np.zeros((mesh.n_nodes, 3))
     w = np.zeros((mesh.n_nodes, 3))
     for i, iv in enumerate(spec.initial_velocity):

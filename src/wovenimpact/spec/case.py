@@ -62,6 +62,10 @@ Schema (see README and examples/cases/)::
                       side as an edge; default along the direction, nose first),
                       contact_stiffness (penalty factor β of k = β m / Δt²; 0.3),
                       contact_damping (ζ, fraction of critical; 1), friction (μ; 0)
+    [[rigid_plane]]   point, normal (toward the nodes it meets), velocity? (prescribed;
+                      default at rest: it holds), nodes? (default all), name?,
+                      contact_stiffness (β; 0.3), contact_damping (ζ; 1), friction (μ; 0):
+                      a rigid plate that presses or holds (docs/solid.md §6)
     [contact]         shell–shell contact: surfaces = plies | parts | element_sets |
                       none, self_contact, penalty_scale (β; 0.1), damping (ζ; 0.3),
                       damping_mode (always | approach), friction (μ; 0)
@@ -584,6 +588,28 @@ class ImpactorSpec(BaseModel):
         return self
 
 
+class RigidPlaneSpec(BaseModel):
+    """``[[rigid_plane]]``: a rigid plate, a plane of infinite extent through ``point``
+    with the unit ``normal`` toward the nodes it meets, moving at the prescribed
+    ``velocity`` (scaled by ``[amplitude]`` like a prescribed nodal velocity; not given:
+    it holds), meeting the nodes of ``nodes`` by node-to-plane penalty (docs/solid.md §6).
+    """
+
+    model_config = STRICT
+    point: tuple[Coordinate, Coordinate, Coordinate]
+    normal: Direction
+    velocity: tuple[Velocity, Velocity, Velocity] = (0.0, 0.0, 0.0)
+    nodes: str = "all"
+    # its name in the energy books (default "plane" and its index)
+    name: str | None = None
+    contact_stiffness: quantity("dimensionless", gt=0, le=0.5,
+                                 example="0.3") = BODY_PENALTY_SCALE
+    # the dashpot of each node–plane pair, a fraction of critical: 1 makes a node come
+    # to rest on the plate
+    contact_damping: quantity("dimensionless", ge=0, le=2, example="1") = 1.0
+    friction: quantity("dimensionless", ge=0, le=10, example="0.2") = 0.0
+
+
 class ContactSpec(BaseModel):
     """``[contact]``: shell–shell contact (plies on plies, layers on layers; theory §6.3).
 
@@ -643,6 +669,7 @@ class CaseSpec(BaseModel):
     impactor: ImpactorSpec | None = None
     spin: SpinSpec | None = None
     contact: ContactSpec = ContactSpec()
+    rigid_plane: list[RigidPlaneSpec] = []
     initial_erosion: list[InitialErosionSpec] = []
     run: RunSpec
 

@@ -82,6 +82,7 @@ def test_two_blocks_pressed_together():
     f_plate = state.planes[0, PL_F + 2]
     f_interface = -cb.f_con[:off[1], 2].sum()  # the upper block's push on the lower
     f_support = state.f_ext[lower.node_sets["z_min"], 2].sum()
+    print(f"plate {f_plate:.4f} N, interface {f_interface:.4f} N, support {f_support:.4f} N")
     assert f_plate > 1.0  # N: pressed
     assert abs(f_interface - f_plate) < 0.02 * f_plate
     assert abs(f_support - f_plate) < 0.02 * f_plate
@@ -98,10 +99,13 @@ def test_two_blocks_pressed_together():
                       for b in base])
     assert np.allclose(x0[under], x0[base])
     sink = state.x[under, 2] - state.x[base, 2]
+    print(f"overlap {sink.max():.3e} m, {sink.max() / mean_overlap:.2f} × F / (n k)")
     assert 0.0 < sink.max() < 3.0 * mean_overlap, (sink.max(), mean_overlap)
     balance = energy_balance(model, state)
     assert balance["error_fraction"] < 1e-4
     totals = booked_totals(state.contact_books[0])
+    print(f"energy error {balance['error_fraction']:.1e}, books {sum(totals.values()):.6e} J,"
+          f" contact energy {balance['contact_energy_J']:.6e} J")
     assert abs(sum(totals.values()) - balance["contact_energy_J"]) < 1e-9 * balance["scale_J"]
     names = part_names(model)
     assert names[-1] == "plate" and len(names) == 3
@@ -133,6 +137,8 @@ def test_block_between_plates_gives_e22():
             shortening.append(side - (state.x[top, 2].mean() - state.x[bottom, 2].mean()))
     slope = np.polyfit(shortening, force, 1)[0]
     expected = THESIS_YARN.e22 * side * side / side
+    print(f"slope / (E22 A / L) = {slope / expected:.4f}, "
+          f"error {energy_balance(model, state)['error_fraction']:.1e}")
     assert abs(slope / expected - 1.0) < 0.03, slope / expected
     assert state.planes[1, PL_X + 2] < side  # the press moved
     assert energy_balance(model, state)["error_fraction"] < 1e-3
@@ -150,6 +156,8 @@ def test_block_dropped_on_a_block_bounces():
     v = np.zeros((model.n_nodes, 3))
     v[off[1]:, 2] = -5.0
     state, ws = run(model, 300, velocity=v)
+    print(f"rebound {state.v[off[1]:, 2].mean():.3f} m/s, "
+          f"error {energy_balance(model, state)['error_fraction']:.1e}")
     assert state.v[off[1]:, 2].mean() > 0.0  # bounced
     assert ws.contact.shell_pairs == 0
     assert energy_balance(model, state)["error_fraction"] < 1e-6
@@ -163,30 +171,12 @@ COARSE_CELL = {"cell": {"name": "coarse thesis cell"},
 
 
 def cell_between_plates(speed=2.0, ramp=2e-6, cell_doc=COARSE_CELL):
-    """The crossover cell of ``cell_doc`` (the thesis's, coarse) between a held plate
-    under it and one moving down at ``speed`` (m/s) over it; the yarns' end faces held
-    along their yarn (the periodic cell's symmetry planes); frictionless."""
-    from wovenimpact.kernels.integrate import FIXED
-    from wovenimpact.model.crossover_cell import crossover_cell
+    """The coarse crossover cell between a held plate and a press (calibration.
+    cell_compression): the yarns' end faces held along their yarn, frictionless."""
+    from wovenimpact.calibration.cell_compression import cell_between_plates as between
     from wovenimpact.spec.crossover import geometry_from_dict
 
-    cell = crossover_cell(geometry_from_dict(cell_doc))
-    mesh = cell.mesh
-    part = solid_part(mesh.nodes, mesh.hexes, {"yarn": SolidSection(THESIS_YARN)},
-                      np.zeros(len(mesh.hexes), dtype=np.int64), frames=cell.frames,
-                      sets=mesh.hex_sets)
-    bcs = BoundaryConditions(len(mesh.nodes))
-    for name, dof in (("warp.x_min", 0), ("warp.x_max", 0), ("fill.y_min", 1),
-                      ("fill.y_max", 1)):
-        bcs.code[mesh.node_sets[name], dof] = FIXED
-    bcs.ramp_time = ramp
-    z = mesh.nodes[:, 2]
-    planes = [RigidPlane(point=(0.0, 0.0, z.min()), normal=(0.0, 0.0, 1.0), name="base"),
-              RigidPlane(point=(0.0, 0.0, z.max()), normal=(0.0, 0.0, -1.0),
-                         velocity=(0.0, 0.0, -speed), name="press")]
-    model = build_model(mesh.nodes, NO_SHELLS, {}, np.zeros(0, dtype=np.int64), bcs=bcs,
-                        solid=part, rigid_planes=planes, node_sets=mesh.node_sets)
-    return cell, model
+    return between(geometry_from_dict(cell_doc), THESIS_YARN, speed=speed, ramp=ramp)
 
 
 def test_crossover_cell_between_plates():
@@ -205,6 +195,7 @@ def test_crossover_cell_between_plates():
         if state.t > 20e-6:
             forces.append((-state.planes[0, PL_F + 2], state.planes[1, PL_F + 2]))
     f_base, f_press = np.mean(forces, axis=0)
+    print(f"base {f_base:.4f} N, press {f_press:.4f} N")
     assert f_press > 0.5  # N
     assert abs(f_base - f_press) < 0.03 * f_press, (f_base, f_press)
     contact = ws.contact.shells
@@ -214,6 +205,8 @@ def test_crossover_cell_between_plates():
     from wovenimpact.kernels.contact_narrow import GEO_DIST, GEO_SIDE
     gap = contact.geo[k, GEO_SIDE] * contact.geo[k, GEO_DIST] + contact.overlap[p]
     thickness = cell.yarns["warp"].thickness
+    print(f"deepest {-gap.min():.3e} m, {-gap.min() / thickness:.2e} of the yarn, error "
+          f"{energy_balance(model, state)['error_fraction']:.1e}")
     assert -gap.min() < 0.02 * thickness, -gap.min() / thickness
     names = part_names(model)
     assert names[:2] == ["warp", "fill"]

@@ -707,6 +707,199 @@ def node_element_map(quads: np.ndarray, n_nodes: int):
     return ptr, elem, corner
 
 
+def check_build_arguments(x0, q, *, alpha, erode_dt_fraction, mass_scaling_fraction,
+                          max_added_mass_fraction, stable_step, eroded_nodes) -> None:
+    """Checks :func:`build_model`'s mesh arrays (shapes, node indices) and run parameters
+    (ranges, names), raising an :class:`InputError` that names the first one wrong."""
+    if x0.ndim != 2 or x0.shape[1] != 3:
+        raise InputError(f"nodes must be an (n, 3) array, got shape {x0.shape}")
+    if q.ndim != 2 or q.shape[1] != 4:
+        raise InputError(f"quads must be an (n, 4) array, got shape {q.shape}")
+    if q.size and (q.min() < 0 or q.max() >= len(x0)):
+        raise InputError(f"quads refer to node {int(q.max())}, but there are {len(x0)} nodes")
+    if not 0.0 <= erode_dt_fraction < 1.0:
+        raise InputError(
+            f"erode_dt_fraction = {erode_dt_fraction!r}: valid 0 ≤ f < 1 (0 disables)"
+        )
+    if not 0.0 < alpha <= 1.0:
+        raise InputError(f"alpha = {alpha!r}: the stable-step factor must be in (0, 1]")
+    if mass_scaling_fraction != 0.0 and not erode_dt_fraction < mass_scaling_fraction < 1.0:
+        raise InputError(
+            f"mass_scaling_fraction = {mass_scaling_fraction!r}: valid 0 (off) or "
+            f"erode_dt_fraction ({erode_dt_fraction!r}) < f < 1 — below the erosion "
+            "fraction an element erodes before it would be scaled"
+        )
+    if not 0.0 < max_added_mass_fraction <= 1.0:
+        raise InputError(
+            f"max_added_mass_fraction = {max_added_mass_fraction!r}: valid 0 < f ≤ 1"
+        )
+    if stable_step not in SL.STABLE_STEPS:
+        raise InputError(
+            f"stable_step = {stable_step!r}: valid {' or '.join(SL.STABLE_STEPS)}")
+    if eroded_nodes not in ERODED_NODES:
+        raise InputError(
+            f"eroded_nodes = {eroded_nodes!r}: valid {' or '.join(map(repr, ERODED_NODES))}")
+
+
+def section_table(sections: dict[str, Section], elem_section, n_elems: int):
+    """Builds the section table: (the section names, the distinct material objects in
+    their order of first use, the (n_sections, N_SECTION) table of section rows, each
+    element's section row (n_elems,)); ``elem_section`` gives names or row indices."""
+    names = list(sections)
+    # materials: one table row per distinct material object
+    mats: list = []
+    for sec in sections.values():
+        if not any(sec.material is m for m in mats):
+            mats.append(sec.material)
+    rows = [sections[n].row(next(i for i, m in enumerate(mats) if m is sections[n].material), n)
+            for n in names]
+    sec_table = np.array(rows).reshape(-1, SL.N_SECTION)
+    es = np.asarray(elem_section)
+    if es.dtype.kind in "US":
+        unknown = sorted(set(es.tolist()) - set(names))
+        if unknown:
+            raise InputError(f"unknown section {unknown[0]!r}; defined: {names}")
+        es = np.array([names.index(s) for s in es.tolist()], dtype=np.int64)
+    es = np.ascontiguousarray(es, dtype=np.int64)
+    if es.shape != (n_elems,):
+        raise InputError(f"elem_section must give one section per element ({n_elems})")
+    return names, mats, sec_table, es
+
+
+def material_table(mats: list):
+    """Builds the material table: (each material's kind (SL.MAT_*), its parameter row,
+    the (n_materials, widest row) table of those rows zero-padded, the initial state of
+    one of its material points)."""
+    kinds, params, states = [], [], []
+    for m in mats:
+        if isinstance(m, FabricParameters):
+            kinds.append(SL.MAT_FABRIC)
+            params.append(m.to_array())
+            states.append(fabric_initial_state(m)[0])
+        elif is_plastic(m):
+            kinds.append(SL.MAT_J2)
+            params.append(j2_parameter_row(m))
+            states.append(j2_initial_state(m)[0])
+        else:
+            kinds.append(SL.MAT_ELASTIC)
+            params.append(np.array([m.modulus, m.poisson, m.density]))
+            states.append(np.zeros(0))
+    n_par = max((len(p) for p in params), default=0)
+    mat_params = np.zeros((len(mats), n_par))
+    for i, p in enumerate(params):
+        mat_params[i, : len(p)] = p
+    return kinds, params, mat_params, states
+
+
+def point_state_tables(sec_table, kinds, states, es):
+    """Builds the material points' initial state: (the width of one point's state, each
+    section's points' state blocks (``Model.section_state0``), the first row of
+    ``State.mat`` each element owns (``Model.mat_row``, n_elems + 1))."""
+    # per section: its points' state blocks side by side, each padded to the longest
+    # state vector of the model's kinds (width of the table: the widest section)
+    point_width = max((len(st) for st in states), default=0)
+    padded = [np.pad(st, (0, point_width - len(st))) for st in states]
+    blocks = [np.tile(padded[int(r[SL.C_MAT])], int(r[SL.C_POINTS]) * int(r[SL.C_INPLANE]))
+              if point_width else np.zeros(0) for r in sec_table]
+    section_state0 = np.zeros((len(blocks), max(1, max((len(b) for b in blocks), default=0))))
+    for i, b in enumerate(blocks):
+        section_state0[i, : len(b)] = b
+    # the material rows each element owns (``State.mat``, one row per point): packed, so
+    # that a fabric element beside 2×2×5-point metal owns 4 rows, not 20 (theory §4.6)
+    sec_rows = np.array([int(r[SL.C_POINTS]) * int(r[SL.C_INPLANE])
+                         if point_width and kinds[int(r[SL.C_MAT])] != SL.MAT_ELASTIC else 1
+                         for r in sec_table], dtype=np.int64)
+    mat_row = np.zeros(len(es) + 1, dtype=np.int64)
+    np.cumsum(sec_rows[es], out=mat_row[1:])
+    return point_width, section_state0, mat_row
+
+
+def element_failure_tables(x0, q, warp_direction, sec_table, es, kinds, params, mat_params):
+    """Builds each element's failure lengths and columns (:func:`characteristic_lengths`,
+    :func:`failure_columns`), and writes each fabric's failure threshold of the vector
+    stage (``P_TU_FLOOR``) into ``mat_params``; returns (elem_length, elem_failure)."""
+    elem_mat = sec_table[es, SL.C_MAT].astype(np.int64)
+    elem_length = characteristic_lengths(x0, q, warp_direction, np.array(kinds)[elem_mat])
+    elem_failure = failure_columns(kinds, params, elem_mat, elem_length,
+                                   sec_table[es, SL.C_THICK])
+    for m, kind in enumerate(kinds):  # the vector stage's failure threshold (P_TU_FLOOR)
+        sel = elem_mat == m
+        if kind == SL.MAT_FABRIC and sel.any():
+            mat_params[m, FP.P_TU_FLOOR:FP.P_TU_FLOOR + 2] = np.minimum(
+                1.0, elem_failure[sel, 0:2].min(axis=0))
+    return elem_length, elem_failure
+
+
+def lumped_masses(x0, q, sec_table, es, kinds, mat_params, area0, ref_grad):
+    """Builds the lumped masses of the shells: (each element's mass, the rotary inertia
+    it lumps on each corner, each node's mass, each node's rotary inertia)."""
+    # lumped masses: a quarter of each element's mass to each corner, and the rotary
+    # inertia the element lumps on each corner (rotary_inertia: rotations never govern
+    # the stable step at the reference geometry; theory §4, "Stable step")
+    m_el = sec_table[es, SL.C_AREAL_MASS] * area0
+    elem_rot_inertia = rotary_inertia(x0, q, sec_table, es, np.array(kinds), mat_params, area0,
+                                      ref_grad)
+    node_mass = np.zeros(len(x0))
+    node_inertia = np.zeros(len(x0))
+    for c in range(4):
+        np.add.at(node_mass, q[:, c], 0.25 * m_el)
+        np.add.at(node_inertia, q[:, c], elem_rot_inertia)
+    return m_el, elem_rot_inertia, node_mass, node_inertia
+
+
+def constraint_codes(bcs: BoundaryConditions | None, solid: SolidPart | None, x0, q,
+                     node_mass):
+    """Builds the constraint code of every degree of freedom: (the boundary conditions,
+    none if not given; the solid part, NO_SOLIDS if none; their codes with the rotations
+    of nodes of hexahedra only held); adds the hexahedra's masses to ``node_mass``."""
+    if bcs is None:
+        bcs = BoundaryConditions(len(x0))
+    if bcs.code.shape != (len(x0), 6):
+        raise InputError(f"boundary conditions are for {bcs.code.shape[0]} nodes, mesh has {len(x0)}")
+    if bcs.ramp_time < 0.0:
+        raise InputError(f"ramp_time = {bcs.ramp_time!r} s must be ≥ 0")
+    solid = NO_SOLIDS if solid is None else solid
+    bc_code = bcs.code.copy()
+    if solid.n_hexes:
+        if solid.node_ptr.shape != (len(x0) + 1,):
+            raise InputError(f"the solid part is for {solid.node_ptr.shape[0] - 1} nodes, the "
+                             f"mesh has {len(x0)}")
+        node_mass += solid.node_masses(len(x0))
+        # a node of solids only has no rotations: they are held (no rotary inertia)
+        in_shell = np.zeros(len(x0), dtype=bool)
+        in_shell[q.ravel()] = True
+        solid_only = np.flatnonzero(~in_shell & (np.diff(solid.node_ptr) > 0))
+        bc_code[solid_only, 3:] = FIXED
+    return bcs, solid, bc_code
+
+
+def node_offsets(q, thick, n_nodes: int) -> np.ndarray:
+    """Builds each node's offset from its shells' mid-surface: half the thickest shell
+    on it (0 on a node of no shell)."""
+    node_offset = np.zeros(n_nodes)
+    for c in range(4):
+        np.maximum.at(node_offset, q[:, c], 0.5 * thick)
+    return node_offset
+
+
+def body_tables(bodies: list[RigidBody] | None):
+    """Builds the rigid bodies' tables: (their parameters (n, N_BODY_PARAM), their
+    profiles (n, most points, 2) zero-padded, their states at t = 0 (n, N_BODY_STATE),
+    their travel directions in the body (n, 3))."""
+    packed = [b.pack() for b in (bodies or [])]
+    body_travel = np.array([b.travel_in_body for b in (bodies or [])],
+                           dtype=float).reshape(-1, 3)
+    n_pts = max((len(p[1]) for p in packed), default=0)
+    body_params = np.zeros((len(packed), RB.N_BODY_PARAM))
+    body_profiles = np.zeros((len(packed), n_pts, 2))
+    body_state0 = np.zeros((len(packed), RB.N_BODY_STATE))
+    for i, (bp, prof, st0) in enumerate(packed):
+        body_params[i] = bp
+        body_profiles[i, : len(prof)] = prof
+        body_state0[i] = st0
+    return body_params, body_profiles, body_state0, body_travel
+
+
 def build_model(
     nodes,
     quads,
@@ -764,143 +957,25 @@ def build_model(
     """
     x0 = np.ascontiguousarray(nodes, dtype=float)
     q = np.ascontiguousarray(quads, dtype=np.int64)
-    if x0.ndim != 2 or x0.shape[1] != 3:
-        raise InputError(f"nodes must be an (n, 3) array, got shape {x0.shape}")
-    if q.ndim != 2 or q.shape[1] != 4:
-        raise InputError(f"quads must be an (n, 4) array, got shape {q.shape}")
-    if q.size and (q.min() < 0 or q.max() >= len(x0)):
-        raise InputError(f"quads refer to node {int(q.max())}, but there are {len(x0)} nodes")
-    if not 0.0 <= erode_dt_fraction < 1.0:
-        raise InputError(
-            f"erode_dt_fraction = {erode_dt_fraction!r}: valid 0 ≤ f < 1 (0 disables)"
-        )
-    if not 0.0 < alpha <= 1.0:
-        raise InputError(f"alpha = {alpha!r}: the stable-step factor must be in (0, 1]")
-    if mass_scaling_fraction != 0.0 and not erode_dt_fraction < mass_scaling_fraction < 1.0:
-        raise InputError(
-            f"mass_scaling_fraction = {mass_scaling_fraction!r}: valid 0 (off) or "
-            f"erode_dt_fraction ({erode_dt_fraction!r}) < f < 1 — below the erosion "
-            "fraction an element erodes before it would be scaled"
-        )
-    if not 0.0 < max_added_mass_fraction <= 1.0:
-        raise InputError(
-            f"max_added_mass_fraction = {max_added_mass_fraction!r}: valid 0 < f ≤ 1"
-        )
-    if stable_step not in SL.STABLE_STEPS:
-        raise InputError(
-            f"stable_step = {stable_step!r}: valid {' or '.join(SL.STABLE_STEPS)}")
-    if eroded_nodes not in ERODED_NODES:
-        raise InputError(
-            f"eroded_nodes = {eroded_nodes!r}: valid {' or '.join(map(repr, ERODED_NODES))}")
-    names = list(sections)
-    # materials: one table row per distinct material object
-    mats: list = []
-    for sec in sections.values():
-        if not any(sec.material is m for m in mats):
-            mats.append(sec.material)
-    rows = [sections[n].row(next(i for i, m in enumerate(mats) if m is sections[n].material), n)
-            for n in names]
-    sec_table = np.array(rows).reshape(-1, SL.N_SECTION)
-    es = np.asarray(elem_section)
-    if es.dtype.kind in "US":
-        unknown = sorted(set(es.tolist()) - set(names))
-        if unknown:
-            raise InputError(f"unknown section {unknown[0]!r}; defined: {names}")
-        es = np.array([names.index(s) for s in es.tolist()], dtype=np.int64)
-    es = np.ascontiguousarray(es, dtype=np.int64)
-    if es.shape != (len(q),):
-        raise InputError(f"elem_section must give one section per element ({len(q)})")
-    kinds, params, states = [], [], []
-    for m in mats:
-        if isinstance(m, FabricParameters):
-            kinds.append(SL.MAT_FABRIC)
-            params.append(m.to_array())
-            states.append(fabric_initial_state(m)[0])
-        elif is_plastic(m):
-            kinds.append(SL.MAT_J2)
-            params.append(j2_parameter_row(m))
-            states.append(j2_initial_state(m)[0])
-        else:
-            kinds.append(SL.MAT_ELASTIC)
-            params.append(np.array([m.modulus, m.poisson, m.density]))
-            states.append(np.zeros(0))
-    n_par = max((len(p) for p in params), default=0)
-    mat_params = np.zeros((len(mats), n_par))
-    for i, p in enumerate(params):
-        mat_params[i, : len(p)] = p
-    # per section: its points' state blocks side by side, each padded to the longest
-    # state vector of the model's kinds (width of the table: the widest section)
-    point_width = max((len(st) for st in states), default=0)
-    padded = [np.pad(st, (0, point_width - len(st))) for st in states]
-    blocks = [np.tile(padded[int(r[SL.C_MAT])], int(r[SL.C_POINTS]) * int(r[SL.C_INPLANE]))
-              if point_width else np.zeros(0) for r in sec_table]
-    section_state0 = np.zeros((len(blocks), max(1, max((len(b) for b in blocks), default=0))))
-    for i, b in enumerate(blocks):
-        section_state0[i, : len(b)] = b
-    # the material rows each element owns (``State.mat``, one row per point): packed, so
-    # that a fabric element beside 2×2×5-point metal owns 4 rows, not 20 (theory §4.6)
-    sec_rows = np.array([int(r[SL.C_POINTS]) * int(r[SL.C_INPLANE])
-                         if point_width and kinds[int(r[SL.C_MAT])] != SL.MAT_ELASTIC else 1
-                         for r in sec_table], dtype=np.int64)
-    mat_row = np.zeros(len(q) + 1, dtype=np.int64)
-    np.cumsum(sec_rows[es], out=mat_row[1:])
+    check_build_arguments(x0, q, alpha=alpha, erode_dt_fraction=erode_dt_fraction,
+                          mass_scaling_fraction=mass_scaling_fraction,
+                          max_added_mass_fraction=max_added_mass_fraction,
+                          stable_step=stable_step, eroded_nodes=eroded_nodes)
+    names, mats, sec_table, es = section_table(sections, elem_section, len(q))
+    kinds, params, mat_params, states = material_table(mats)
+    point_width, section_state0, mat_row = point_state_tables(sec_table, kinds, states, es)
     ref_grad, area0, gauss_grad, gauss_weight = material_frame_gradients(x0, q, warp_direction)
-    elem_mat = sec_table[es, SL.C_MAT].astype(np.int64)
-    elem_length = characteristic_lengths(x0, q, warp_direction, np.array(kinds)[elem_mat])
-    elem_failure = failure_columns(kinds, params, elem_mat, elem_length,
-                                   sec_table[es, SL.C_THICK])
-    for m, kind in enumerate(kinds):  # the vector stage's failure threshold (P_TU_FLOOR)
-        sel = elem_mat == m
-        if kind == SL.MAT_FABRIC and sel.any():
-            mat_params[m, FP.P_TU_FLOOR:FP.P_TU_FLOOR + 2] = np.minimum(
-                1.0, elem_failure[sel, 0:2].min(axis=0))
-    # lumped masses: a quarter of each element's mass to each corner, and the rotary
-    # inertia the element lumps on each corner (rotary_inertia: rotations never govern
-    # the stable step at the reference geometry; theory §4, "Stable step")
+    elem_length, elem_failure = element_failure_tables(x0, q, warp_direction, sec_table, es,
+                                                       kinds, params, mat_params)
     thick = sec_table[es, SL.C_THICK]
-    m_el = sec_table[es, SL.C_AREAL_MASS] * area0
-    elem_rot_inertia = rotary_inertia(x0, q, sec_table, es, np.array(kinds), mat_params, area0,
-                                      ref_grad)
-    node_mass = np.zeros(len(x0))
-    node_inertia = np.zeros(len(x0))
-    for c in range(4):
-        np.add.at(node_mass, q[:, c], 0.25 * m_el)
-        np.add.at(node_inertia, q[:, c], elem_rot_inertia)
-    if bcs is None:
-        bcs = BoundaryConditions(len(x0))
-    if bcs.code.shape != (len(x0), 6):
-        raise InputError(f"boundary conditions are for {bcs.code.shape[0]} nodes, mesh has {len(x0)}")
-    if bcs.ramp_time < 0.0:
-        raise InputError(f"ramp_time = {bcs.ramp_time!r} s must be ≥ 0")
-    solid = NO_SOLIDS if solid is None else solid
-    bc_code = bcs.code.copy()
-    if solid.n_hexes:
-        if solid.node_ptr.shape != (len(x0) + 1,):
-            raise InputError(f"the solid part is for {solid.node_ptr.shape[0] - 1} nodes, the "
-                             f"mesh has {len(x0)}")
-        node_mass += solid.node_masses(len(x0))
-        # a node of solids only has no rotations: they are held (no rotary inertia)
-        in_shell = np.zeros(len(x0), dtype=bool)
-        in_shell[q.ravel()] = True
-        solid_only = np.flatnonzero(~in_shell & (np.diff(solid.node_ptr) > 0))
-        bc_code[solid_only, 3:] = FIXED
+    m_el, elem_rot_inertia, node_mass, node_inertia = lumped_masses(
+        x0, q, sec_table, es, kinds, mat_params, area0, ref_grad)
+    bcs, solid, bc_code = constraint_codes(bcs, solid, x0, q, node_mass)
     ba = np.zeros((len(x0), 3)) if body_accel is None else np.broadcast_to(
         np.asarray(body_accel, dtype=float), (len(x0), 3)).copy()
     ptr, n_elem, n_corner = node_element_map(q, len(x0))
-    node_offset = np.zeros(len(x0))
-    for c in range(4):
-        np.maximum.at(node_offset, q[:, c], 0.5 * thick)
-    packed = [b.pack() for b in (bodies or [])]
-    body_travel = np.array([b.travel_in_body for b in (bodies or [])],
-                           dtype=float).reshape(-1, 3)
-    n_pts = max((len(p[1]) for p in packed), default=0)
-    body_params = np.zeros((len(packed), RB.N_BODY_PARAM))
-    body_profiles = np.zeros((len(packed), n_pts, 2))
-    body_state0 = np.zeros((len(packed), RB.N_BODY_STATE))
-    for i, (bp, prof, st0) in enumerate(packed):
-        body_params[i] = bp
-        body_profiles[i, : len(prof)] = prof
-        body_state0[i] = st0
+    node_offset = node_offsets(q, thick, len(x0))
+    body_params, body_profiles, body_state0, body_travel = body_tables(bodies)
     striking = [b.impactor.edge_radius(sideways=b.axis is not None) for b in bodies or ()]
     rel = release_array(release_elems, len(q))
     if rel.size:  # a blade strikes with its edge: half its shell's thickness

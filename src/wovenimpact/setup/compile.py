@@ -521,16 +521,15 @@ def check_plane_start(model, plane, i: int) -> None:
             "of rigid_plane.nodes on the side its normal points to)")
 
 
-def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
-    """Build the Model and the State at t = 0 of a case (paths relative to ``base``)."""
-    base = Path(base)
-    materials = {n: load_case_material(base, n, ref) for n, ref in spec.materials.items()}
+def shell_sections(spec: CaseSpec, materials: dict) -> dict[str, Section]:
+    """Builds the case's shell sections (``[sections.NAME]``) on its materials, refusing a
+    transversely isotropic material (that is for ``[solid_sections.NAME]``)."""
     for name, s in spec.sections.items():
         if is_solid_material(materials[s.material]):
             raise InputError(f"sections.{name}.material: {s.material!r} is a transversely "
                              "isotropic material, for solid sections (valid: a fabric or "
                              "metal for a shell section, or [solid_sections.NAME])")
-    sections = {
+    return {
         name: Section(
             material=materials[s.material], thickness=s.thickness,
             bending_modulus=s.bending_modulus, bending_poisson=s.bending_poisson,
@@ -540,22 +539,35 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         )
         for name, s in spec.sections.items()
     }
+
+
+def case_mesh(spec: CaseSpec, base: Path, sections: dict[str, Section]):
+    """Builds the case's mesh, each element's section name and the warp directions (one
+    vector, or one per element): a generated containment mesh's, or :func:`make_mesh`'s
+    with an imported casing's circumferential warp and an imported blade's radial one
+    (its containment sets checked and named, :func:`containment_sets`)."""
     warp = (spec.mesh.warp if isinstance(spec.mesh, ImportedMeshSpec)
             else getattr(spec.mesh, "warp_direction", None))
     if isinstance(spec.mesh, ContainmentMeshSpec):
-        mesh, elem_sections, warp = containment_mesh(spec.mesh, sections)
-    else:
-        mesh, elem_sections = make_mesh(spec, base, sections)
-        if isinstance(warp, str):  # "circumferential" (an imported casing)
-            warp = circumferential_directions(mesh, spec.mesh.axis)
-        if getattr(spec.mesh, "containment", None) is not None:
-            containment_sets(mesh, spec.mesh.containment, spec.mesh.file)
-            # the blade's warp is radial, as a generated blade's (it lies in the plane of
-            # the axis, normal to the casing's hoop direction)
-            warp = np.array(np.broadcast_to(np.asarray(warp, dtype=float),
-                                            (mesh.n_elems, 3)))
-            blade = mesh.elem_sets["blade.blade"]
-            warp[blade] = radial_directions(mesh, blade)
+        return containment_mesh(spec.mesh, sections)
+    mesh, elem_sections = make_mesh(spec, base, sections)
+    if isinstance(warp, str):  # "circumferential" (an imported casing)
+        warp = circumferential_directions(mesh, spec.mesh.axis)
+    if getattr(spec.mesh, "containment", None) is not None:
+        containment_sets(mesh, spec.mesh.containment, spec.mesh.file)
+        # the blade's warp is radial, as a generated blade's (it lies in the plane of
+        # the axis, normal to the casing's hoop direction)
+        warp = np.array(np.broadcast_to(np.asarray(warp, dtype=float),
+                                        (mesh.n_elems, 3)))
+        blade = mesh.elem_sets["blade.blade"]
+        warp[blade] = radial_directions(mesh, blade)
+    return mesh, elem_sections, warp
+
+
+def boundary_conditions(spec: CaseSpec, mesh: Mesh):
+    """Builds the constraints of the case's ``[[boundary]]`` entries and of a spinning
+    blade's root: (the :class:`BoundaryConditions`, the spin vector, None without
+    ``[spin]``); a boundary on a set that holds no node is refused."""
     bcs = BoundaryConditions(mesh.n_nodes, ramp_time=spec.amplitude.ramp_time)
     for i, b in enumerate(spec.boundary):
         nodes = node_set(mesh, b.nodes, f"boundary[{i}].nodes")
@@ -577,7 +589,13 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     spin = None if spec.spin is None else np.array([0.0, 0.0, spec.spin.rate])
     if spin is not None:  # a containment mesh (spec.case.check_references)
         bcs.rotate(mesh.node_sets["blade.root"], spin)
-    accel = None if spec.body_force is None else spec.body_force.acceleration
+    return bcs, spin
+
+
+def impactor_bodies(spec: CaseSpec) -> list[RigidBody]:
+    """Builds the rigid body of the case's ``[impactor]`` (none without one): a quarter of
+    it in a quarter model, where it must sit on the symmetry axis and travel along z (or
+    fly sideways, :func:`check_quarter_sideways`)."""
     bodies = []
     if spec.impactor is not None:
         im = spec.impactor
@@ -602,10 +620,18 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
                                 damping=im.contact_damping, friction=im.friction,
                                 fraction=0.25 if quarter else 1.0, axial_only=quarter,
                                 axis=im.axis))
-    planes = rigid_planes(spec, mesh)
+    return bodies
+
+
+def case_model(spec: CaseSpec, mesh: Mesh, sections: dict[str, Section], elem_sections,
+               warp, bcs: BoundaryConditions, bodies: list[RigidBody],
+               planes: list[RigidPlane], spin, solid: SolidPart | None) -> Model:
+    """Builds the case's :class:`Model` (:func:`build_model`) from its mesh, the sections
+    its elements use, constraints, impactor, rigid plates and hexahedra, with the body
+    force, the contact's and the run's parameters and a spinning blade's release."""
+    accel = None if spec.body_force is None else spec.body_force.acceleration
     used = {s: i for i, s in enumerate(dict.fromkeys(elem_sections))}
-    solid = solid_sections(spec, materials, mesh)
-    model = build_model(
+    return build_model(
         mesh.nodes, mesh.quads, {s: sections[s] for s in used},
         np.array([used[s] for s in elem_sections], dtype=np.int64), bcs=bcs,
         warp_direction=warp, body_accel=accel, alpha=spec.run.alpha,
@@ -626,8 +652,12 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
         solid=solid,
         rigid_planes=planes,
     )
-    for i, plane in enumerate(planes):
-        check_plane_start(model, plane, i)
+
+
+def initial_velocities(spec: CaseSpec, mesh: Mesh, model: Model):
+    """Builds the velocity and angular velocity of every node at t = 0 from the case's
+    ``[[initial_velocity]]`` entries (n_nodes, 3 each), zero on the constrained degrees
+    of freedom; an entry that would move no node is refused."""
     v = np.zeros((mesh.n_nodes, 3))
     w = np.zeros((mesh.n_nodes, 3))
     for i, iv in enumerate(spec.initial_velocity):
@@ -652,6 +682,24 @@ def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
     fixed = model.bc_code[:, :3] == 1
     v[fixed] = 0.0
     w[model.bc_code[:, 3:] == 1] = 0.0
+    return v, w
+
+
+def compile_case(spec: CaseSpec, base: Path) -> CompiledCase:
+    """Build the Model and the State at t = 0 of a case (paths relative to ``base``)."""
+    base = Path(base)
+    materials = {n: load_case_material(base, n, ref) for n, ref in spec.materials.items()}
+    sections = shell_sections(spec, materials)
+    mesh, elem_sections, warp = case_mesh(spec, base, sections)
+    bcs, spin = boundary_conditions(spec, mesh)
+    bodies = impactor_bodies(spec)
+    planes = rigid_planes(spec, mesh)
+    solid = solid_sections(spec, materials, mesh)
+    model = case_model(spec, mesh, sections, elem_sections, warp, bcs, bodies, planes, spin,
+                       solid)
+    for i, plane in enumerate(planes):
+        check_plane_start(model, plane, i)
+    v, w = initial_velocities(spec, mesh, model)
     check_impactor_clearance(model)
     state = initial_state(model, velocity=v, angular_velocity=w)
     dt = check_case(spec, model, state, mesh, sections)  # setup.sanity: before the spin-up

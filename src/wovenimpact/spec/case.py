@@ -520,9 +520,9 @@ class RunSpec(BaseModel):
     # the run stops once the added mass exceeds this fraction of the model's mass
     max_added_mass_fraction: quantity("dimensionless", gt=0, le=1, example="0.02") = 0.02
     threads: integer(ge=1, example=2) | None = None
-    # largest energy-balance error fraction of a run that ends with exit 0 (runs.summarise;
-    # docs/theory.md §5): 1 %, the report's verdict line; the shipped examples and study
-    # variants stay below 4e-3
+    # largest energy-balance error fraction of a run that ends with exit 0
+    # (results.summary.summarise; docs/theory.md §5): 1 %, the report's verdict line; the
+    # shipped examples and study variants stay below 4e-3
     energy_tolerance: quantity("dimensionless", gt=0, le=1, example="0.01") = 0.01
     # the predicted step count end_time / Δt₁ above which a run is refused (setup.sanity)
     max_steps: integer(ge=1, example=DEFAULT_MAX_STEPS) = DEFAULT_MAX_STEPS

@@ -21,6 +21,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from wovenimpact.calibration.compression import CompressionFit, fit_compression
+from wovenimpact.errors import InputError
 from wovenimpact.kernels.contact_plane import PL_F
 from wovenimpact.kernels.integrate import FIXED
 from wovenimpact.model.crossover_cell import crossover_cell
@@ -72,7 +73,8 @@ class CellCompression:
             second half of the run (quasi-static when small).
         hourglass_fraction: hourglass energy over internal work at the end.
         energy_error: the energy balance's error fraction at the end.
-        fit: the compaction law fitted to the samples with F ≥ 1 % of the target.
+        fit: the compaction law fitted to the samples with F ≥ 1 % of the target; None
+            when it does not fit (too few samples, or a curve without a limit).
         steps, elements: the steps taken and the hexahedra.
     """
 
@@ -120,8 +122,10 @@ def compress_cell(cell_spec, material, *, force: float = 3.0, speed: float = 1.0
     kinetic_fraction = float(np.max(kin[late, 1] / np.maximum(kin[late, 2], 1e-300)))
     balance = energy_balance(model, state)
     use = (arr[:, 2] >= 0.01 * force) & (arr[:, 1] > 0.0)
-    fit = fit_compression(arr[use, 1], arr[use, 2], source="crossover cell") \
-        if np.count_nonzero(use) >= 3 else None
+    try:
+        fit = fit_compression(arr[use, 1], arr[use, 2], source="crossover cell")
+    except InputError:  # too few points, or a curve without a limit: no fit
+        fit = None
     return CellCompression(
         t=arr[:, 0], d=arr[:, 1], force=arr[:, 2], force_base=arr[:, 3],
         force_press=arr[:, 4], kinetic_fraction=kinetic_fraction,

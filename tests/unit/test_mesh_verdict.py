@@ -140,3 +140,42 @@ def test_a_sharp_striker_is_never_resolved_and_the_box_says_so():
     assert found["kevlar_thesis"]["striker_resolved"] is False
     box = mesh_box({"mesh_verdict": found})
     assert box.status == "fail" and "sharp edge (radius 0)" in box.value and "fillet" in box.value
+
+
+def casing_verdict(axial_size):
+    """A 30° sector of the 1 mm aluminium inner shell (mid-surface R = 250.5 mm, 150 mm
+    long), 7 mm around and ``axial_size`` along the axis, its elements the set
+    ``casing.layer0`` as a compiled containment case names them."""
+    from wovenimpact.model.casing import casing_mesh
+
+    aluminium = load_material(REFERENCE_METAL)
+    mesh = casing_mesh([0.2505], 0.15, 7e-3, sector=30.0, centre_angle=90.0,
+                      axial_size=axial_size)
+    model = build_model(mesh.nodes, mesh.quads, {"s": Section(aluminium, thickness=1e-3)},
+                        ["s"] * mesh.n_elems,
+                        elem_sets={f"casing.{k}": v for k, v in mesh.elem_sets.items()})
+    found = mesh_verdict(model, initial_state(model))
+    return aluminium, found[aluminium.name], {"mesh_verdict": found}
+
+
+@pytest.mark.parametrize("axial_size, edge_mm, resolved", [(7e-3, 150 / 22, False),
+                                                           (1e-3, 1.0, True)])
+def test_a_metal_casing_is_judged_on_its_edge_along_the_axis(axial_size, edge_mm, resolved):
+    """ℓ = √(R t)/[3(1 − ν²)]^{1/4} = 12.36 mm for the 1 mm shell at R = 250.5 mm: 150 mm
+    in ⌈150/7⌉ = 22 rows (6.82 mm) is coarser than ℓ/10, in 150 rows (1 mm) finer."""
+    aluminium, v, summary = casing_verdict(axial_size)
+    ell = (0.2505 * 1e-3) ** 0.5 / (3.0 * (1.0 - aluminium.poisson**2)) ** 0.25
+    assert v["casing_bending_length_mm"] == pytest.approx(ell * 1e3, rel=1e-9)
+    assert 12.3 < v["casing_bending_length_mm"] < 12.4
+    assert v["casing_axial_edge_mm"] == pytest.approx(edge_mm, rel=1e-9)
+    assert v["casing_bending_resolved"] is resolved
+    # the fracture law is not regularised, so the box fails either way; its text says why
+    box = mesh_box(summary)
+    assert box.status == "fail"
+    said = "resolved" if resolved else "not resolved (needs ≤ 1.24 mm"
+    assert f"along the casing's axis, its bending length 12.4 mm {said}" in box.value
+
+
+def test_a_plate_says_nothing_of_a_casings_bending():
+    v, _ = verdict(load_material(REFERENCE_METAL), 1e-3, thickness=1e-3)
+    assert v["casing_bending_resolved"] is None and v["casing_bending_length_mm"] is None

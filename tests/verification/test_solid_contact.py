@@ -302,3 +302,39 @@ def test_the_cell_compression_example_compiles_and_presses():
     print(f"t = {state.t * 1e6:.2f} us: base {f_base:.3e} N, press {f_press:.3e} N")
     assert f_press > 0.0 and f_base > 0.0
     assert energy_balance(model, state)["error_fraction"] < 1e-3
+
+
+def test_restart_with_plates_and_solid_contact_ends_bitwise(tmp_path):
+    """The coarse cell between a base and a press (the example's case on a 6 × 4 × 1 cell),
+    killed after a checkpoint and restarted, ends with the same history.csv and the same
+    State — the plates' rows (position, velocity, force) and the contact books included —
+    as an uninterrupted run."""
+    from wovenimpact.io.checkpoint import latest_checkpoint, load_checkpoint
+    from wovenimpact.runs import run_case
+    from wovenimpact.setup.compile import compile_case
+    from wovenimpact.spec.case import load_case
+
+    geometry = (ROOT / "examples" / "crossover" / "thesis_cell.toml").read_text()
+    geometry = geometry.replace("along = 12", "along = 6").replace("across = 8", "across = 4")
+    geometry = geometry.replace("through = 2", "through = 1")
+    (tmp_path / "cell.toml").write_text(geometry, encoding="utf-8")
+    text = (ROOT / "examples" / "crossover" / "cell_compression.toml").read_text()
+    text = text.replace('"../materials/', f'"{(ROOT / "examples" / "materials").as_posix()}/')
+    text = text.replace('file = "thesis_cell.toml"', 'file = "cell.toml"')
+    text = text.replace('"-0.25 m/s"', '"-2 m/s"').replace('ramp_time = "5 us"',
+                                                           'ramp_time = "0.5 us"')
+    text = text.replace('checkpoint_interval = "2 us"', 'checkpoint_interval = "0.5 us"')
+    case = tmp_path / "case.toml"
+    case.write_text(text, encoding="utf-8")
+    whole, broken = tmp_path / "whole", tmp_path / "broken"
+    full = run_case(case, whole)
+    partial = run_case(case, broken, max_steps=int(0.7 * full["steps"]))
+    assert "interrupted_at_step" in partial
+    run_case(case, broken, restart=True)
+    assert (whole / "history.csv").read_text() == (broken / "history.csv").read_text()
+    spec, base = load_case(case)
+    digest = compile_case(spec, base).model.digest()
+    a = load_checkpoint(latest_checkpoint(whole / "checkpoints"), digest)
+    b = load_checkpoint(latest_checkpoint(broken / "checkpoints"), digest)
+    assert a.planes.shape == (2, 9) and a.planes[1, PL_F + 2] > 0.0
+    assert a.equals(b)

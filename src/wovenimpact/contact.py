@@ -314,8 +314,15 @@ class ShellContact:
         self.seg_alive = np.ones(ne, dtype=np.int8)  # shells' alive flags, then the faces'
         self.h_node = np.zeros(nn)
         on = part != 0
+        shell_on = on & (self.one_sided == 0)
         for c in range(4):
-            np.maximum.at(self.h_node, quads[on, c], self.h_seg[on])
+            np.maximum.at(self.h_node, quads[shell_on, c], self.h_seg[shell_on])
+        # the skins' floor follows a node's offset, or on a solid its faces' reach
+        self.h_skin = self.h_node
+        if self.one_sided.any():
+            self.h_skin = self.h_node.copy()
+            for c in range(4):
+                np.maximum.at(self.h_skin, quads[on, c], self.h_seg[on])
         self.node_ply = node_plies(self.node_ptr, self.node_elem, self.ply)
         # what the kernels read of the surfaces and the law (fixed)
         self.surfaces = ContactSurfaces(
@@ -478,7 +485,7 @@ class ShellContact:
         if self.skin is not None:
             out[:] = 0.5 * self.skin
         else:
-            node_skins(v, dt, REUSE_STEPS, self.h_node, SKIN_FLOOR, out)
+            node_skins(v, dt, REUSE_STEPS, self.h_skin, SKIN_FLOOR, out)
         return out
 
     def _full_search(self, x, v, dt: float) -> None:

@@ -269,7 +269,8 @@ def evaluate_node_pairs(p, x, quads, ply, h_node, h_seg, one_sided, margin, seg,
         side = 1.0 if dn >= 0.0 else -1.0
         d = math.sqrt(rx * rx + ry * ry + rz * rz)
         if one_sided[s] != 0:  # a solid's face: its outward normal, the signed distance
-            if inside == 0 or -dn > h_seg[s]:  # beyond its edges, or deeper than its reach
+            # beyond its edges, or deeper than its reach: no pair
+            if inside == 0 or h_node[p] - dn > h_seg[s]:
                 keep[k] = 0
                 continue
             nx, ny, nz = sx, sy, sz
@@ -389,7 +390,7 @@ def penalty_forces(x, v, dt, surfaces, law, overlap, seg, seg_on, node_on, candi
                 continue
             s = pair_seg[k]
             if one_sided[s] != 0:  # a solid's face: the signed distance along its normal
-                g = geo[k, GEO_SIDE] * geo[k, GEO_DIST] + overlap[p]
+                g = geo[k, GEO_SIDE] * geo[k, GEO_DIST] - (h_node[p] - overlap[p])
             else:
                 g = geo[k, GEO_DIST] - (h_node[p] + h_seg[s] - overlap[p])
             if not g < 0.0:
@@ -480,7 +481,7 @@ def initial_overlap(x, surfaces, seg, seg_on, candidates, pairs, overlap):
                     continue
                 s = pair_seg[k]
                 if one_sided[s] != 0:
-                    o = max(o, -geo[k, GEO_SIDE] * geo[k, GEO_DIST])
+                    o = max(o, h_node[p] - geo[k, GEO_SIDE] * geo[k, GEO_DIST])
                 else:
                     o = max(o, h_node[p] + h_seg[s] - geo[k, GEO_DIST])
         overlap[p] = o

@@ -1,4 +1,5 @@
-"""Shell–shell general contact ("plies on plies"): the Python driver of the contact kernels.
+"""Shell–shell general contact ("plies on plies"), and the solids' faces (docs/solid.md §6):
+the Python driver of the contact kernels.
 
 :class:`ShellContact` owns the buffers and parameters; :mod:`wovenimpact.kernels.
 contact_broad` finds candidate (node, segment) pairs, :mod:`wovenimpact.kernels.
@@ -233,6 +234,12 @@ class ShellContact:
 
     Offsets: segment offset h_s = t_e / 2 of its element; node offset h_p = the largest
     t_e / 2 of the taking-part elements around it.
+
+    Solids (docs/solid.md §6): the exterior faces of the Model's hexahedra are segments
+    after the shells' (``n_shells`` of them first), one-sided (``one_sided``), each
+    connected body a surface labelled after the shells' plies; a face's h_s is its reach
+    SOLID_REACH · V0 / A, a node of solids only has h_p = 0 (its skins follow its faces'
+    reach). ``elements``/``plies`` select among the shells; the faces always take part.
     """
 
     def __init__(

@@ -29,7 +29,13 @@ Gap and penalty, for a kept pair of node p and segment s:
     f_n = (−k g − c v_n) n  on the node when g < 0,  energy ½ k g²,
 
 h the half-thicknesses (shell offsets) and o_p the node's initial-overlap
-allowance (``initial_overlap``; 0 if unused). With β ≤ ½ the pair's frequency obeys
+allowance (``initial_overlap``; 0 if unused).
+
+A solid's exterior face (``one_sided`` 1; docs/solid.md §6) has no offset and an inside:
+n is its outward normal x,ξ × x,η (never turned), the gap is the signed distance
+g = (p − x_c)·n − (h_p − o_p), and only a projection inside the face, no deeper than
+the face's reach h_s behind it, makes a candidate. All the faces of one body form one
+group whatever the node's side: the closest decides whether the node is inside. With β ≤ ½ the pair's frequency obeys
 ω² Δt² = β min(m_p, m̄_s)(1/m_p + 1/m̄_s) ≤ 2β ≤ 1 < 4: contact never limits the
 stable step.
 

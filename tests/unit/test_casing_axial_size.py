@@ -64,3 +64,19 @@ def test_a_bad_axial_size_is_refused_naming_the_key(value, message):
 
     with pytest.raises(InputError, match=message):
         load_case(CASE, [f"mesh.casing.axial_element_size={value}"])
+
+
+def test_the_summary_and_the_report_name_the_axial_size(rings):
+    """summary.json's casing_axial_element_size_m where the key is given (not otherwise),
+    and the report's element-size line reads both sizes of the casing."""
+    from wovenimpact.io.report import element_size_text
+    from wovenimpact.results.summary import element_sizes
+    from wovenimpact.spec.case import load_case
+
+    fine, _ = load_case(CASE, ["mesh.casing.axial_element_size=4 mm"])
+    sizes = element_sizes(fine, rings["fine axially"].model)
+    assert sizes == {"element_size_m": 0.005, "blade_element_size_m": 0.005,
+                     "casing_axial_element_size_m": 0.004}
+    assert element_size_text(sizes) == "casing 5 mm around × 4 mm along the axis, blade 5 mm"
+    plain, _ = load_case(CASE)
+    assert "casing_axial_element_size_m" not in element_sizes(plain, rings["today"].model)

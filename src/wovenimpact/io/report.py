@@ -261,11 +261,15 @@ def mesh_box(summary: dict) -> Verdict:
 
 
 def element_size_text(summary: dict) -> str:
-    """The element size(s) of a run in mm: "casing 10 mm, blade 5 mm" or "2 mm"."""
+    """The element size(s) of a run in mm: "casing 10 mm, blade 5 mm", "casing 7 mm
+    around × 2 mm along the axis, blade 5 mm" or "2 mm"."""
     size, blade = summary.get("element_size_m"), summary.get("blade_element_size_m")
     if size is None and blade is None:
         return "not in this summary (written before wovenimpact recorded it): see the mesh box"
     mm = (lambda v: "n/a" if v is None else f"{v * 1e3:.3g} mm")
+    if "casing_axial_element_size_m" in summary:
+        axial = summary["casing_axial_element_size_m"]
+        return f"casing {mm(size)} around × {mm(axial)} along the axis, blade {mm(blade)}"
     if "blade_element_size_m" in summary:
         return f"casing {mm(size)}, blade {mm(blade)}"
     return mm(size)

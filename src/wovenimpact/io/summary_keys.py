@@ -188,6 +188,10 @@ KEYS: dict[str, Key] = {
                                   "∛(element volume)"),
     "blade_element_size_m": Key(_R, "blade element size", *MM,
                                 meaning="mesh.blade.element_size, else the casing's"),
+    "casing_axial_element_size_m": Key(_R, "casing element size along the axis", *MM,
+                                       meaning="mesh.casing.axial_element_size (given: the "
+                                               "casing's elements are element size around, "
+                                               "this along the axis)"),
     "mesh_verdict": Key(_R, "mesh verdict",
                         meaning="each failing material's elements against the sizes its "
                                 "failure law is calibrated for (docs/theory.md §1.4)"),

@@ -147,7 +147,8 @@ def element_sizes(spec, model) -> dict:
     """summary.json's element sizes (m), the first thing a reader of a result asks:
     ``element_size_m``, the case's ``mesh.element_size`` (a containment casing's: the fine
     sector's in a graded ring) and, for a containment case, ``blade_element_size_m``, the
-    blade's (``mesh.blade.element_size``, else the casing's). An imported mesh has no
+    blade's (``mesh.blade.element_size``, else the casing's), and
+    ``casing_axial_element_size_m`` where ``mesh.casing.axial_element_size`` is given. An imported mesh has no
     such key: there each is the median √(element area) of the elements it stands for
     (the casing layers' and the rest, the blade, in an imported containment mesh), and a
     mesh of hexahedra only (``mesh.kind = "block"`` or imported) has the median
@@ -158,8 +159,11 @@ def element_sizes(spec, model) -> dict:
     if mesh.kind == "plate":
         return {"element_size_m": float(mesh.element_size)}
     if mesh.kind == "containment":
-        return {"element_size_m": float(mesh.element_size),
-                "blade_element_size_m": float(mesh.blade_element_size)}
+        sizes = {"element_size_m": float(mesh.element_size),
+                 "blade_element_size_m": float(mesh.blade_element_size)}
+        if mesh.casing.axial_element_size is not None:
+            sizes["casing_axial_element_size_m"] = float(mesh.casing.axial_element_size)
+        return sizes
 
     def median_size(elems) -> float | None:
         return float(np.sqrt(np.median(model.area0[elems]))) if len(elems) else None
@@ -237,4 +241,6 @@ def summary_keys(spec) -> tuple[str, ...]:
 
     extra = (CONTAINMENT_SUMMARY_KEYS if is_containment_spec(spec)
              else IMPACT_SUMMARY_KEYS if spec.impactor is not None else ())
+    if getattr(getattr(spec.mesh, "casing", None), "axial_element_size", None) is not None:
+        extra += ("casing_axial_element_size_m",)  # element_sizes: only where it is given
     return tuple(dict.fromkeys(COMMON_SUMMARY_KEYS + extra))

@@ -147,6 +147,53 @@ def node_plies(node_ptr, node_elem, ply) -> np.ndarray:
     return np.where((counts > 0) & (low == high), low, -1).astype(np.int64)
 
 
+def check_law(beta, damping, friction, damping_mode, margin) -> None:
+    """Raise InputError unless the contact law's parameters and the search margin are
+    valid (the ranges of ShellContact's keyword parameters)."""
+    if not (math.isfinite(beta) and 0.0 < beta <= 0.5):
+        raise InputError(f"contact beta = {beta!r}; valid: 0 < β ≤ 0.5 (default 0.1)")
+    if not (math.isfinite(damping) and 0.0 <= damping <= 2.0):
+        raise InputError(f"contact damping = {damping!r}; valid: 0 ≤ ζ ≤ 2 (a fraction of "
+                         "critical damping; default 1)")
+    if not (math.isfinite(friction) and friction >= 0.0):
+        raise InputError(f"contact friction = {friction!r}; valid: a coefficient μ ≥ 0")
+    if damping_mode not in DAMPING_MODES:
+        raise InputError(f"contact damping_mode = {damping_mode!r}; valid: "
+                         f"{' or '.join(map(repr, DAMPING_MODES))}")
+    if not (math.isfinite(margin) and margin >= 0.0):
+        raise InputError(f"contact margin = {margin!r} m; valid: ≥ 0")
+
+
+def check_skin(skin) -> None:
+    """Raise InputError unless ``skin`` is None (per-node skins) or a length ≥ 0."""
+    if skin is not None and not (math.isfinite(skin) and skin >= 0.0):
+        raise InputError(f"contact skin = {skin!r} m; valid: ≥ 0, or unset for the "
+                         "per-node skins that follow the speed")
+
+
+def shells_taking_part(model, elements, plies) -> np.ndarray:
+    """(n_shells,) int8 flags of the shells taking part in contact: the ``elements``
+    given, else those of the ``plies`` given, else all; InputError on an unknown one."""
+    ne = model.quads.shape[0]
+    part = np.zeros(ne, dtype=np.int8)
+    if elements is not None:
+        idx = np.asarray(elements, dtype=np.int64).ravel()
+        if idx.size and (idx.min() < 0 or idx.max() >= ne):
+            raise InputError(f"contact elements refer to element {int(idx.max())}; "
+                             f"valid: 0 ≤ index < {ne}")
+        part[idx] = 1
+    elif plies is not None:
+        wanted = np.asarray(plies, dtype=np.int64).ravel()
+        unknown = sorted(set(wanted.tolist()) - set(np.unique(model.ply).tolist()))
+        if unknown:
+            raise InputError(f"contact plies {unknown} do not exist; the model has plies "
+                             f"{np.unique(model.ply).tolist()}")
+        part[np.isin(model.ply, wanted)] = 1
+    else:
+        part[:] = 1
+    return part
+
+
 class ShellContact:
     """Node-to-segment penalty contact between shell plies, both passes, with offsets.
 
@@ -259,18 +306,7 @@ class ShellContact:
         x_initial=None,
         capacity: int | None = None,
     ) -> None:
-        if not (math.isfinite(beta) and 0.0 < beta <= 0.5):
-            raise InputError(f"contact beta = {beta!r}; valid: 0 < β ≤ 0.5 (default 0.1)")
-        if not (math.isfinite(damping) and 0.0 <= damping <= 2.0):
-            raise InputError(f"contact damping = {damping!r}; valid: 0 ≤ ζ ≤ 2 (a fraction of "
-                             "critical damping; default 1)")
-        if not (math.isfinite(friction) and friction >= 0.0):
-            raise InputError(f"contact friction = {friction!r}; valid: a coefficient μ ≥ 0")
-        if damping_mode not in DAMPING_MODES:
-            raise InputError(f"contact damping_mode = {damping_mode!r}; valid: "
-                             f"{' or '.join(map(repr, DAMPING_MODES))}")
-        if not (math.isfinite(margin) and margin >= 0.0):
-            raise InputError(f"contact margin = {margin!r} m; valid: ≥ 0")
+        check_law(beta, damping, friction, damping_mode, margin)
         self.beta = float(beta)
         self.damping = float(damping)
         self.friction = float(friction)
@@ -278,25 +314,30 @@ class ShellContact:
         self.approach = damping_mode == "approach"
         self.self_contact = bool(self_contact)
         self.margin = float(margin)
+        self._build_surfaces(model, shells_taking_part(model, elements, plies))
+        self.law = ContactLaw(beta=self.beta, zeta=self.damping, mu=self.friction,
+                              approach=self.approach)
+        check_skin(skin)
+        self.skin = None if skin is None else float(skin)
+        nn, ne = self.node_part.shape[0], self.quads.shape[0]
+        self._alloc_search_state(nn, ne)
+        self._alloc_scratch(nn, ne)
+        if capacity is None:
+            capacity = max(64, 8 * int(self.node_part.sum()))
+        self._alloc_pairs(capacity)
+        if remove_initial_overlap:
+            x = model.x0 if x_initial is None else np.ascontiguousarray(x_initial, dtype=float)
+            self._measure_overlap(x)
+
+    def _build_surfaces(self, model, part: np.ndarray) -> None:
+        """The segments table and the surfaces the kernels read (fixed): the shells'
+        segments (``quads``, ``ply``, half thicknesses ``h_seg``), then the solids'
+        exterior faces (one-sided, their reach as ``h_seg``, each body a surface labelled
+        after the shells' plies); the node → segment map, the nodes' offsets ``h_node``
+        and skin floors ``h_skin``, ``node_ply``, the taking-part flags ``elem_part`` (from
+        ``part``, the shells') and ``node_part``, ``seg_alive``, and ``surfaces``."""
         quads = np.ascontiguousarray(model.quads, dtype=np.int64)
         n_shells, nn = quads.shape[0], model.x0.shape[0]
-        part = np.zeros(n_shells, dtype=np.int8)
-        ne = n_shells
-        if elements is not None:
-            idx = np.asarray(elements, dtype=np.int64).ravel()
-            if idx.size and (idx.min() < 0 or idx.max() >= ne):
-                raise InputError(f"contact elements refer to element {int(idx.max())}; "
-                                 f"valid: 0 ≤ index < {ne}")
-            part[idx] = 1
-        elif plies is not None:
-            wanted = np.asarray(plies, dtype=np.int64).ravel()
-            unknown = sorted(set(wanted.tolist()) - set(np.unique(model.ply).tolist()))
-            if unknown:
-                raise InputError(f"contact plies {unknown} do not exist; the model has plies "
-                                 f"{np.unique(model.ply).tolist()}")
-            part[np.isin(model.ply, wanted)] = 1
-        else:
-            part[:] = 1
         self.n_shells = n_shells
         self.ply = np.ascontiguousarray(model.ply, dtype=np.int64)
         self.node_mass = np.ascontiguousarray(model.node_mass, dtype=float)
@@ -304,6 +345,7 @@ class ShellContact:
         self.node_elem = np.ascontiguousarray(model.node_elem, dtype=np.int64)
         self.h_seg = 0.5 * model.sections[model.elem_section, SL.C_THICK].astype(float)
         self.one_sided = np.zeros(n_shells, dtype=np.int8)
+        ne = n_shells
         if getattr(model, "n_hexes", 0):
             # the solids' exterior faces after the shells: one-sided segments without
             # offset, each body a surface labelled after the shells' plies
@@ -331,21 +373,19 @@ class ShellContact:
             for c in range(4):
                 np.maximum.at(self.h_skin, quads[on, c], self.h_seg[on])
         self.node_ply = node_plies(self.node_ptr, self.node_elem, self.ply)
-        # what the kernels read of the surfaces and the law (fixed)
+        # what the kernels read of the surfaces (fixed)
         self.surfaces = ContactSurfaces(
             quads=self.quads, ply=self.ply, node_ply=self.node_ply, node_ptr=self.node_ptr,
             node_elem=self.node_elem, node_mass=self.node_mass, h_node=self.h_node,
             h_seg=self.h_seg, margin=self.margin, self_contact=self.self_contact,
             one_sided=self.one_sided)
-        self.law = ContactLaw(beta=self.beta, zeta=self.damping, mu=self.friction,
-                              approach=self.approach)
-        self.slots = np.zeros((nn, CANDIDATE_SLOTS), dtype=np.int64)
         self.node_part = np.zeros(nn, dtype=np.int8)
         self.node_part[quads[on].ravel()] = 1
-        if skin is not None and not (math.isfinite(skin) and skin >= 0.0):
-            raise InputError(f"contact skin = {skin!r} m; valid: ≥ 0, or unset for the "
-                             "per-node skins that follow the speed")
-        self.skin = None if skin is None else float(skin)
+
+    def _alloc_search_state(self, nn: int, ne: int) -> None:
+        """The state of candidate reuse for ``nn`` nodes and ``ne`` segments: the skins
+        and configuration of the last full search (none yet), the search counters and
+        their causes, and the buffers of the incremental updates (contact_update)."""
         self.sigma = np.zeros(nn)  # node skins of the last search (m)
         self.no_skin = np.zeros(nn)  # zero skins: a search that is not reused
         # the configuration and masks of the last search of forces(); no search yet
@@ -373,7 +413,13 @@ class ShellContact:
         self.new_bounds = np.zeros(6)
         self.new_bins = SegmentBins()
         self.side_bins = SegmentBins()
-        # fixed-size scratch
+
+    def _alloc_scratch(self, nn: int, ne: int) -> None:
+        """The fixed-size scratch for ``nn`` nodes and ``ne`` segments (masks, segment
+        boxes, planes and geometry, the search's slots and bin entries, the pair
+        pointers, node forces, ``overlap``), the counters of forces() and the energy
+        books' compact tables (grown on demand); the pair buffers are _alloc_pairs'."""
+        self.slots = np.zeros((nn, CANDIDATE_SLOTS), dtype=np.int64)
         self.seg_on = np.zeros(ne, dtype=np.int8)
         self.node_on = np.zeros(nn, dtype=np.int8)
         self.seg_box = np.zeros((ne, N_SEG_BOX))
@@ -393,17 +439,17 @@ class ShellContact:
         self.act_if = np.zeros(0, dtype=np.int64)
         self.act_pw = np.zeros((0, 2 * N_KINDS))
         self.cell = 0.0
-        if capacity is None:
-            capacity = max(64, 8 * int(self.node_part.sum()))
-        self._alloc_pairs(capacity)
-        if remove_initial_overlap:
-            x = model.x0 if x_initial is None else np.ascontiguousarray(x_initial, dtype=float)
-            contact_masks(np.ones(ne, dtype=np.int8), part, np.ones(nn, dtype=np.int8),
-                          self.node_part, self.seg_on, self.node_on)
-            self._search(x, self.no_skin)
-            segment_geometry(x, self.quads, self.seg_on, self.seg_geo)
-            initial_overlap(x, self.surfaces, self.seg_geo, self.seg_on, self.candidates_now,
-                            self.pair_tables, self.overlap)
+
+    def _measure_overlap(self, x) -> None:
+        """``overlap``: each taking-part node's initial penetration (m) in the
+        configuration ``x``, from a search without skins (remove_initial_overlap)."""
+        ne, nn = self.quads.shape[0], self.node_part.shape[0]
+        contact_masks(np.ones(ne, dtype=np.int8), self.elem_part, np.ones(nn, dtype=np.int8),
+                      self.node_part, self.seg_on, self.node_on)
+        self._search(x, self.no_skin)
+        segment_geometry(x, self.quads, self.seg_on, self.seg_geo)
+        initial_overlap(x, self.surfaces, self.seg_geo, self.seg_on, self.candidates_now,
+                        self.pair_tables, self.overlap)
 
     @property
     def candidates_now(self) -> Candidates:

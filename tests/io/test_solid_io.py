@@ -240,3 +240,26 @@ def test_a_wrong_solid_input_is_refused_naming_its_key(tmp_path, change, key):
         doc[table] = {**doc[table], **value} if table.endswith("sections") else value
     with pytest.raises(InputError, match=key.replace(".", r"\.")):
         compile_case(case_from_dict(doc), tmp_path)
+
+
+@pytest.mark.parametrize("extra, sections, message", [
+    ("*ELSET, ELSET=SKIN2\n3\n", {"SKIN": "skin", "SKIN2": "skin2"},
+     r"mesh\.sections: element 0 is in two sets with different sections \('skin' and 'skin2'\)"),
+    ("*ELSET, ELSET=YARN2\n2\n", {"YARN": "yarn", "YARN2": "yarn2"},
+     r"mesh\.sections: brick 1 is in two sets with different sections \('yarn' and 'yarn2'\)"),
+])
+def test_an_element_in_two_sets_of_different_sections_is_refused(tmp_path, extra, sections,
+                                                                  message):
+    """setup.compile.give_section, for the shells' sets and the bricks'."""
+    (tmp_path / "mixed.inp").write_text(INP + extra, encoding="utf-8")
+    doc = {
+        "case": {"name": "bricks"},
+        "materials": {"yarn": YARN.as_posix(), "steel": STEEL.as_posix()},
+        "sections": {n: {"material": "steel", "thickness": "0.1 mm"} for n in ("skin", "skin2")},
+        "solid_sections": {n: {"material": "yarn"} for n in ("yarn", "yarn2")},
+        "mesh": {"kind": "abaqus", "file": "mixed.inp", "length_unit": "1 mm",
+                 "sections": {"SKIN": "skin", "YARN": "yarn", **sections}},
+        "run": {"end_time": "1 us"},
+    }
+    with pytest.raises(InputError, match=message):
+        compile_case(case_from_dict(doc), tmp_path)

@@ -241,6 +241,6 @@ def summary_keys(spec) -> tuple[str, ...]:
 
     extra = (CONTAINMENT_SUMMARY_KEYS if is_containment_spec(spec)
              else IMPACT_SUMMARY_KEYS if spec.impactor is not None else ())
-    if getattr(getattr(spec.mesh, "casing", None), "axial_element_size", None) is not None:
+    if spec.mesh.kind == "containment" and spec.mesh.casing.axial_element_size is not None:
         extra += ("casing_axial_element_size_m",)  # element_sizes: only where it is given
     return tuple(dict.fromkeys(COMMON_SUMMARY_KEYS + extra))

@@ -161,11 +161,7 @@ def make_mesh(spec: CaseSpec, base: Path, sections: dict | None = None
             raise InputError(f"mesh.sections: element set {elset!r} of {m.file} holds no "
                              f"element, so section {section!r} would be given to nothing "
                              "(valid: a set that holds elements)")
-        for e in mesh.elem_sets[elset]:
-            if names[e] is not None and names[e] != section:
-                raise InputError(f"mesh.sections: element {e} is in two sets with different "
-                                 f"sections ({names[e]!r} and {section!r})")
-            names[e] = section
+        give_section(names, mesh.elem_sets[elset], section, "element")
     missing = [e for e, s in enumerate(names) if s is None]
     if missing:
         raise InputError(f"mesh.sections: {len(missing)} elements (first: {missing[0]}) are in "
@@ -174,6 +170,17 @@ def make_mesh(spec: CaseSpec, base: Path, sections: dict | None = None
         sections.update(section_thicknesses(deck, names, sections, m.length_unit, m.file))
     mesh.ply = contact_surfaces(mesh, spec.contact.surfaces, shell_sets)
     return mesh, names  # type: ignore[return-value]
+
+
+def give_section(names: list, elements, section: str, noun: str) -> None:
+    """``names[e] = section`` for each element e of a set of ``mesh.sections``; an element
+    already given another section by an earlier set is an InputError (``noun``: "element"
+    for shells, "brick" for hexahedra)."""
+    for e in elements:
+        if names[e] is not None and names[e] != section:
+            raise InputError(f"mesh.sections: {noun} {e} is in two sets with different "
+                             f"sections ({names[e]!r} and {section!r})")
+        names[e] = section
 
 
 def solid_sections(spec: CaseSpec, materials: dict, mesh: Mesh) -> SolidPart | None:
@@ -210,11 +217,7 @@ def solid_sections(spec: CaseSpec, materials: dict, mesh: Mesh) -> SolidPart | N
                                  f"8-node brick (C3D8R, C3D8), so solid section {section!r} "
                                  f"would be given to nothing; sets of bricks there: "
                                  f"{sorted(k for k, v in mesh.hex_sets.items() if len(v))}")
-            for e in mesh.hex_sets[elset]:
-                if names[e] is not None and names[e] != section:
-                    raise InputError(f"mesh.sections: brick {e} is in two sets with different "
-                                     f"sections ({names[e]!r} and {section!r})")
-                names[e] = section
+            give_section(names, mesh.hex_sets[elset], section, "brick")
         missing = [e for e, s in enumerate(names) if s is None]
         if missing:
             raise InputError(f"mesh.sections: {len(missing)} 8-node bricks (first: {missing[0]}) "

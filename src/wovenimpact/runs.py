@@ -208,7 +208,7 @@ def run_spec(
             raise
         taken += 1
         if h_sched.due(state.t) or state.t >= run.end_time:
-            row = history_row(model, state, normaliser, casing_watch)
+            row = history_row(model, state, normaliser, casing_watch, ws.contact)
             normaliser = row["energy_normaliser_part_J"]
             history.append(row)
             decided = watch(history) if watch else None

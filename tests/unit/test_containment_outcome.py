@@ -136,7 +136,7 @@ def test_containment_outputs_bulge_layer_and_material_energies_and_fragment_plot
     them against quantities.ply_energies) and the materials' energies are those layers'
     sums (aluminium: the inner shell; the fabric section: the plies); the run draws the
     fragment plot and not a plate's deflection profile, and writes casing and blade as
-    two VTU blocks."""
+    two VTU blocks; its history has the blade–casing and layer contact forces."""
     from pathlib import Path
 
     from wovenimpact.io.history import read_csv
@@ -198,6 +198,12 @@ def test_containment_outputs_bulge_layer_and_material_energies_and_fragment_plot
     assert blade < -sum(per_layer) < 0.0  # the fragment lost more than the casing took
     assert sum(per_layer) + blade == pytest.approx(total, rel=1e-9)
     assert (out / "plots" / "fragment.png").exists()
+    # the contact force histories (results.contact_forces): blade on casing and layer k on
+    # layer k + 1, zero before the impact, acting once the tip has struck
+    forces = ["contact_force_blade_casing_N", "contact_force_layer0_layer1_N",
+              "contact_force_layer1_layer2_N"]
+    assert all(h[c][0] == 0.0 for c in forces)
+    assert all(np.max(h[c]) > 0.0 for c in forces[:2])
     assert not (out / "plots" / "ply_deflection.png").exists()
     # the VTU series: casing and blade as the blocks (parts 0, 1) of each frame, each file
     # with its own nodes, together every element once

@@ -309,6 +309,37 @@ def layer_energy_plot(h: dict, path: str | Path, title: str = "",
     return path
 
 
+def contact_force_plot(h: dict, path: str | Path, title: str = "", markers=()) -> Path | None:
+    """The contact force histories of results.contact_forces (kN): the blade on the casing
+    and layer k on layer k + 1 (containment), or ply on ply along the impactor's travel
+    with the force on the impactor (plate impact); ``markers`` as on the fragment plot.
+    None (nothing written) when the history has no such column."""
+    columns = [c for c in h if c.startswith("contact_force_") and c != "contact_force_full_N"]
+    if "contact_force_full_N" in h and columns:
+        columns = ["contact_force_full_N"] + columns
+    if not columns:
+        return None
+    path = Path(path)
+    t = h["time_s"] * 1e6
+    fig, ax = plt.subplots(figsize=(7.5, 4.4))
+    for c in columns:
+        label = ("on the impactor" if c == "contact_force_full_N" else
+                 c.removeprefix("contact_force_").removesuffix("_full_N").removesuffix("_N")
+                 .replace("_", " on ", 1).replace("_", " "))
+        ax.plot(t, 1e-3 * np.asarray(h[c], dtype=float), label=label,
+                lw=1.6 if c in ("contact_force_full_N", "contact_force_blade_casing_N") else 1.0)
+    _mark((ax,), markers)
+    ax.set_xlabel("time (µs)")
+    plate = columns[0] == "contact_force_full_N"  # along the travel, whole problem
+    ax.set_ylabel("contact force along the travel (kN)" if plate else "contact force (kN)")
+    ax.set_title(title)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7, ncol=2, loc="upper right")
+    fig.tight_layout()
+    _save(fig, path)
+    return path
+
+
 def deflection_plot(model, state, path: str | Path, title: str = "") -> Path:
     """Deflection of each ply along the line y ≈ 0 (the x axis through the impact
     point) at the end of the run."""
@@ -337,7 +368,7 @@ def write_run_plots(out: Path, title: str, model, state, h: dict, summary: dict)
     """The plots of a finished run in ``OUT/plots``: energies; a containment run's fragment
     plot, a plate's deflection profile and impactor plot, each with the instants its
     layers (plies) were first perforated and its outcome decided; the energy each layer
-    or ply absorbed over time."""
+    or ply absorbed over time; the contact forces between the parts."""
     from wovenimpact.results.containment import is_containment, layer_materials
     from wovenimpact.results.quantities import symmetry_factor  # (the parameters' name)
 
@@ -361,6 +392,7 @@ def write_run_plots(out: Path, title: str, model, state, h: dict, summary: dict)
         impactor_plot(h, plots / "impactor.png", title=title, markers=markers)
     layer_energy_plot(h, plots / "layer_energy.png", title=title, symmetry_factor=factor,
                       names=names, markers=markers)
+    contact_force_plot(h, plots / "contact_forces.png", title=title, markers=markers)
 
 
 def _save(fig, path: Path) -> None:

@@ -13,6 +13,7 @@ import numpy as np
 
 from wovenimpact.interfaces import booked_totals
 from wovenimpact.kernels import shell_layout as SL
+from wovenimpact.results.contact_forces import contact_force_columns, contact_force_row
 from wovenimpact.results.containment import (
     CASING_ENERGY_COLUMNS,
     CONTAINMENT_COLUMNS,
@@ -85,12 +86,15 @@ def history_columns(model) -> tuple[str, ...]:
     ``ply{p}_intact_ahead`` (quantities.ply_row). After them, appended later still,
     ``reaction_force_{x,y,z}_part_N``: the summed reaction force of the supports (nodes with
     all three translations fixed) in global axes, the force whose work
-    ``reaction_work_part_J`` books (quantities.support_reaction)."""
+    ``reaction_work_part_J`` books (quantities.support_reaction). Last, the contact force
+    between the blade and the casing and between consecutive layers or plies
+    (results.contact_forces: ``contact_force_blade_casing_N``,
+    ``contact_force_layer{k}_layer{k+1}_N``, ``contact_force_ply{p}_ply{q}_full_N``)."""
     return (HISTORY_COLUMNS + (IMPACT_COLUMNS if model.body_params.shape[0] else ())
             + (METAL_COLUMNS if has_metal(model) else ())
             + (MASS_SCALING_COLUMNS if model.mass_scaling_fraction > 0.0 else ())
             + (CONTAINMENT_COLUMNS + CASING_ENERGY_COLUMNS if is_containment(model) else ())
-            + per_layer_columns(model) + REACTION_COLUMNS)
+            + per_layer_columns(model) + REACTION_COLUMNS + contact_force_columns(model))
 
 
 def per_layer_columns(model) -> tuple[str, ...]:
@@ -103,11 +107,13 @@ def per_layer_columns(model) -> tuple[str, ...]:
 
 
 def history_row(model, state: State, normaliser: float = 0.0,
-                watch: CasingWatch | None = None) -> dict:
+                watch: CasingWatch | None = None, contact=None) -> dict:
     """One history.csv row of ``state`` (columns :func:`history_columns`); ``normaliser``
     is the previous row's ``energy_normaliser_part_J`` (0 for the first row); ``watch``
     the run's :class:`~wovenimpact.results.containment.CasingWatch` (containment models; made
-    for the row when not given)."""
+    for the row when not given); ``contact`` the step's contact buffers
+    (``Workspace.contact``), whose last forces give the interface force columns (zeros
+    without: before the first step)."""
     eb = energy_balance(model, state)
     booked = booked_totals(state.contact_books[0])
     scale = max(normaliser, eb["scale_J"])
@@ -128,6 +134,7 @@ def history_row(model, state: State, normaliser: float = 0.0,
     if model.mass_scaling_fraction > 0.0:
         impact.update(mass_scaling_row(state))
     impact.update(reaction_row(model, state))
+    impact.update(contact_force_row(model, contact))
     return {
         **impact,
         "time_s": float(state.t), "step": int(state.step), "dt_s": float(state.dt),

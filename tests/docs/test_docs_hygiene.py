@@ -99,3 +99,31 @@ def test_the_link_check_sees_links():
     assert len(relative_links(ROOT / "docs" / "index.md")) >= 8
     outside = (ROOT / "docs" / "../../shared/MODEL.md").resolve()
     assert not outside.is_relative_to(ROOT)
+
+
+THEORY = ROOT / "docs" / "theory.md"
+DATE = re.compile(r"\b20\d\d-\d\d(?:-\d\d)?\b")
+HASH = re.compile(r"\b(?=[0-9a-f]*[a-f])(?=[0-9a-f]*\d)[0-9a-f]{7,40}\b")
+
+
+def diary_marks(text: str) -> list[str]:
+    """Dates and commit hashes in a manual's text, links to the dated notes left out (a
+    note's file name carries its month: docs/notes/2026-11-….md)."""
+    text = re.sub(r"\[[^\]]*\]\(notes/[^)]*\)", "", text)
+    return DATE.findall(text) + HASH.findall(text)
+
+
+def test_the_manual_is_under_1500_lines_and_holds_no_diary():
+    """docs/theory.md is a manual, not a notebook (issue 37): under 1 500 lines, and no
+    date or commit hash in it (what was tried, and when, lives in docs/notes/)."""
+    text = THEORY.read_text(encoding="utf-8")
+    assert len(text.splitlines()) < 1500
+    assert diary_marks(text) == []
+
+
+def test_the_diary_check_sees_dates_and_hashes():
+    """The check above finds a date and a commit hash, and passes a link to a note."""
+    assert diary_marks("measured on 2026-11-28 at 14916d7") == ["2026-11-28", "14916d7"]
+    assert diary_marks("see [the note](notes/2026-11-mesh-convergence.md)") == []
+    assert diary_marks("[notes/2026-11-x.md](notes/2026-11-x.md)") == []
+    assert diary_marks("a = 0.1239 mm, 1e-12, deadbeef is no hash but ab12cd3 is") == ["ab12cd3"]

@@ -286,6 +286,56 @@ def test_transverse_compression_of_the_cell_to_3_newtons():
     assert r.energy_error < 0.01
 
 
+@pytest.mark.slow
+def test_compression_with_the_thesis_end_conditions_is_set_by_the_transverse_moduli():
+    """The thesis's end conditions (§5.3.2: the yarns' ends move only along their own
+    yarn) on its mesh (12 × 8 × 2), squeezed at 1 m/s until the yarns' contact force (its
+    F_c) reaches 3 N (about 15 s): the held ends carry part of the press's force (the press
+    pushes more than 1.5 × the yarns' force, the base gets less than a fifth of the
+    press's), the run is quasi-static (kinetic energy < 2 % of the internal work) with the
+    hourglass energy below 10 % of it and the energy balanced; and the compression is the
+    yarn's transverse compliance: with E22, G12 and G23 a third of Table 5-2's, d_c at 3 N
+    grows by more than 1.5 × (a compression set by the yarns' bending would not move).
+    The figures, beside the thesis's: docs/solid.md §6.3."""
+    import dataclasses
+
+    from wovenimpact.calibration.cell_compression import compress_cell
+    from wovenimpact.spec.crossover import geometry_from_dict
+
+    doc = dict(COARSE_CELL, mesh={"along": 12, "across": 8, "through": 2})
+    soft = dataclasses.replace(THESIS_YARN, e22=THESIS_YARN.e22 / 3, g12=THESIS_YARN.g12 / 3,
+                               g23=THESIS_YARN.g23 / 3)
+    r, r_soft = (compress_cell(geometry_from_dict(doc), y, force=3.0, speed=1.0, ends="thesis",
+                               measure="yarns") for y in (THESIS_YARN, soft))
+    print(f"d(3 N) {r.d[-1] * 1e3:.4f} mm (softer {r_soft.d[-1] * 1e3:.4f} mm); press "
+          f"{r.force_press[-1]:.3f}, base {r.force_base[-1]:.3f}, yarns {r.force_yarns[-1]:.3f} N;"
+          f" kinetic {r.kinetic_fraction:.4f}, hourglass {r.hourglass_fraction:.4f}")
+    assert r.force_yarns[-1] >= 3.0 and np.array_equal(r.force, r.force_yarns)
+    assert r.force_press[-1] > 1.5 * r.force_yarns[-1]
+    assert r.force_base[-1] < 0.2 * r.force_press[-1]
+    assert r.kinetic_fraction < 0.02 and r.hourglass_fraction < 0.1
+    assert r.energy_error < 1e-6
+    assert r_soft.d[-1] > 1.5 * r.d[-1]
+
+
+def test_the_yarns_contact_force_is_the_plates_when_the_ends_hold_nothing_vertical():
+    """With the ends held by symmetry (along their own yarn only), nothing but the yarns'
+    contact carries the press's force to the base: at the end of 30 µs on the coarse cell
+    the yarns' contact force (results.contact_forces) is the mean of the two plates'
+    within 5 %; bad end conditions are refused by name."""
+    from wovenimpact.calibration.cell_compression import compress_cell
+    from wovenimpact.errors import InputError
+    from wovenimpact.spec.crossover import geometry_from_dict
+
+    r = compress_cell(geometry_from_dict(COARSE_CELL), THESIS_YARN, force=100.0, speed=1.0,
+                      max_time=30e-6)
+    print(f"plates {r.force[-1]:.4f} N, yarns {r.force_yarns[-1]:.4f} N")
+    assert r.force[-1] > 0.5
+    assert r.force_yarns[-1] == pytest.approx(r.force[-1], rel=0.05)
+    with pytest.raises(InputError, match="ends = 'clamped'"):
+        compress_cell(geometry_from_dict(COARSE_CELL), THESIS_YARN, ends="clamped")
+
+
 def test_the_cell_compression_example_compiles_and_presses():
     """examples/crossover/cell_compression.toml: the thesis's cell between a base and a
     press from a case file; 300 steps (2.3 µs) press it: the press's force is positive

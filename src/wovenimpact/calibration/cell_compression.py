@@ -22,25 +22,34 @@ import numpy as np
 
 from wovenimpact.calibration.compression import CompressionFit, fit_compression
 from wovenimpact.errors import InputError
+from wovenimpact.interfaces import n_parts, part_names
 from wovenimpact.kernels.contact_plane import PL_F
 from wovenimpact.kernels.integrate import FIXED
 from wovenimpact.model.crossover_cell import crossover_cell
 from wovenimpact.model.model import BoundaryConditions, ShellContactParams, build_model
 from wovenimpact.model.rigid_plane import RigidPlane
 from wovenimpact.model.solid import SolidSection, solid_part
+from wovenimpact.results.contact_forces import interface_forces
 from wovenimpact.results.energy import energy_balance
 from wovenimpact.solver.explicit import Workspace, step
 from wovenimpact.state import initial_state
 
-# the yarns' end faces and the direction each is held in (the cell's symmetry planes)
+# the yarns' end faces and the direction along each yarn
 END_FACES = (("warp.x_min", 0), ("warp.x_max", 0), ("fill.y_min", 1), ("fill.y_max", 1))
+# how the end faces are held: "symmetry" along their own yarn only (the periodic cell's
+# symmetry planes), "thesis" in the two other directions only (thesis §5.3.2: "the only
+# displacements authorized are along each yarn's principal direction")
+END_CONDITIONS = ("symmetry", "thesis")
 
 
 def cell_between_plates(cell_spec, material, *, speed: float = 1.0, ramp: float = 5e-6,
-                        hourglass: float = 0.05, contact=None):
+                        hourglass: float = 0.05, contact=None, ends: str = "symmetry"):
     """(cell, model): the crossover cell of a geometry spec (spec.crossover) of the
     transversely isotropic ``material`` between a held plate under it ("base") and one
-    moving down at ``speed`` (m/s, ramped over ``ramp`` s) over it ("press")."""
+    moving down at ``speed`` (m/s, ramped over ``ramp`` s) over it ("press"); the yarns'
+    end faces held as ``ends`` says (:data:`END_CONDITIONS`)."""
+    if ends not in END_CONDITIONS:
+        raise InputError(f"ends = {ends!r}: valid are {', '.join(END_CONDITIONS)}")
     cell = crossover_cell(cell_spec)
     mesh = cell.mesh
     part = solid_part(mesh.nodes, mesh.hexes,
@@ -49,7 +58,9 @@ def cell_between_plates(cell_spec, material, *, speed: float = 1.0, ramp: float 
                       sets=mesh.hex_sets)
     bcs = BoundaryConditions(len(mesh.nodes))
     for name, dof in END_FACES:
-        bcs.code[mesh.node_sets[name], dof] = FIXED
+        held = (dof,) if ends == "symmetry" else tuple(d for d in range(3) if d != dof)
+        for d in held:
+            bcs.code[mesh.node_sets[name], d] = FIXED
     bcs.ramp_time = ramp
     z = mesh.nodes[:, 2]
     planes = [RigidPlane(point=(0.0, 0.0, z.min()), normal=(0.0, 0.0, 1.0), name="base"),
@@ -69,6 +80,9 @@ class CellCompression:
     Attributes:
         t, d, force: time, the cell's compression d_c and force F_c at each sample.
         force_base, force_press: the two plates' forces (their mean is ``force``).
+        force_yarns: the vertical force the warp presses the fill with, through their
+            contact (the thesis's F_c, "the contact force between the yarns"; equal to
+            the plates' with the ends held by symmetry, less where the ends carry some).
         kinetic_fraction: the largest kinetic energy over the internal work in the
             second half of the run (quasi-static when small).
         hourglass_fraction: hourglass energy over internal work at the end.
@@ -83,6 +97,7 @@ class CellCompression:
     force: np.ndarray
     force_base: np.ndarray
     force_press: np.ndarray
+    force_yarns: np.ndarray
     kinetic_fraction: float
     hourglass_fraction: float
     energy_error: float
@@ -93,11 +108,18 @@ class CellCompression:
 
 def compress_cell(cell_spec, material, *, force: float = 3.0, speed: float = 1.0,
                   ramp: float = 5e-6, sample: float = 0.5e-6, max_time: float = 1e-3,
-                  hourglass: float = 0.05) -> CellCompression:
+                  hourglass: float = 0.05, ends: str = "symmetry",
+                  measure: str = "plates") -> CellCompression:
     """Squeeze the cell until F_c reaches ``force`` (N) or ``max_time`` (s) passes,
-    sampling every ``sample`` s (module docstring); fit a and b."""
+    sampling every ``sample`` s (module docstring); fit a and b. F_c is the plates' mean
+    force (``measure = "plates"``) or the yarns' contact force (``"yarns"``, the thesis's
+    with its end conditions ``ends = "thesis"``)."""
+    if measure not in ("plates", "yarns"):
+        raise InputError(f"measure = {measure!r}: valid are plates, yarns")
     _, model = cell_between_plates(cell_spec, material, speed=speed, ramp=ramp,
-                                   hourglass=hourglass)
+                                   hourglass=hourglass, ends=ends)
+    names = part_names(model)
+    warp, fill, parts = names.index("warp"), names.index("fill"), n_parts(model)
     state = initial_state(model)
     ws = Workspace.for_model(model, state)
     thick0 = float(np.ptp(model.x0[:, 2]))
@@ -111,12 +133,14 @@ def compress_cell(cell_spec, material, *, force: float = 3.0, speed: float = 1.0
         next_sample += sample
         f_base, f_press = -state.planes[0, PL_F + 2], state.planes[1, PL_F + 2]
         d = thick0 - float(np.ptp(state.x[:, 2]))
-        rows.append((state.t, d, 0.5 * (f_base + f_press), f_base, f_press))
+        f_yarns = -float(interface_forces(ws.contact, parts)[fill, warp, 2])
+        f_c = 0.5 * (f_base + f_press) if measure == "plates" else f_yarns
+        rows.append((state.t, d, f_c, f_base, f_press, f_yarns))
         balance = energy_balance(model, state)
         kinetic.append((state.t, balance["kinetic_J"], balance["internal_work_J"]))
         if rows[-1][2] >= force:
             break
-    arr = np.array(rows).reshape(-1, 5)
+    arr = np.array(rows).reshape(-1, 6)
     kin = np.array(kinetic).reshape(-1, 3)
     late = kin[:, 0] >= 0.5 * kin[-1, 0]
     kinetic_fraction = float(np.max(kin[late, 1] / np.maximum(kin[late, 2], 1e-300)))
@@ -128,7 +152,7 @@ def compress_cell(cell_spec, material, *, force: float = 3.0, speed: float = 1.0
         fit = None
     return CellCompression(
         t=arr[:, 0], d=arr[:, 1], force=arr[:, 2], force_base=arr[:, 3],
-        force_press=arr[:, 4], kinetic_fraction=kinetic_fraction,
+        force_press=arr[:, 4], force_yarns=arr[:, 5], kinetic_fraction=kinetic_fraction,
         hourglass_fraction=float(balance["hourglass_J"] / max(balance["internal_work_J"],
                                                                1e-300)),
         energy_error=float(balance["error_fraction"]), fit=fit, steps=int(state.step),

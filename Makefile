@@ -8,10 +8,16 @@ STAMP  := $(VENV)/.installed
 
 venv: $(STAMP)
 
+# After installing, one step of the flagship case compiles its kernels into the cache
+# (~/.cache/wovenimpact/numba, once per install or kernel change; its time:
+# docs/performance.md), so that `make run` reaches its first step within seconds.
 $(STAMP): pyproject.toml
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[test]'
+	@echo "make: compiling the kernels once (a few minutes; cached afterwards)"
+	$(BIN)/wovenimpact run examples/plate_impact/plies4_120.toml --out $(VENV)/warm-up \
+	    --set 'run.end_time=0.5 us' > $(VENV)/warm-up.log 2>&1
 	touch $(STAMP)
 
 # Flagship example: 4 Kevlar plies struck at 120 m/s (thesis ch. 7; its time: docs/performance.md),

@@ -96,7 +96,7 @@ def run(
 
     if not as_json:
         err_console.print(f"{case.stem}: building the model (a machine's first run also "
-                          "compiles the kernels: a minute or two, then cached)",
+                          "compiles the kernels: a few minutes, then cached)",
                           highlight=False, soft_wrap=True)
     try:
         summary = run_case(case, out, restart=restart, threads=threads, progress=report,

@@ -8,6 +8,7 @@ from wovenimpact.cli import (  # noqa: F401  (register commands)
     crossover_cell,
     design,
     element_test,
+    export_deck,
     run,
     sweep,
     validate,

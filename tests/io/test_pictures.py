@@ -22,6 +22,7 @@ from wovenimpact.io.pictures import (
     frame_view,
     frames_of,
     read_part,
+    rim_edges,
     write_pictures,
 )
 from wovenimpact.io.plots import event_markers, layer_energy_columns
@@ -98,7 +99,17 @@ def test_an_eroded_element_is_not_drawn(perforated, tmp_path):
     assert sorted(before.elements.tolist()) == sorted(alive_cells(src).tolist())
     m = meshio.read(src)
     alive = [a.copy() for a in m.cell_data["alive"]]
-    victim = int(np.flatnonzero(alive[0] != 0.0)[0])
+    conn = part.connectivity
+    live = alive[0] != 0.0
+
+    def neighbours(e):  # the cells sharing an edge with cell e
+        mine = {frozenset(p) for p in zip(conn[e], np.roll(conn[e], -1))}
+        return [f for f, c in enumerate(conn) if f != e
+                and any(frozenset(p) in mine for p in zip(c, np.roll(c, -1)))]
+
+    # an alive cell whose edge-neighbours are all alive (its hole has a whole rim)
+    victim = next(e for e in np.flatnonzero(live)
+                  if len(neighbours(e)) >= 2 and all(live[f] for f in neighbours(e)))
     alive[0][victim] = 0.0
     m.cell_data["alive"] = alive
     copy = tmp_path / "step_000001.vtu"
@@ -106,6 +117,29 @@ def test_an_eroded_element_is_not_drawn(perforated, tmp_path):
     after = frame_polygons({"": read_part(copy)}, view)
     assert after.corners.shape[0] == before.corners.shape[0] - 1
     assert ids[victim] not in after.elements and ids[victim] in before.elements
+    # its hole is outlined: one rim segment per edge it shares with a drawn cell, lying
+    # on its own corners as drawn (a victim inside the pack has four such neighbours)
+    shared = len(neighbours(victim))  # one edge each (quads of one ply)
+
+    def segments(rim):
+        return {frozenset(tuple(np.round(x, 12)) for x in seg) for seg in rim}
+
+    new = segments(after.rim) - segments(before.rim)
+    corners = {tuple(np.round(x, 12))
+               for x in before.corners[before.elements.tolist().index(ids[victim])]}
+    assert shared >= 2 and len(new) == shared
+    assert all(x in corners for seg in new for x in seg)
+
+
+def test_the_rim_of_a_hole_is_the_edges_eroded_cells_share_with_drawn_ones():
+    """Three quads in a row, the middle one eroded: its two shared edges are the rim, one
+    from each neighbour; a triangle (a repeated corner) contributes no degenerate edge;
+    nothing eroded, no rim."""
+    conn = np.array([[0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 8, 7, 7]])
+    rim = rim_edges(conn, np.array([0, 2, 3]), np.array([1]))
+    assert sorted(map(tuple, rim.tolist())) == [(0, 1), (1, 3)]  # quad 0's edge 1-5, quad 2's 6-2
+    assert rim_edges(conn, np.array([0, 1, 2]), np.array([3])).tolist() == [[2, 1]]  # 3-7
+    assert rim_edges(conn, np.array([0, 1, 2, 3]), np.array([], dtype=int)).shape == (0, 2)
 
 
 def test_per_ply_columns_and_perforation_instants(perforated):

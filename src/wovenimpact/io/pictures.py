@@ -3,7 +3,8 @@
 Drawn off-screen from the VTU frames a run writes (``OUT/fields``, :mod:`.fields`), read
 back with meshio, as matplotlib 3-D polygons (``mpl_toolkits.mplot3d``'s
 Poly3DCollection, the Agg backend: no display, nothing beyond matplotlib and meshio,
-which the package needs anyway). Eroded elements (cell data ``alive`` = 0) are not drawn.
+which the package needs anyway). Eroded elements (cell data ``alive`` = 0) are not drawn;
+the edges they shared with drawn elements are, in magenta: the rims of the holes.
 
 - **Which instants** (:func:`choose_frames`): up to four frames — the first written at
   or after first contact (:func:`first_contact_time`: the first history row at which the
@@ -33,7 +34,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import matplotlib
@@ -44,7 +45,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib import colormaps  # noqa: E402
 from matplotlib.colors import Normalize  # noqa: E402
-from mpl_toolkits.mplot3d.art3d import Poly3DCollection  # noqa: E402
+from mpl_toolkits.mplot3d.art3d import Line3DCollection, Poly3DCollection  # noqa: E402
 
 from wovenimpact.io.atomic import atomic_path, atomic_write_text  # noqa: E402
 from wovenimpact.io.fields import PVD_NAME, _frame_index, _part_name, read_pvd  # noqa: E402
@@ -55,12 +56,14 @@ N_FRAMES = 4
 MAX_POLYGONS = 6000
 CASING_WINDOW_DEG = 30.0
 DAMAGE_MAP, STRAIN_MAP, BLADE_GREY = "YlOrRd", "viridis", (0.62, 0.62, 0.66, 1.0)
+RIM_COLOUR = (0.85, 0.0, 0.45, 1.0)  # the holes' rims: magenta, apart from both colour maps
 
 
 @dataclass
 class Part:
     """One VTU file of a frame as polygons: corner coordinates (n, 4, 3; a triangle
-    repeats its last corner), reference centroids, and the cell arrays by name."""
+    repeats its last corner), reference centroids, the cell arrays by name, the points and
+    their displacements, and the cells' point indices (n, 4)."""
 
     name: str
     corners: np.ndarray
@@ -68,6 +71,7 @@ class Part:
     cells: dict[str, np.ndarray]
     points: np.ndarray
     displacement: np.ndarray
+    connectivity: np.ndarray | None = None
 
 
 def read_part(path: str | Path, name: str = "") -> Part:
@@ -85,7 +89,7 @@ def read_part(path: str | Path, name: str = "") -> Part:
         conn.append(c)
     conn = np.concatenate(conn) if conn else np.zeros((0, 4), dtype=np.int64)
     cells = {k: np.concatenate([np.asarray(a) for a in v]) for k, v in mesh.cell_data.items()}
-    return Part(name, x[conn], x0[conn].mean(axis=1), cells, x, u)
+    return Part(name, x[conn], x0[conn].mean(axis=1), cells, x, u, conn)
 
 
 def frames_of(fields: str | Path) -> list[tuple[int, float, list[tuple[str, Path]]]]:
@@ -222,7 +226,8 @@ def _casing_view(casing: Part, blade: Part, max_polygons: int) -> View:
 @dataclass
 class Polygons:
     """What a picture draws: corners (n, 4, 3), face colours (n, 4), the drawn cells'
-    ``element`` ids, and counts of the view: cells, alive, drawn."""
+    ``element`` ids, counts of the view (cells, alive, drawn), and the rim of the holes
+    (m, 2, 3): the drawn cells' edges that eroded cells share (:func:`rim_edges`)."""
 
     corners: np.ndarray
     colours: np.ndarray
@@ -232,12 +237,34 @@ class Polygons:
     strain_max: float
     fabric: bool
     metal: bool
+    rim: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 3)))
+
+
+def rim_edges(connectivity: np.ndarray, drawn: np.ndarray, eroded: np.ndarray) -> np.ndarray:
+    """(m, 2) (row of ``drawn``, local edge c) of the edges of the drawn cells that an
+    eroded cell shares: the rim of a hole. ``connectivity`` (n, 4) point indices of all
+    cells (a triangle repeats its last corner: that edge is skipped); ``drawn`` and
+    ``eroded`` the indices of the drawn and the eroded cells."""
+    if not (drawn.size and eroded.size):
+        return np.zeros((0, 2), dtype=np.int64)
+
+    def keys(cells):
+        a = connectivity[cells]
+        b = np.roll(a, -1, axis=1)
+        lo, hi = np.minimum(a, b), np.maximum(a, b)
+        return lo * (int(connectivity.max()) + 1) + hi, a != b
+
+    gone, real = keys(eroded)
+    gone = np.unique(gone[real])
+    mine, real = keys(drawn)
+    row, edge = np.nonzero(real & np.isin(mine, gone))
+    return np.stack([row, edge], axis=1)
 
 
 def frame_polygons(parts: dict[str, Part], view: View) -> Polygons:
     """The polygons of the alive cells in ``view`` (eroded ones left out), coloured: fabric
     by damage, metal by plastic strain (on one scale over the picture), the blade grey."""
-    rows = []
+    rows, rims = [], []
     for name, part in parts.items():
         sel = view.in_view[name]
         alive = np.asarray(part.cells.get("alive", np.ones(sel.size)), dtype=float) != 0.0
@@ -256,6 +283,10 @@ def frame_polygons(parts: dict[str, Part], view: View) -> Polygons:
         fabric = fabric[draw] if fabric.shape[0] == sel.size else fabric
         rows.append((name, corners, damage, strain, fabric, part.cells.get(
             "element", np.arange(sel.size))[draw], int(sel.sum()), int(draw.sum()), n))
+        if part.connectivity is not None and name != "blade":
+            rim = rim_edges(part.connectivity, np.flatnonzero(draw), np.flatnonzero(sel & ~alive))
+            rims.append(np.stack([corners[rim[:, 0], rim[:, 1]],
+                                  corners[rim[:, 0], (rim[:, 1] + 1) % 4]], axis=1))
     strain_max = max([float(np.max(r[3], initial=0.0)) for r in rows if r[0] != "blade"]
                      + [1e-3])
     dmap, smap = colormaps[DAMAGE_MAP], colormaps[STRAIN_MAP]
@@ -271,7 +302,8 @@ def frame_polygons(parts: dict[str, Part], view: View) -> Polygons:
                     np.concatenate(colours) if colours else np.zeros((0, 4)),
                     np.concatenate([r[5] for r in rows]) if rows else np.zeros(0, int),
                     sum(r[6] for r in rows), sum(r[7] for r in rows), strain_max,
-                    any(f for f, _ in has), any(m for _, m in has))
+                    any(f for f, _ in has), any(m for _, m in has),
+                    np.concatenate(rims) if rims else np.zeros((0, 2, 3)))
 
 
 def draw(polygons: Polygons, view: View, path: str | Path, title: str) -> Poly3DCollection:
@@ -282,6 +314,8 @@ def draw(polygons: Polygons, view: View, path: str | Path, title: str) -> Poly3D
     coll = Poly3DCollection(polygons.corners, facecolors=polygons.colours,
                             edgecolors=(0, 0, 0, 0.15), linewidths=0.15)
     ax.add_collection3d(coll)
+    if polygons.rim.shape[0]:  # the holes' rims, over the faces
+        ax.add_collection3d(Line3DCollection(polygons.rim, colors=RIM_COLOUR, linewidths=1.4))
     pts = polygons.corners.reshape(-1, 3)
     if pts.size:
         # one scale on every axis (true shape), an axis at least 5 % of the longest

@@ -370,7 +370,8 @@ def _pictures_html(out: Path) -> list[str]:
     body = ['<h2 id="pictures">Deformed structure</h2>',
             "<p>The structure at a few instants (from first contact to the end), drawn from "
             "the run's field frames (<code>fields/</code>): fabric coloured by damage, metal "
-            "by plastic strain; eroded elements are not drawn.</p>",
+            "by plastic strain; eroded elements are not drawn, the rims of their holes are "
+            "outlined in magenta.</p>",
             '<div class="pictures">']
     for e in entries:
         png = out / "pictures" / e["file"]

@@ -28,7 +28,7 @@ from wovenimpact.materials.fabric import regularised_columns as fabric_regularis
 from wovenimpact.materials.metal import MetalParameters, j2_parameter_row
 from wovenimpact.materials.metal import initial_state as j2_initial_state
 from wovenimpact.materials.metal import regularised_columns as j2_regularised_columns
-from wovenimpact.model.solid import NO_SOLIDS, SolidPart
+from wovenimpact.model.solid import NO_SOLIDS, SolidPart, section_indices
 
 DOF_NAMES = ("ux", "uy", "uz", "rx", "ry", "rz")
 
@@ -754,15 +754,7 @@ def section_table(sections: dict[str, Section], elem_section, n_elems: int):
     rows = [sections[n].row(next(i for i, m in enumerate(mats) if m is sections[n].material), n)
             for n in names]
     sec_table = np.array(rows).reshape(-1, SL.N_SECTION)
-    es = np.asarray(elem_section)
-    if es.dtype.kind in "US":
-        unknown = sorted(set(es.tolist()) - set(names))
-        if unknown:
-            raise InputError(f"unknown section {unknown[0]!r}; defined: {names}")
-        es = np.array([names.index(s) for s in es.tolist()], dtype=np.int64)
-    es = np.ascontiguousarray(es, dtype=np.int64)
-    if es.shape != (n_elems,):
-        raise InputError(f"elem_section must give one section per element ({n_elems})")
+    es = section_indices(elem_section, names, n_elems, "section", "elem_section", "element")
     return names, mats, sec_table, es
 
 

@@ -236,6 +236,24 @@ def _frames(sections: list[SolidSection], section: np.ndarray, frames) -> np.nda
     return f
 
 
+def section_indices(given, names: list[str], n: int, kind: str, argument: str,
+                    entity: str) -> np.ndarray:
+    """(n,) int64 row indices of each element's section: ``given`` names (looked up in
+    ``names``) or indices already; an InputError for an unknown ``kind`` name or a count
+    that is not one per ``entity`` (``argument`` names the input). Used for the shells'
+    sections (model.section_table) and the hexahedra's (:func:`solid_part`)."""
+    sec = np.asarray(given)
+    if sec.dtype.kind in "US":
+        unknown = sorted(set(sec.tolist()) - set(names))
+        if unknown:
+            raise InputError(f"unknown {kind} {unknown[0]!r}; defined: {names}")
+        sec = np.array([names.index(s) for s in sec.tolist()], dtype=np.int64)
+    sec = np.ascontiguousarray(sec, dtype=np.int64)
+    if sec.shape != (n,):
+        raise InputError(f"{argument} must give one section per {entity} ({n})")
+    return sec
+
+
 def solid_part(x0, hexes, sections: dict[str, SolidSection], hex_section, frames=None,
                sets: dict | None = None) -> SolidPart:
     """The solid arrays of a Model (module docstring).
@@ -262,15 +280,8 @@ def solid_part(x0, hexes, sections: dict[str, SolidSection], hex_section, frames
     if h.size and (h.min() < 0 or h.max() >= len(x0)):
         raise InputError(f"hexes refer to node {int(h.max())}, but there are {len(x0)} nodes")
     names = list(sections)
-    sec = np.asarray(hex_section)
-    if sec.dtype.kind in "US":
-        unknown = sorted(set(sec.tolist()) - set(names))
-        if unknown:
-            raise InputError(f"unknown solid section {unknown[0]!r}; defined: {names}")
-        sec = np.array([names.index(s) for s in sec.tolist()], dtype=np.int64)
-    sec = np.ascontiguousarray(sec, dtype=np.int64).reshape(-1)
-    if sec.shape != (len(h),):
-        raise InputError(f"hex_section must give one section per hexahedron ({len(h)})")
+    sec = section_indices(hex_section, names, len(h), "solid section", "hex_section",
+                          "hexahedron")
     mats: list[TransverseIsotropicParameters] = []
     for name in names:
         s = sections[name]

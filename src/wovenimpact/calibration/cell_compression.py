@@ -21,14 +21,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from wovenimpact.calibration.compression import CompressionFit, fit_compression
+from wovenimpact.calibration.crossover_cell import cell_solid
 from wovenimpact.errors import InputError
 from wovenimpact.interfaces import n_parts, part_names
 from wovenimpact.kernels.contact_plane import PL_F
 from wovenimpact.kernels.integrate import FIXED
-from wovenimpact.model.crossover_cell import crossover_cell
 from wovenimpact.model.model import BoundaryConditions, ShellContactParams, build_model
 from wovenimpact.model.rigid_plane import RigidPlane
-from wovenimpact.model.solid import SolidSection, solid_part
 from wovenimpact.results.contact_forces import interface_forces
 from wovenimpact.results.energy import energy_balance
 from wovenimpact.solver.explicit import Workspace, step
@@ -50,12 +49,8 @@ def cell_between_plates(cell_spec, material, *, speed: float = 1.0, ramp: float 
     end faces held as ``ends`` says (:data:`END_CONDITIONS`)."""
     if ends not in END_CONDITIONS:
         raise InputError(f"ends = {ends!r}: valid are {', '.join(END_CONDITIONS)}")
-    cell = crossover_cell(cell_spec)
+    cell, part = cell_solid(cell_spec, material, hourglass)
     mesh = cell.mesh
-    part = solid_part(mesh.nodes, mesh.hexes,
-                      {"yarn": SolidSection(material, hourglass=hourglass)},
-                      np.zeros(len(mesh.hexes), dtype=np.int64), frames=cell.frames,
-                      sets=mesh.hex_sets)
     bcs = BoundaryConditions(len(mesh.nodes))
     for name, dof in END_FACES:
         held = (dof,) if ends == "symmetry" else tuple(d for d in range(3) if d != dof)

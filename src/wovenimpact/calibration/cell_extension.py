@@ -33,10 +33,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from wovenimpact.calibration.crossover_cell import cell_solid
 from wovenimpact.kernels import solid_layout as L
-from wovenimpact.model.crossover_cell import crossover_cell
 from wovenimpact.model.model import BoundaryConditions, ShellContactParams, build_model
-from wovenimpact.model.solid import SolidSection, solid_part
 from wovenimpact.results.energy import energy_balance
 from wovenimpact.solver.explicit import Workspace, step
 from wovenimpact.state import initial_state
@@ -48,12 +47,8 @@ def cell_in_extension(cell_spec, material, *, speed: float = 1.0, ramp: float = 
     transversely isotropic ``material``, the warp's x_max face pulled along x at ``speed``
     (m/s, ramped over ``ramp`` s) and held in y, z; its x_min face and the fill's end faces
     held (module docstring)."""
-    cell = crossover_cell(cell_spec)
+    cell, part = cell_solid(cell_spec, material, hourglass)
     mesh = cell.mesh
-    part = solid_part(mesh.nodes, mesh.hexes,
-                      {"yarn": SolidSection(material, hourglass=hourglass)},
-                      np.zeros(len(mesh.hexes), dtype=np.int64), frames=cell.frames,
-                      sets=mesh.hex_sets)
     bcs = BoundaryConditions(len(mesh.nodes), ramp_time=ramp)
     held = np.concatenate([mesh.node_sets[n] for n in ("warp.x_min", "fill.y_min", "fill.y_max")])
     bcs.fix(held, (0, 1, 2))

@@ -36,6 +36,20 @@ _UNIT = SolidSection(TransverseIsotropicParameters(e11=1.0, e22=1.0, g12=1.0, g2
                                                    nu12=0.0, nu23=0.0, density=1.0))
 
 
+def cell_solid(cell_spec, material, hourglass: float = 0.05):
+    """(cell, part): the crossover cell of a geometry spec (spec.crossover) and its
+    yarns as one solid section of ``material`` (hourglass coefficient ``hourglass``), the
+    material axes following the yarns — what the virtual tests run
+    (calibration.cell_compression, calibration.cell_extension)."""
+    cell = crossover_cell(cell_spec)
+    mesh = cell.mesh
+    part = solid_part(mesh.nodes, mesh.hexes,
+                      {"yarn": SolidSection(material, hourglass=hourglass)},
+                      np.zeros(len(mesh.hexes), dtype=np.int64), frames=cell.frames,
+                      sets=mesh.hex_sets)
+    return cell, part
+
+
 def element_volumes(cell: CrossoverCell) -> np.ndarray:
     """V0 of each hexahedron (m³), the exact volume of the trilinear element."""
     n = len(cell.mesh.hexes)

@@ -301,12 +301,7 @@ def layer_energy_plot(h: dict, path: str | Path, title: str = "",
     ax.set_xlabel("time (µs)")
     ax.set_ylabel(("contact work per ply" if plate else "absorbed energy per layer")
                   + ", whole problem (J)")
-    ax.set_title(title)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, ncol=2, loc="center left")
-    fig.tight_layout()
-    _save(fig, path)
-    return path
+    return _finish_time_plot(fig, ax, title, "center left", path)
 
 
 def contact_force_plot(h: dict, path: str | Path, title: str = "", markers=()) -> Path | None:
@@ -332,9 +327,14 @@ def contact_force_plot(h: dict, path: str | Path, title: str = "", markers=()) -
     ax.set_xlabel("time (µs)")
     plate = columns[0] == "contact_force_full_N"  # along the travel, whole problem
     ax.set_ylabel("contact force along the travel (kN)" if plate else "contact force (kN)")
+    return _finish_time_plot(fig, ax, title, "upper right", path)
+
+
+def _finish_time_plot(fig, ax, title: str, legend_loc: str, path: Path) -> Path:
+    """Title, grid and a two-column legend at ``legend_loc``; saved to ``path``."""
     ax.set_title(title)
     ax.grid(alpha=0.3)
-    ax.legend(fontsize=7, ncol=2, loc="upper right")
+    ax.legend(fontsize=7, ncol=2, loc=legend_loc)
     fig.tight_layout()
     _save(fig, path)
     return path

@@ -1,4 +1,4 @@
-"""Uniaxial extension of the thesis's crossover cell on three meshes (docs/solid.md §6.5).
+"""Uniaxial and biaxial extension of the thesis's crossover cell (docs/solid.md §6.5).
 
     python examples/crossover/extension_study.py [--quick]
 
@@ -7,7 +7,9 @@ Each row pulls the warp of ``thesis_cell.toml`` (yarn ``kevlar_yarn_solid.toml``
 (calibration.cell_extension.extend_cell), and prints the thesis's E1 and ν (eqs. 5.6, 5.7:
 the middle elements' axial stress over axial strain, and their strain across the yarn
 over it), the cell's tangent modulus (the pulled end's force over the yarn's section,
-against the cell's strain) and the checks. ``--quick``: the thesis's mesh only.
+against the cell's strain) and the checks; then, on the thesis's mesh, the fill pulled too
+at 0.5, 1 and 2 times the warp's strain (biaxial), the two yarns' end forces at 0.5 and 1 %.
+``--quick``: the thesis's mesh only, no biaxial rows.
 """
 
 from __future__ import annotations
@@ -39,6 +41,17 @@ def main(quick: bool) -> None:
               f"{r.section * 1e6:.4f} | {r.kinetic_fraction:.4f} | {r.hourglass_fraction:.4f} | "
               f"{r.energy_error:.0e} | {r.steps} ({time.perf_counter() - t0:.0f} s) |", flush=True)
     print("| thesis (Abaqus, §5.3.1) | 96.117 | ≈ 0.30 | — | — | — | — | — | — |")
+    if quick:
+        return
+    print()
+    print("| fill strain / warp strain | warp / fill force at 0.5 % (N) | at 1 % (N) | kinetic |")
+    print("|---|---|---|---|")
+    for ratio in (0.0, 0.5, 1.0, 2.0):
+        r = extend_cell(geometry, yarn, strain=0.01, ratio=ratio)
+        i = int(abs(r.strain - 0.005).argmin())
+        print(f"| {ratio:g}{' (fill held)' if ratio == 0 else ''} | {r.force[i]:.1f} / "
+              f"{r.force_fill[i]:.1f} | {r.force[-1]:.1f} / {r.force_fill[-1]:.1f} | "
+              f"{r.kinetic_fraction:.4f} |", flush=True)
 
 
 if __name__ == "__main__":

@@ -34,6 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from wovenimpact.calibration.crossover_cell import cell_solid
+from wovenimpact.errors import InputError
 from wovenimpact.kernels import solid_layout as L
 from wovenimpact.model.model import BoundaryConditions, ShellContactParams, build_model
 from wovenimpact.results.energy import energy_balance
@@ -42,18 +43,25 @@ from wovenimpact.state import initial_state
 
 
 def cell_in_extension(cell_spec, material, *, speed: float = 1.0, ramp: float = 5e-6,
-                      hourglass: float = 0.05, contact=None):
+                      hourglass: float = 0.05, contact=None, ratio: float = 0.0):
     """(cell, model): the crossover cell of a geometry spec (spec.crossover) of the
     transversely isotropic ``material``, the warp's x_max face pulled along x at ``speed``
-    (m/s, ramped over ``ramp`` s) and held in y, z; its x_min face and the fill's end faces
-    held (module docstring)."""
+    (m/s, ramped over ``ramp`` s) and held in y, z; its x_min face and the fill's y_min face
+    held; the fill's y_max face held too (``ratio`` 0, the uniaxial test) or pulled along
+    y at ``ratio`` × ``speed`` and held in x, z (a biaxial test at that ratio of the fill's
+    strain to the warp's: the cell is square)."""
+    if not ratio >= 0.0:
+        raise InputError(f"ratio = {ratio!r}: valid is a ratio of strains ≥ 0")
     cell, part = cell_solid(cell_spec, material, hourglass)
     mesh = cell.mesh
     bcs = BoundaryConditions(len(mesh.nodes), ramp_time=ramp)
-    held = np.concatenate([mesh.node_sets[n] for n in ("warp.x_min", "fill.y_min", "fill.y_max")])
-    bcs.fix(held, (0, 1, 2))
+    held = ("warp.x_min", "fill.y_min") + (("fill.y_max",) if ratio == 0.0 else ())
+    bcs.fix(np.concatenate([mesh.node_sets[n] for n in held]), (0, 1, 2))
     pulled = mesh.node_sets["warp.x_max"]
     bcs.fix(pulled, (1, 2)).prescribe(pulled, 0, speed)
+    if ratio > 0.0:
+        fill_end = mesh.node_sets["fill.y_max"]
+        bcs.fix(fill_end, (0, 2)).prescribe(fill_end, 1, ratio * speed)
     model = build_model(mesh.nodes, np.zeros((0, 4), dtype=np.int64), {},
                         np.zeros(0, dtype=np.int64), bcs=bcs, solid=part,
                         node_sets=mesh.node_sets,
@@ -100,6 +108,9 @@ class CellExtension:
     Attributes:
         strain: the cell's strain u / L at each sample.
         force: the pulled face's force (N); stress: force over the yarn's mean section.
+        force_fill: the force along y on the fill's y_max face (N): its tension, picked
+            up through crimp interchange when held (uniaxial) or pulled (biaxial).
+        ratio: the fill's strain over the warp's (0: fill held).
         sigma1, eps1, eps2: the middle elements' axial stress and their strains along a1
             and a2 (module docstring).
         section: the yarn's mean section A (m²); length: the cell's length L (m).
@@ -113,6 +124,8 @@ class CellExtension:
 
     strain: np.ndarray
     force: np.ndarray
+    force_fill: np.ndarray
+    ratio: float
     stress: np.ndarray
     sigma1: np.ndarray
     eps1: np.ndarray
@@ -130,11 +143,14 @@ class CellExtension:
 
 
 def extend_cell(cell_spec, material, *, strain: float = 0.01, speed: float = 1.0,
-                ramp: float = 5e-6, samples: int = 50, hourglass: float = 0.05) -> CellExtension:
+                ramp: float = 5e-6, samples: int = 50, hourglass: float = 0.05,
+                ratio: float = 0.0) -> CellExtension:
     """Pull the warp until the cell's strain reaches ``strain``, sampling ``samples``
-    times (module docstring)."""
+    times (module docstring); the fill held (``ratio`` 0) or pulled at ``ratio`` times
+    the warp's strain (:func:`cell_in_extension`)."""
     cell, model = cell_in_extension(cell_spec, material, speed=speed, ramp=ramp,
-                                    hourglass=hourglass)
+                                    hourglass=hourglass, ratio=ratio)
+    fill_end = cell.mesh.node_sets["fill.y_max"]
     state = initial_state(model)
     ws = Workspace.for_model(model, state)
     pulled = cell.mesh.node_sets["warp.x_max"]
@@ -154,13 +170,14 @@ def extend_cell(cell_spec, material, *, strain: float = 0.01, speed: float = 1.0
             continue
         next_sample += every
         force = float(np.sum(state.f_ext[pulled, 0]))
-        rows.append((eps, force, *axial_and_cross_strain(model, state, middle, frames)))
+        rows.append((eps, force, float(np.sum(state.f_ext[fill_end, 1])),
+                     *axial_and_cross_strain(model, state, middle, frames)))
         balance = energy_balance(model, state)
         kinetic.append(balance["kinetic_J"] / max(balance["internal_work_J"], 1e-300))
         if eps >= strain:
             break
     arr = np.array(rows)
-    e, f, s1, e1, e2 = arr.T
+    e, f, f_fill, s1, e1, e2 = arr.T
     use = e1 > 0.1 * e1[-1]
     slope = float(s1[use] @ e1[use] / (e1[use] @ e1[use]))
     nu = float(-(e2[use] @ e1[use]) / (e1[use] @ e1[use]))
@@ -168,7 +185,7 @@ def extend_cell(cell_spec, material, *, strain: float = 0.01, speed: float = 1.0
     tangent = float(np.polyfit(e[late], f[late] / section, 1)[0]) if late.sum() > 1 else float("nan")
     balance = energy_balance(model, state)
     return CellExtension(
-        strain=e, force=f, stress=f / section, sigma1=s1, eps1=e1, eps2=e2, section=section,
+        strain=e, force=f, force_fill=f_fill, ratio=float(ratio), stress=f / section, sigma1=s1, eps1=e1, eps2=e2, section=section,
         length=length, e1=slope, nu=nu, tangent=tangent,
         kinetic_fraction=float(max(kinetic[len(kinetic) // 2:])),
         hourglass_fraction=float(balance["hourglass_J"] / max(balance["internal_work_J"], 1e-300)),

@@ -1,4 +1,5 @@
-"""``wovenimpact calibrate crimp|compression|fracture``: model parameters from measurements.
+"""``wovenimpact calibrate crimp|compression|fracture|crossover``: model parameters from
+measurements and virtual tests.
 
 - ``crimp``: crimp amplitude h0 from thread count and crimp (thesis eq. 5.2–5.5, Table 5-1).
 - ``compression``: a, b of the compaction law F = b·d/(a − d) from a force–compression
@@ -6,6 +7,9 @@
 - ``fracture``: the element-size regularisation of a metal's fracture strain, fitted on
   a simulated tension test at several meshes (docs/theory.md §7.3), written as the
   material file's ``[material.regularisation]`` with a CSV and a figure.
+- ``crossover``: a fabric material file from the 3-D crossover cell's virtual tests
+  (compression → a, b; uniaxial extension → the yarns' modulus), with the round trip of
+  the written file's single-element tests against the cell (docs/solid.md §6.6).
 """
 
 from __future__ import annotations
@@ -277,3 +281,40 @@ def _fracture_result(cal, l_ref: float | None, paths: dict) -> dict:
         "wall_s": cal.wall_s,
         **{f"{k}_file": str(p) for k, p in paths.items()},
     }
+
+
+@calibrate_app.command("crossover")
+def crossover(
+    geometry: Annotated[Path, typer.Argument(help="The cell's geometry file, e.g. "
+                                                  "examples/crossover/thesis_cell.toml.")],
+    yarn: Annotated[Path, typer.Option("--yarn", help="The yarn's transversely isotropic "
+                                       "material file, e.g. "
+                                       "examples/materials/kevlar_yarn_solid.toml.")],
+    template: Annotated[Path, typer.Option("--template", help="A fabric material file whose "
+                                           "strength, shear law and options are kept, e.g. "
+                                           "examples/materials/kevlar_thesis.toml.")],
+    out: Annotated[Path, typer.Option("--out", help="Directory for fabric.toml, "
+                                      "crossover_calibration.json and the figures.")],
+    as_json: Annotated[bool, typer.Option("--json", help="Print one JSON object (SI units).")
+                       ] = False,
+) -> None:
+    """Calibrate a fabric from the 3-D crossover cell (thesis ch. 5): squeeze the cell to
+    3 N between rigid plates (→ the compaction law's a, b), pull its warp to 1 % (→ the
+    yarns' modulus E1), and write the template fabric file with those values and the
+    geometry's thread counts, crimps, widths, thicknesses and section areas, each line
+    with its source. Prints the round trip: the written file's single-element tests
+    against the cell. A few minutes on the thesis's cell."""
+    from wovenimpact.calibration.crossover_calibration import calibrate_crossover
+    from wovenimpact.io.outdir import write_failure
+
+    try:
+        doc = calibrate_crossover(geometry, yarn, template, out)
+    except InputError as err:
+        _fail_input(err)
+    except OSError as err:
+        fail(write_failure(err, str(out)))
+    summary = {"fabric_file": str(out / doc["fabric_file"]), "E1_Pa": doc["e1_Pa"],
+               "a_m": doc["a_m"], "b_N": doc["b_N"], "fit_r2": doc["fit_r2"]}
+    for row in doc["round_trip"]:
+        summary[f"round_trip {row['test']} at {row['at']}"] = f"{row['error']:+.1%}"
+    emit(summary, as_json, title=f"crossover calibration: {geometry.name}")

@@ -14,9 +14,10 @@ transversely isotropic yarn is
 The fabric file written is a *template* fabric file with, in ``[material.warp]`` and
 ``[material.fill]``, the thread count, crimp, width, thickness and the yarn's section
 area of the geometry, the modulus E1, and in ``[material.compaction]`` a and b, each line
-followed by a comment naming its source; what the cell does not give (the yarns'
-strength, the shear law, the options) stays the template's, and the file says so. The
-fill's modulus is the warp's E1 (one yarn material; the fill is not pulled).
+followed by a comment naming its source, and the ultimate tension as the template yarn's
+strength T_u / A times the cell's section; what the cell does not give (the shear law, the
+options) stays the template's, and the file says so. The fill's modulus is the warp's E1
+(one yarn material; the fill is not pulled).
 
 The *round trip* (:func:`round_trip`): the written file's single-element tests (the
 shell's yarn model, calibration.single_element) against the cell — the uniaxial test
@@ -78,8 +79,12 @@ def _q(x: float, unit: str, scale: float, digits: int = 6) -> str:
     return f'"{x * scale:.{digits}g} {unit}"'
 
 
-def cell_values(geometry, compression, extension) -> dict[tuple[str, str], tuple[str, str]]:
-    """The fabric file's values the cell gives (module docstring), with their sources."""
+def cell_values(geometry, compression, extension,
+                template=None) -> dict[tuple[str, str], tuple[str, str]]:
+    """The fabric file's values the cell gives (module docstring), with their sources;
+    with the ``template``'s FabricParameters, each family's ultimate tension too: the
+    template yarn's strength T_u / A times the cell's section (the same fibre, another
+    yarn size)."""
     cell = crossover_cell(geometry)
     values = {}
     if compression.fit is None:
@@ -98,6 +103,12 @@ def cell_values(geometry, compression, extension) -> dict[tuple[str, str], tuple
         values[(t, "modulus")] = (_q(extension.e1, "GPa", 1e-9, 5),
                                   "E1 of the cell's uniaxial extension (eq. 5.6)"
                                   + ("" if name == "warp" else ", the warp's: one yarn"))
+        if template is not None:
+            own = getattr(template, name)
+            strength = own.ultimate_tension / own.area
+            values[(t, "ultimate_tension")] = (
+                _q(strength * area, "N", 1.0, 5),
+                f"the template yarn's strength T_u/A = {strength * 1e-6:.5g} MPa × this area")
     fit = compression.fit
     values[("material.compaction", "a")] = (
         _q(fit.a_m, "mm", 1e3, 5), f"the cell squeezed to 3 N (eq. 5.8 fit, r² {fit.r2:.3f})")
@@ -151,10 +162,11 @@ def calibrate_crossover(geometry_path, yarn_path, template_path, out: Path,
     head = (f"# Written by `wovenimpact calibrate crossover` from {Path(geometry_path).name} "
             f"(geometry) and\n# {Path(yarn_path).name} (yarn), over the template "
             f"{Path(template_path).name}: the lines marked with\n# their source come from "
-            "the 3-D cell (docs/solid.md §6.6); the yarns' strength, the shear\n# law and "
-            "the options are the template's (its header comments, which name the\n# "
-            "sources of its own values, are left out).\n")
-    values = cell_values(geometry, compression, extension)
+            "the 3-D cell (docs/solid.md §6.6) or scale the template's yarn strength;\n# the "
+            "shear law and the options are the template's (its header comments, which\n# "
+            "name the sources of its own values, are left out).\n")
+    values = cell_values(geometry, compression, extension,
+                         load_material(template_path))
     values[("material", "name")] = (json.dumps(f"crossover cell {geometry.cell.name}"),
                                     "the geometry file's cell")
     text = head + set_values(drop_header(template), values)

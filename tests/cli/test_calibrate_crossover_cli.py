@@ -38,7 +38,8 @@ def test_the_thesis_cell_writes_a_fabric_file_that_loads(tmp_path):
     thickness); T_u is the template yarn's strength times the cell's section; the shear
     law is the template's; the
     round trip is reported for the uniaxial, biaxial and compression tests, with the
-    compaction law within 15 % of the cell's curve at 2 and 3 N (it is fitted to it)."""
+    compaction law within 15 % of the cell's curve at 2 and 3 N (it is fitted to it); a
+    run whose hourglass energy exceeds 5 % of its internal work is named in a warning."""
     out = tmp_path / "cal"
     result = CliRunner().invoke(app, [
         "calibrate", "crossover", str(ROOT / "examples" / "crossover" / "thesis_cell.toml"),
@@ -64,5 +65,9 @@ def test_the_thesis_cell_writes_a_fabric_file_that_loads(tmp_path):
     for row in doc["round_trip"]:
         if row["test"] == "compression" and row["at"] in ("2 N", "3 N"):
             assert abs(row["error"]) < 0.15, row
+    # each run beyond the bounds (hourglass 5 %, kinetic 1 %, energy 1 %) is named
+    for name, c in doc["checks"].items():
+        named = any(w.startswith(f"{name}: hourglass") for w in doc["warnings"])
+        assert named == (c["hourglass_fraction"] > 0.05), (name, c)
     assert (out / "compression.png").stat().st_size > 0
     assert (out / "extension.png").stat().st_size > 0

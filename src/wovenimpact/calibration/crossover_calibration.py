@@ -143,6 +143,25 @@ def round_trip(params, compression, extension, biaxial) -> list[dict]:
     return rows
 
 
+# a virtual test is trusted when quasi-static and its hourglass energy small (issue bounds)
+MAX_KINETIC, MAX_HOURGLASS, MAX_ENERGY_ERROR = 0.01, 0.05, 0.01
+
+
+def check_warnings(checks: dict) -> list[str]:
+    """A sentence for each run whose kinetic energy exceeds MAX_KINETIC, hourglass energy
+    MAX_HOURGLASS (fractions of the internal work) or energy error MAX_ENERGY_ERROR: the
+    figure it gave is less trustworthy (a finer cell, or a slower pull or press)."""
+    out = []
+    for name, c in checks.items():
+        for key, limit, what in (("kinetic_fraction", MAX_KINETIC, "kinetic energy"),
+                                 ("hourglass_fraction", MAX_HOURGLASS, "hourglass energy"),
+                                 ("energy_error", MAX_ENERGY_ERROR, "energy error")):
+            if c[key] > limit:
+                out.append(f"{name}: {what} {c[key]:.1%} of the internal work, above "
+                           f"{limit:.0%} (a finer cell{' or a slower test' if key == 'kinetic_fraction' else ''})")
+    return out
+
+
 def calibrate_crossover(geometry_path, yarn_path, template_path, out: Path,
                         speed: float = 1.0) -> dict:
     """Run the virtual tests, write ``OUT/fabric.toml`` (the template with the cell's
@@ -176,16 +195,17 @@ def calibrate_crossover(geometry_path, yarn_path, template_path, out: Path,
     atomic_write_text(fabric_path, text)
     params = load_material(fabric_path)  # the file must load as written
     rows = round_trip(params, compression, extension, biaxial)
+    checks = {name: {"kinetic_fraction": r.kinetic_fraction,
+                     "hourglass_fraction": r.hourglass_fraction,
+                     "energy_error": r.energy_error, "steps": r.steps, "elements": r.elements}
+              for name, r in (("compression", compression), ("extension", extension),
+                              ("equibiaxial", biaxial))}
     doc = {
         "fabric_file": fabric_path.name,
         "e1_Pa": extension.e1, "nu": extension.nu, "a_m": compression.fit.a_m,
         "b_N": compression.fit.b_N, "fit_r2": compression.fit.r2,
-        "checks": {name: {"kinetic_fraction": r.kinetic_fraction,
-                          "hourglass_fraction": r.hourglass_fraction,
-                          "energy_error": r.energy_error, "steps": r.steps,
-                          "elements": r.elements}
-                   for name, r in (("compression", compression), ("extension", extension),
-                                   ("equibiaxial", biaxial))},
+        "checks": checks,
+        "warnings": check_warnings(checks),
         "round_trip": rows,
     }
     atomic_write_text(out / "crossover_calibration.json", json.dumps(doc, indent=2) + "\n")

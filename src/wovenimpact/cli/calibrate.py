@@ -20,7 +20,7 @@ from typing import Annotated
 
 import typer
 
-from wovenimpact.cli.app import calibrate_app, emit, fail
+from wovenimpact.cli.app import calibrate_app, emit, err_console, fail
 from wovenimpact.errors import InputError
 
 
@@ -318,3 +318,6 @@ def crossover(
     for row in doc["round_trip"]:
         summary[f"round_trip {row['test']} at {row['at']}"] = f"{row['error']:+.1%}"
     emit(summary, as_json, title=f"crossover calibration: {geometry.name}")
+    if not as_json:
+        for warning in doc["warnings"]:
+            err_console.print(f"warning: {warning}", highlight=False, markup=False)

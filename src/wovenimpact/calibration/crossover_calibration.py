@@ -229,13 +229,7 @@ def _figures(out: Path, compression, extension, biaxial, params) -> None:
     d = np.linspace(0.0, min(float(compression.d.max()), 0.999 * fit.a_m), 100)
     ax.plot(d * 1e3, fit.b_N * d / (fit.a_m - d), "--",
             label=f"F = b d/(a − d): a = {fit.a_m * 1e3:.4f} mm, b = {fit.b_N:.3f} N")
-    ax.set_xlabel("compression d_c (mm)")
-    ax.set_ylabel("F_c (N)")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(out / "compression.png", dpi=110)
-    plt.close(fig)
+    _save(fig, ax, "compression d_c (mm)", "F_c (N)", out / "compression.png")
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
     side = extension.length
     for test, run, style in (("uniaxial", extension, "C0"), ("biaxial", biaxial, "C1")):
@@ -244,10 +238,18 @@ def _figures(out: Path, compression, extension, biaxial, params) -> None:
                              n_steps=400).history
         ax.plot(np.asarray(h["displacement_m"]) / side * 100, h["tension_w_N"], "--",
                 color=style, label=f"shell single element, {test}")
-    ax.set_xlabel("strain of the warp (%)")
-    ax.set_ylabel("warp end force / yarn tension (N)")
+    _save(fig, ax, "strain of the warp (%)", "warp end force / yarn tension (N)",
+          out / "extension.png")
+
+
+def _save(fig, ax, xlabel: str, ylabel: str, path: Path) -> None:
+    """Axis labels, grid and legend; written to ``path`` and closed."""
+    import matplotlib.pyplot as plt
+
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(out / "extension.png", dpi=110)
+    fig.savefig(path, dpi=110)
     plt.close(fig)

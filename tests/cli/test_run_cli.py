@@ -10,11 +10,12 @@ import pytest
 from typer.testing import CliRunner
 
 from wovenimpact.cli.app import app
-from wovenimpact.io.checkpoint import latest_checkpoint, load_checkpoint
+from wovenimpact.io.checkpoint import latest_checkpoint
 from wovenimpact.io.history import read_csv
 from wovenimpact.runs import run_case
 from wovenimpact.setup.compile import compile_case
 from wovenimpact.spec.case import load_case
+from tests.restart import interrupted_and_resumed
 
 ROOT = Path(__file__).resolve().parents[2]
 KEVLAR = ROOT / "examples" / "materials" / "kevlar_thesis.toml"
@@ -104,19 +105,10 @@ def test_restart_ends_bitwise_identical_to_an_uninterrupted_run(tmp_path, kind):
     text = CASE if kind == "kicked ply" else two_plies_struck()
     end = "12 us" if kind == "kicked ply" else "15 us"
     case = write_case(tmp_path, end=end, text=text)
-    whole, broken = tmp_path / "whole", tmp_path / "broken"
-    full = run_case(case, whole)
+    # "killed" after the 8 µs checkpoint (one every 4 µs)
+    full, whole, broken, a, b = interrupted_and_resumed(case, tmp_path, 0.8)
     if kind == "two plies struck":
         assert min(full["max_deflection_per_ply_m"]) > 0.0  # the lower ply was struck too
-    partial = run_case(case, broken, max_steps=int(0.8 * full["steps"]))  # "killed" after
-    # the 8 µs checkpoint (one every 4 µs)
-    assert "interrupted_at_step" in partial
-    run_case(case, broken, restart=True)
-    assert (whole / "history.csv").read_text() == (broken / "history.csv").read_text()
-    spec, base = load_case(case)
-    digest = compile_case(spec, base).model.digest()
-    a = load_checkpoint(latest_checkpoint(whole / "checkpoints"), digest)
-    b = load_checkpoint(latest_checkpoint(broken / "checkpoints"), digest)
     assert a.equals(b)
     fa = sorted(p.name for p in (whole / "fields").glob("*.vtu"))
     fb = sorted(p.name for p in (broken / "fields").glob("*.vtu"))

@@ -26,6 +26,7 @@ from wovenimpact.setup.compile import compile_case
 from wovenimpact.spec.case import case_from_dict, load_case
 from wovenimpact.spec.material import load_material
 from wovenimpact.state import initial_state
+from tests.restart import interrupted_and_resumed
 
 ROOT = Path(__file__).resolve().parents[2]
 YARN = ROOT / "examples" / "materials" / "kevlar_yarn_solid.toml"
@@ -79,16 +80,7 @@ def test_restart_of_a_solid_run_ends_bitwise_identical(tmp_path):
     hourglass forces and energies included) and the same frames as an uninterrupted
     run."""
     case = write_case(tmp_path)
-    whole, broken = tmp_path / "whole", tmp_path / "broken"
-    full = run_case(case, whole)
-    partial = run_case(case, broken, max_steps=int(0.7 * full["steps"]))
-    assert "interrupted_at_step" in partial
-    run_case(case, broken, restart=True)
-    assert (whole / "history.csv").read_text() == (broken / "history.csv").read_text()
-    spec, base = load_case(case)
-    digest = compile_case(spec, base).model.digest()
-    a = load_checkpoint(latest_checkpoint(whole / "checkpoints"), digest)
-    b = load_checkpoint(latest_checkpoint(broken / "checkpoints"), digest)
+    _, whole, broken, a, b = interrupted_and_resumed(case, tmp_path, 0.7)
     assert a.hex.shape == (32, L.N_HEX_STATE) and np.abs(a.hex[:, L.H_SIG]).max() > 1e6
     assert a.equals(b)
     assert a.hex.tobytes() == b.hex.tobytes()

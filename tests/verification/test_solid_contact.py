@@ -362,10 +362,7 @@ def test_restart_with_plates_and_solid_contact_ends_bitwise(tmp_path):
     killed after a checkpoint and restarted, ends with the same history.csv and the same
     State — the plates' rows (position, velocity, force) and the contact books included —
     as an uninterrupted run."""
-    from wovenimpact.io.checkpoint import latest_checkpoint, load_checkpoint
-    from wovenimpact.runs import run_case
-    from wovenimpact.setup.compile import compile_case
-    from wovenimpact.spec.case import load_case
+    from tests.restart import interrupted_and_resumed
 
     geometry = (ROOT / "examples" / "crossover" / "thesis_cell.toml").read_text()
     geometry = geometry.replace("along = 12", "along = 6").replace("across = 8", "across = 4")
@@ -379,16 +376,7 @@ def test_restart_with_plates_and_solid_contact_ends_bitwise(tmp_path):
     text = text.replace('checkpoint_interval = "2 us"', 'checkpoint_interval = "0.5 us"')
     case = tmp_path / "case.toml"
     case.write_text(text, encoding="utf-8")
-    whole, broken = tmp_path / "whole", tmp_path / "broken"
-    full = run_case(case, whole)
-    partial = run_case(case, broken, max_steps=int(0.7 * full["steps"]))
-    assert "interrupted_at_step" in partial
-    run_case(case, broken, restart=True)
-    assert (whole / "history.csv").read_text() == (broken / "history.csv").read_text()
-    spec, base = load_case(case)
-    digest = compile_case(spec, base).model.digest()
-    a = load_checkpoint(latest_checkpoint(whole / "checkpoints"), digest)
-    b = load_checkpoint(latest_checkpoint(broken / "checkpoints"), digest)
+    _, _, _, a, b = interrupted_and_resumed(case, tmp_path, 0.7)
     assert a.planes.shape == (2, 9) and a.planes[1, PL_F + 2] > 0.0
     assert a.equals(b)
 

@@ -117,23 +117,30 @@ def cell_values(geometry, compression, extension,
     return values
 
 
-def round_trip(params, compression, extension, biaxial) -> list[dict]:
-    """Rows (test, at, cell, shell, error) of the written file's single-element tests
-    against the cell (module docstring); ``params`` the file's FabricParameters."""
+def shell_tests(params, side: float) -> dict[str, dict]:
+    """The written file's single-element uniaxial and equibiaxial tests (the shell's yarn
+    model, calibration.single_element) to the largest round-trip strain of a cell of side
+    ``side``: {test: history}, read by :func:`round_trip` and the figure."""
     from wovenimpact.calibration.single_element import run_element_test
 
-    side = extension.length
+    return {test: run_element_test(params, test, amplitude=max(ROUND_TRIP_STRAINS) * side,
+                                   n_steps=400).history
+            for test in ("uniaxial", "biaxial")}
+
+
+def round_trip(shell: dict[str, dict], side: float, compression, extension,
+               biaxial) -> list[dict]:
+    """Rows (test, at, cell, shell, error) of the written file's single-element tests
+    (``shell``, :func:`shell_tests`) against the cell (module docstring)."""
     rows = []
     for test, cell_run in (("uniaxial", extension), ("biaxial", biaxial)):
-        result = run_element_test(params, test, amplitude=max(ROUND_TRIP_STRAINS) * side,
-                                  n_steps=400)
-        h = result.history
+        h = shell[test]
         eps = np.asarray(h["displacement_m"]) / side
         for e in ROUND_TRIP_STRAINS:
-            shell = float(np.interp(e, eps, h["tension_w_N"]))
+            shell_force = float(np.interp(e, eps, h["tension_w_N"]))
             cell = float(np.interp(e, cell_run.strain, cell_run.force))
             rows.append({"test": test, "at": f"strain {e:.3g}", "cell_N": cell,
-                         "shell_N": shell, "error": shell / cell - 1.0})
+                         "shell_N": shell_force, "error": shell_force / cell - 1.0})
     fit = compression.fit
     for f in ROUND_TRIP_FORCES:
         d_cell = float(np.interp(f, compression.force, compression.d))
@@ -194,7 +201,8 @@ def calibrate_crossover(geometry_path, yarn_path, template_path, out: Path,
     fabric_path = out / "fabric.toml"
     atomic_write_text(fabric_path, text)
     params = load_material(fabric_path)  # the file must load as written
-    rows = round_trip(params, compression, extension, biaxial)
+    shell = shell_tests(params, extension.length)
+    rows = round_trip(shell, extension.length, compression, extension, biaxial)
     checks = {name: {"kinetic_fraction": r.kinetic_fraction,
                      "hourglass_fraction": r.hourglass_fraction,
                      "energy_error": r.energy_error, "steps": r.steps, "elements": r.elements}
@@ -209,19 +217,17 @@ def calibrate_crossover(geometry_path, yarn_path, template_path, out: Path,
         "round_trip": rows,
     }
     atomic_write_text(out / "crossover_calibration.json", json.dumps(doc, indent=2) + "\n")
-    _figures(out, compression, extension, biaxial, params)
+    _figures(out, compression, extension, biaxial, shell)
     return doc
 
 
-def _figures(out: Path, compression, extension, biaxial, params) -> None:
+def _figures(out: Path, compression, extension, biaxial, shell: dict[str, dict]) -> None:
     """compression.png (the cell's curve and the law) and extension.png (the cell's end
     forces and the written file's single-element tensions)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
-    from wovenimpact.calibration.single_element import run_element_test
 
     fit = compression.fit
     fig, ax = plt.subplots(figsize=(6.4, 4.2))
@@ -234,8 +240,7 @@ def _figures(out: Path, compression, extension, biaxial, params) -> None:
     side = extension.length
     for test, run, style in (("uniaxial", extension, "C0"), ("biaxial", biaxial, "C1")):
         ax.plot(run.strain * 100, run.force, color=style, label=f"cell, {test}")
-        h = run_element_test(params, test, amplitude=float(run.strain[-1]) * side,
-                             n_steps=400).history
+        h = shell[test]
         ax.plot(np.asarray(h["displacement_m"]) / side * 100, h["tension_w_N"], "--",
                 color=style, label=f"shell single element, {test}")
     _save(fig, ax, "strain of the warp (%)", "warp end force / yarn tension (N)",

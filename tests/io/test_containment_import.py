@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 
 from wovenimpact.errors import InputError
-from wovenimpact.setup.compile import compile_case, containment_mesh
+from wovenimpact.setup.compile import compile_case
 from wovenimpact.solver import Workspace, step
 from wovenimpact.spec.case import case_from_dict
 from wovenimpact.spec.fields import read_toml, set_dotted

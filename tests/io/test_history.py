@@ -6,8 +6,7 @@ import numpy as np
 import pytest
 
 from wovenimpact.errors import InputError
-from wovenimpact.io.history import ENERGY_COLUMNS, History, energy_row, read_csv
-from wovenimpact.state import KINETIC, N_ENERGY, W_INT, State
+from wovenimpact.io.history import History, read_csv
 
 COLUMNS = ("time_s", "step", "kinetic_energy_J", "reaction_z_N")
 
@@ -59,21 +58,6 @@ def test_non_finite_values_survive(tmp_path):
     h.write_csv(tmp_path / "h.csv")
     x = read_csv(tmp_path / "h.csv")["x_m"]
     assert np.isnan(x[0]) and x[1] == -np.inf
-
-
-def test_energy_row_of_a_state():
-    energy = np.arange(N_ENERGY, dtype=float)
-    s = State(t=2e-6, step=4, dt=5e-7, x=np.zeros((1, 3)), v=np.zeros((1, 3)),
-              omega=np.zeros((1, 3)), elem=np.zeros((0, 22)), mat=np.zeros((0, 1)),
-              f_int=np.zeros((1, 6)), f_ext=np.zeros((1, 6)),
-              node_active=np.ones(1, np.int8), energy=energy)
-    h = History()
-    h.append(energy_row(s))
-    a = h.arrays()
-    assert h.columns == ENERGY_COLUMNS
-    assert a["kinetic_energy_J"][0] == energy[KINETIC]
-    assert a["internal_work_J"][0] == energy[W_INT]
-    assert a["step"].dtype == np.int64
 
 
 @pytest.mark.parametrize(

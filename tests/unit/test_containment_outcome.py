@@ -455,7 +455,6 @@ def test_an_escape_stops_the_run_only_once_the_fragments_speed_has_settled():
     plies on the 7 mm ring did: 117.7 → 111.5 m/s in the 500 µs after it passed); once
     its speed has stayed within 0.5 % for the hold, the run stops. Contained stops on
     the hold alone; undecided never stops."""
-    from types import SimpleNamespace
 
     from wovenimpact.results.containment import (
         CONTAINMENT_COLUMNS,

@@ -23,7 +23,6 @@ from wovenimpact.kernels.fabric import (
     MAX_ITER,
     compaction_energy,
     shear_modulus_true,
-    yarn_vertical_force,
 )
 from wovenimpact.materials.fabric import initial_state, update_points
 
@@ -68,24 +67,6 @@ def test_compaction_energy_is_the_integral_of_the_law():
     x = np.linspace(0.0, delta, 200001)
     numeric = np.trapezoid(b * x / (a - x), x)
     assert compaction_energy(delta, a, b) == pytest.approx(numeric, rel=1e-8)
-
-
-def test_vertical_force_derivative_matches_finite_difference():
-    k, ell0, h0 = 3e7, 0.47037e-3, 0.1248e-3
-    lt0 = math.hypot(ell0, h0)
-    ell = 0.485e-3  # slack below H = √(L0² − ℓ²) = 0.0379 mm
-    assert yarn_vertical_force(k, ell, ell0, 3.7e-5, h0, lt0) == (0.0, 0.0, 0.0)
-    for h in (5e-5, 8e-5, 1.2e-4):
-        f, df, t = yarn_vertical_force(k, ell, ell0, h, h0, lt0)
-        d = 1e-11
-        fd = (
-            yarn_vertical_force(k, ell, ell0, h + d, h0, lt0)[0]
-            - yarn_vertical_force(k, ell, ell0, h - d, h0, lt0)[0]
-        )
-        assert df == pytest.approx(fd / (2 * d), rel=1e-5)
-        length = math.hypot(ell, h)
-        assert t == pytest.approx(k * (length - lt0), rel=1e-14)
-        assert f == pytest.approx(2 * t * h / length, rel=1e-14)
 
 
 def test_shear_energy_is_the_integral_of_the_secant_law():

@@ -13,8 +13,16 @@ from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.model import BoundaryConditions, Section, build_model
 from wovenimpact.results.energy import energy_balance
 from wovenimpact.solver import Workspace, step
-from wovenimpact.solver.explicit import element_forces
+from wovenimpact.kernels.gather import gather_nodal_forces
+from wovenimpact.solver.explicit import shell_forces
 from wovenimpact.state import KINETIC0, initial_state
+
+
+def element_forces(model, state, ws) -> None:
+    """The element forces at x^n and their nodal sums (into ws), without a step."""
+    shell_forces(model, state, ws)
+    gather_nodal_forces(model.node_ptr, model.node_elem, model.node_corner, ws.blocks, ws.alive,
+                        ws.f_int, ws.live)
 
 
 def distorted_square(n=4, amplitude=0.25, seed=3):

@@ -570,7 +570,7 @@ def calibration_figure(cal: Calibration, path: Path, title: str) -> Path:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from wovenimpact.io.atomic import atomic_path
+    from wovenimpact.io.atomic import save_png
 
     h = np.array([m.element_size for m in cal.meshes]) * 1e3
     target = cal.reference.elongation_at_fracture * 1e3
@@ -612,11 +612,7 @@ def calibration_figure(cal: Calibration, path: Path, title: str) -> Path:
         ax.minorticks_off()
     fig.suptitle(title, fontsize=10)
     fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=120, format="png")
-    plt.close(fig)
-    return path
+    return save_png(fig, path)
 
 
 def write_calibration(cal: Calibration, material_file: Path, out: Path,

@@ -19,24 +19,10 @@ import numpy as np
 
 from wovenimpact.errors import InputError
 from wovenimpact.io.atomic import atomic_write_text
-from wovenimpact.state import ERODED_INTERNAL, ERODED_KINETIC, KINETIC, W_EXT, W_INT, State
 
 TIME = "time_s"
-ENERGY_COLUMNS = (
-    TIME, "step", "dt_s", "kinetic_energy_J", "internal_work_J", "external_work_J",
-    "eroded_kinetic_energy_J", "eroded_internal_energy_J",
-)
 _NAME = re.compile(r"[A-Za-z][A-Za-z0-9_]*")
 _INT = re.compile(r"[+-]?\d+")
-
-
-def energy_row(state: State) -> dict[str, float | int]:
-    """The :data:`ENERGY_COLUMNS` of ``state``."""
-    e = state.energy
-    return {TIME: float(state.t), "step": int(state.step), "dt_s": float(state.dt),
-            "kinetic_energy_J": float(e[KINETIC]), "internal_work_J": float(e[W_INT]),
-            "external_work_J": float(e[W_EXT]), "eroded_kinetic_energy_J": float(e[ERODED_KINETIC]),
-            "eroded_internal_energy_J": float(e[ERODED_INTERNAL])}
 
 
 class History:
@@ -47,7 +33,7 @@ class History:
             include ``time_s``.
     """
 
-    def __init__(self, columns: Sequence[str] = ENERGY_COLUMNS) -> None:
+    def __init__(self, columns: Sequence[str]) -> None:
         self.columns = tuple(_check_columns(columns))
         self._rows: list[tuple[float | int, ...]] = []
 

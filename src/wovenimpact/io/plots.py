@@ -10,7 +10,7 @@ import numpy as np
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from wovenimpact.io.atomic import atomic_path  # noqa: E402
+from wovenimpact.io.atomic import save_png  # noqa: E402
 
 
 DAMPING_COLUMNS = ("contact_dissipated_part_J", "contact_damping_part_J")  # first present
@@ -75,7 +75,7 @@ def energy_plot(h: dict, path: str | Path, title: str = "", symmetry_factor: flo
     else:
         fig = single_energy_figure(h, title, symmetry_factor)
     fig.tight_layout()
-    _save(fig, path)
+    save_png(fig, path)
     return path
 
 
@@ -201,7 +201,7 @@ def impactor_plot(h: dict, path: str | Path, title: str = "", markers=()) -> Pat
     a2.set_xlabel("time (µs)")
     a2.grid(alpha=0.3)
     fig.tight_layout()
-    _save(fig, path)
+    save_png(fig, path)
     return path
 
 
@@ -256,7 +256,7 @@ def fragment_plot(h: dict, path: str | Path, title: str = "", outcome: str = "",
     a2.set_xlabel("time (µs)")
     a2.grid(alpha=0.3)
     fig.tight_layout()
-    _save(fig, path)
+    save_png(fig, path)
     return path
 
 
@@ -336,7 +336,7 @@ def _finish_time_plot(fig, ax, title: str, legend_loc: str, path: Path) -> Path:
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7, ncol=2, loc=legend_loc)
     fig.tight_layout()
-    _save(fig, path)
+    save_png(fig, path)
     return path
 
 
@@ -360,7 +360,7 @@ def deflection_plot(model, state, path: str | Path, title: str = "") -> Path:
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
     fig.tight_layout()
-    _save(fig, path)
+    save_png(fig, path)
     return path
 
 
@@ -393,10 +393,3 @@ def write_run_plots(out: Path, title: str, model, state, h: dict, summary: dict)
     layer_energy_plot(h, plots / "layer_energy.png", title=title, symmetry_factor=factor,
                       names=names, markers=markers)
     contact_force_plot(h, plots / "contact_forces.png", title=title, markers=markers)
-
-
-def _save(fig, path: Path) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=120, format="png")
-    plt.close(fig)

@@ -111,29 +111,6 @@ def yarn_extension(ell, ell0, h, h0, ell_truss0):
 
 
 @kernel
-def yarn_vertical_force(k, ell, ell0, h, h0, ell_truss0):
-    """Vertical force of one yarn on the crossing, F = 2 T H / L (eq. 6.21–6.22).
-
-    Args:
-        k: (1 − d) E A / L0, axial stiffness of the half truss (N/m).
-        ell, ell0: ℓ, current and ℓ0, initial in-plane half-length (m).
-        h, h0: H, crimp height (the formula is odd in H) and h0, its initial value (m).
-        ell_truss0: L0 = √(ℓ0² + h0²) (m).
-
-    Returns:
-        (F, dF/dH, T): force (N), its derivative (N/m), tension
-        T = k ⟨L − L0⟩ (eq. 6.20; yarns carry no compression).
-    """
-    ext, length = yarn_extension(ell, ell0, h, h0, ell_truss0)
-    if ext <= 0.0 or k == 0.0:
-        return 0.0, 0.0, 0.0
-    tension = k * ext
-    force = 2.0 * tension * h / length
-    dforce = 2.0 * k * (1.0 - ell_truss0 * ell * ell / (length * length * length))
-    return force, dforce, tension
-
-
-@kernel
 def compaction_closure(force, a, b):
     """Overclosure δ(F) = a F / (b + F), inverse of F = b δ / (a − δ) (eq. 5.8), and dδ/dF."""
     if force <= 0.0:
@@ -377,20 +354,53 @@ def yarn_frame(f11, f12, f21, f22):
     Returns (ok, λ_w, λ_f, e_wx, e_wy, e_fx, e_fy, cos θ, sin θ, γ); ok is False for a
     zero, non-finite or inverted pair of yarn directions.
     """
-    gwx, gwy = f11, f21
-    gfx, gfy = f12, f22
-    lam_w = math.sqrt(gwx * gwx + gwy * gwy)
-    lam_f = math.sqrt(gfx * gfx + gfy * gfy)
+    lam_w, lam_f = yarn_stretches(f11, f12, f21, f22)
     if not (lam_w > 0.0 and lam_f > 0.0):  # also catches NaN
         return False, lam_w, lam_f, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    ewx, ewy = gwx / lam_w, gwy / lam_w
-    efx, efy = gfx / lam_f, gfy / lam_f
-    cos_t = ewx * efx + ewy * efy
-    sin_t = ewx * efy - ewy * efx
+    ewx, ewy, efx, efy, cos_t, sin_t = yarn_directions(f11, f21, f12, f22, lam_w, lam_f)
     if not (sin_t > 0.0) or not math.isfinite(cos_t):
         return False, lam_w, lam_f, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    gamma = 0.5 * math.pi - atan2_upper(sin_t, cos_t)  # libm's to 1 ulp; vectorises (kernels.vecmath)
-    return True, lam_w, lam_f, ewx, ewy, efx, efy, cos_t, sin_t, gamma
+    return True, lam_w, lam_f, ewx, ewy, efx, efy, cos_t, sin_t, trellis_angle(sin_t, cos_t)
+
+
+@inline_kernel
+def yarn_stretches(f11, f12, f21, f22):
+    """The yarns' current stretches λ_w = |F e_x|, λ_f = |F e_y| (fibre frame)."""
+    return math.sqrt(f11 * f11 + f21 * f21), math.sqrt(f12 * f12 + f22 * f22)
+
+
+@inline_kernel
+def yarn_directions(gwx, gwy, gfx, gfy, lam_w, lam_f):
+    """The yarns' unit directions e_w = F e_x/λ_w, e_f = F e_y/λ_f and cos θ, sin θ of the
+    angle between them (eq. 6.5): (e_wx, e_wy, e_fx, e_fy, cos θ, sin θ)."""
+    ewx, ewy = gwx / lam_w, gwy / lam_w
+    efx, efy = gfx / lam_f, gfy / lam_f
+    return ewx, ewy, efx, efy, ewx * efx + ewy * efy, ewx * efy - ewy * efx
+
+
+@inline_kernel
+def trellis_angle(sin_t, cos_t):
+    """γ = π/2 − θ (θ in (0, π) from sin θ > 0 and cos θ; libm's atan2 to 1 ulp, and
+    vectorises: kernels.vecmath)."""
+    return 0.5 * math.pi - atan2_upper(sin_t, cos_t)
+
+
+@inline_kernel
+def virial_components(c_w, c_f, ewx, ewy, efx, efy):
+    """The yarns' membrane resultant c_w e_w⊗e_w + c_f e_f⊗e_f (theory §1.5):
+    (N_xx, N_yy, N_xy)."""
+    return (c_w * ewx * ewx + c_f * efx * efx, c_w * ewy * ewy + c_f * efy * efy,
+            c_w * ewx * ewy + c_f * efx * efy)
+
+
+@inline_kernel
+def shear_step_stiffness(thick, g_tan, cs):
+    """The stable step's isotropic stiffness of a fabric point (theory §1.8): the shear
+    tangent t dτ/dγ and the shear resultant's own (geometric) stiffness |N_s| = t|τ|/(J
+    sinθ), counted twice — a shear strain takes both in-plane gradients, Σ_I |∇N_I|² =
+    2/L² on a square where a yarn family's takes one, and the step pairs it with the
+    element's L_e."""
+    return 2.0 * (thick * g_tan + abs(cs))
 
 
 @inline_kernel
@@ -867,9 +877,7 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
     # lengths L of the final heights from the solve above
     c_w, c_f, stiff, k_w, k_f = yarn_resultant(p, m, use_table, lam_w, lam_f, sin_t, d_w, d_f,
                                                t_w, t_f, l_w, l_f, gw_cross, gf_cross)
-    n_xx = c_w * ewx * ewx + c_f * efx * efx
-    n_yy = c_w * ewy * ewy + c_f * efy * efy
-    n_xy = c_w * ewx * ewy + c_f * efx * efy
+    n_xx, n_yy, n_xy = virial_components(c_w, c_f, ewx, ewy, efx, efy)
 
     # 4b. trellis shear (theory §1.6): τ(γ), applied through its work conjugate
     tau, g_tan, e_shear = trellis_shear(p, m, s_in, i, gamma, dgamma, h_w, h_f, lam_w, lam_f)
@@ -877,11 +885,7 @@ def fabric_point(p, m, fo11, fo12, fo21, fo22, f11, f12, f21, f22, s_in, s_out, 
     s_out[i, S_SHEAR_ENERGY] = e_shear
     n_xx, n_yy, n_xy, cs = shear_resultant(n_xx, n_yy, n_xy, thick, tau, lam_w, lam_f, ewx,
                                            ewy, efx, efy, cos_t, sin_t)
-    # the stable step's isotropic part (theory §1.8): the shear tangent and the shear
-    # resultant's own (geometric) stiffness |N_s| = t|τ|/(J sinθ), counted twice — a
-    # shear strain takes both in-plane gradients, Σ_I |∇N_I|² = 2/L² on a square where a
-    # yarn family's takes one, and the step pairs it with the element's L_e
-    k_shear = 2.0 * (thick * g_tan + abs(cs))
+    k_shear = shear_step_stiffness(thick, g_tan, cs)
     stiff += thick * g_tan
 
     # 5. stored energy per unit reference area

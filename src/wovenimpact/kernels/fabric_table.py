@@ -168,18 +168,21 @@ def crossover_from_table(p, m, lam_w, lam_f):
     ax0, ax1, bx0, bx1, dax0, dax1, dbx0, dbx1 = hermite_basis((lam_w - x0) / hx, hx)
     ay0, ay1, by0, by1, day0, day1, dby0, dby1 = hermite_basis((lam_f - y0) / hy, hy)
     u10 = u00 + _U(TAB_STRIDE * nf)
-    w0, gw0, gf0, hw0, hf0 = hermite_corner(p, m, u00, ax0, bx0, dax0, dbx0, ay0, by0, day0, dby0)
-    w1, gw1, gf1, hw1, hf1 = hermite_corner(p, m, u00 + STRIDE, ax0, bx0, dax0, dbx0,
-                                            ay1, by1, day1, dby1)
-    w2, gw2, gf2, hw2, hf2 = hermite_corner(p, m, u10, ax1, bx1, dax1, dbx1, ay0, by0, day0, dby0)
-    w3, gw3, gf3, hw3, hf3 = hermite_corner(p, m, u10 + STRIDE, ax1, bx1, dax1, dbx1,
-                                            ay1, by1, day1, dby1)
-    w = (w0 + w1) + (w2 + w3)
-    gw = (gw0 + gw1) + (gw2 + gw3)
-    gf = (gf0 + gf1) + (gf2 + gf3)
-    hw = (hw0 + hw1) + (hw2 + hw3)
-    hf = (hf0 + hf1) + (hf2 + hf3)
+    w, gw, gf, hw, hf = cell_sum(
+        hermite_corner(p, m, u00, ax0, bx0, dax0, dbx0, ay0, by0, day0, dby0),
+        hermite_corner(p, m, u00 + STRIDE, ax0, bx0, dax0, dbx0, ay1, by1, day1, dby1),
+        hermite_corner(p, m, u10, ax1, bx1, dax1, dbx1, ay0, by0, day0, dby0),
+        hermite_corner(p, m, u10 + STRIDE, ax1, bx1, dax1, dbx1, ay1, by1, day1, dby1))
     return True, w, gw, gf, hw, hf
+
+
+@inline_kernel
+def cell_sum(c0, c1, c2, c3):
+    """The interpolant on a knot cell: the sum of its four corners' terms (each (W,
+    ∂W/∂λ_w, ∂W/∂λ_f, H_w, H_f), :func:`hermite_corner`), paired as (c0 + c1) + (c2 + c3)."""
+    return ((c0[0] + c1[0]) + (c2[0] + c3[0]), (c0[1] + c1[1]) + (c2[1] + c3[1]),
+            (c0[2] + c1[2]) + (c2[2] + c3[2]), (c0[3] + c1[3]) + (c2[3] + c3[3]),
+            (c0[4] + c1[4]) + (c2[4] + c3[4]))
 
 
 @kernel

@@ -218,6 +218,84 @@ def hourglass_mode(q_old, k, gam_mid, rates, dt):
 
 
 @inline_kernel
+def hourglass_stiffnesses(r, c_memb, area, bb, d_b, full):
+    """The generalised hourglass stiffnesses (k_m, k_w, k_θ) = (r C_m A Σb², r 16 D Σb²,
+    r D A Σb²) (theory §4, hourglass control); k_m = 0 for a 2×2 membrane, which has no
+    in-plane modes. The w mode's 16 D Σb² is the twist energy of a square element's
+    bilinear w at r = 1."""
+    k_m = 0.0 if full else r * c_memb * area * bb
+    return k_m, r * 16.0 * d_b * bb, r * d_b * area * bb
+
+
+@inline_kernel
+def hourglass_update(q_old, k_m, k_w, k_t, gam_mid, rates, dt):
+    """The five hourglass resultants (in-plane x, y; w; θ_x, θ_y) from their old values
+    q_old (5-tuple) and the midpoint rates (v_x, v_y, v_z, θ_x, θ_y of the corners), each
+    :func:`hourglass_mode`. Returns ((Q_0 … Q_4), their energy increment)."""
+    hg0, e_hg = hourglass_mode(q_old[0], k_m, gam_mid, rates[0], dt)
+    hg1, de = hourglass_mode(q_old[1], k_m, gam_mid, rates[1], dt)
+    e_hg += de
+    hg2, de = hourglass_mode(q_old[2], k_w, gam_mid, rates[2], dt)
+    e_hg += de
+    hg3, de = hourglass_mode(q_old[3], k_t, gam_mid, rates[3], dt)
+    e_hg += de
+    hg4, de = hourglass_mode(q_old[4], k_t, gam_mid, rates[4], dt)
+    e_hg += de
+    return (hg0, hg1, hg2, hg3, hg4), e_hg
+
+
+@inline_kernel
+def plate_stiffness(e_b, thick, nu_b):
+    """Bending stiffness of the plate law, D = E_b t³ / 12(1 − ν_b²)."""
+    return e_b * thick * thick * thick / (12.0 * (1.0 - nu_b * nu_b))
+
+
+@inline_kernel
+def plate_moments(m_old, d_b, nu_b, dk):
+    """M += D Δκ (plate law, rate form) from M_old = (M_xx, M_yy, M_xy) and
+    Δκ = (Δκ_x, Δκ_y, 2Δκ_xy)."""
+    return (m_old[0] + d_b * (dk[0] + nu_b * dk[1]), m_old[1] + d_b * (dk[1] + nu_b * dk[0]),
+            m_old[2] + d_b * 0.5 * (1.0 - nu_b) * dk[2])
+
+
+@inline_kernel
+def shear_forces(q_old, kgt, dg):
+    """Q += k G t Δγ from Q_old = (Q_x, Q_y) and Δγ = (Δγ_xz, Δγ_yz)."""
+    return q_old[0] + kgt * dg[0], q_old[1] + kgt * dg[1]
+
+
+@inline_kernel
+def bending_work(area, w_bend, m_old, m_new, q_old, q_new, dk, dg):
+    """The step's bending and transverse-shear work, trapezoid rule on the increments:
+    A [w ½(M_old + M)·Δκ + ½(Q_old + Q)·Δγ] (w = 0 where the points book the bending)."""
+    return area * (
+        w_bend * (0.5 * (m_old[0] + m_new[0]) * dk[0] + 0.5 * (m_old[1] + m_new[1]) * dk[1]
+                  + 0.5 * (m_old[2] + m_new[2]) * dk[2])
+        + 0.5 * (q_old[0] + q_new[0]) * dg[0] + 0.5 * (q_old[1] + q_new[1]) * dg[1]
+    )
+
+
+@inline_kernel
+def point_gradient(lx, ly, q1, q2):
+    """F = Σ_I x̂_I ⊗ G_I at a Gauss point with reference gradients G = (q1, q2)
+    (``full_membrane``): (F11, F12, F21, F22)."""
+    f11 = lx[0] * q1[0] + lx[1] * q1[1] + lx[2] * q1[2] + lx[3] * q1[3]
+    f12 = lx[0] * q2[0] + lx[1] * q2[1] + lx[2] * q2[2] + lx[3] * q2[3]
+    f21 = ly[0] * q1[0] + ly[1] * q1[1] + ly[2] * q1[2] + ly[3] * q1[3]
+    f22 = ly[0] * q2[0] + ly[1] * q2[1] + ly[2] * q2[2] + ly[3] * q2[3]
+    return f11, f12, f21, f22
+
+
+@inline_kernel
+def point_corner_forces(wg, p11, p12, p21, p22, q1, q2):
+    """A Gauss point's share of the membrane's corner forces, w_g P G_I: ((f̂x_I), (f̂y_I))."""
+    return ((wg * (p11 * q1[0] + p12 * q2[0]), wg * (p11 * q1[1] + p12 * q2[1]),
+             wg * (p11 * q1[2] + p12 * q2[2]), wg * (p11 * q1[3] + p12 * q2[3])),
+            (wg * (p21 * q1[0] + p22 * q2[0]), wg * (p21 * q1[1] + p22 * q2[1]),
+             wg * (p21 * q1[2] + p22 * q2[2]), wg * (p21 * q1[3] + p22 * q2[3])))
+
+
+@inline_kernel
 def clear_block(blocks, e):
     """No force or moment at any corner of element e."""
     for i in range(4):
@@ -404,10 +482,7 @@ def full_membrane(
               gauss_grad[e, g, 0, 3])
         q2 = (gauss_grad[e, g, 1, 0], gauss_grad[e, g, 1, 1], gauss_grad[e, g, 1, 2],
               gauss_grad[e, g, 1, 3])
-        f11 = lx[0] * q1[0] + lx[1] * q1[1] + lx[2] * q1[2] + lx[3] * q1[3]
-        f12 = lx[0] * q2[0] + lx[1] * q2[1] + lx[2] * q2[2] + lx[3] * q2[3]
-        f21 = ly[0] * q1[0] + ly[1] * q1[1] + ly[2] * q1[2] + ly[3] * q1[3]
-        f22 = ly[0] * q2[0] + ly[1] * q2[1] + ly[2] * q2[2] + ly[3] * q2[3]
+        f11, f12, f21, f22 = point_gradient(lx, ly, q1, q2)
         det = f11 * f22 - f12 * f21
         if not (det > 0.0):
             st = EL_NAN if not math.isfinite(det) else EL_INVERTED
@@ -440,10 +515,9 @@ def full_membrane(
         m_yy += wg * mb
         m_xy += wg * mc
         p11, p12, p21, p22 = first_piola(a, b, c12, f11, f12, f21, f22)
-        fx = (fx[0] + wg * (p11 * q1[0] + p12 * q2[0]), fx[1] + wg * (p11 * q1[1] + p12 * q2[1]),
-              fx[2] + wg * (p11 * q1[2] + p12 * q2[2]), fx[3] + wg * (p11 * q1[3] + p12 * q2[3]))
-        fy = (fy[0] + wg * (p21 * q1[0] + p22 * q2[0]), fy[1] + wg * (p21 * q1[1] + p22 * q2[1]),
-              fy[2] + wg * (p21 * q1[2] + p22 * q2[2]), fy[3] + wg * (p21 * q1[3] + p22 * q2[3]))
+        tx, ty = point_corner_forces(wg, p11, p12, p21, p22, q1, q2)
+        fx = (fx[0] + tx[0], fx[1] + tx[1], fx[2] + tx[2], fx[3] + tx[3])
+        fy = (fy[0] + ty[0], fy[1] + ty[1], fy[2] + ty[2], fy[3] + ty[3])
     if kind == MAT_FABRIC:
         sync_yarn_damage(rows_out, row0, n_pts)
     inv = 1.0 / a0
@@ -576,30 +650,26 @@ def bending_and_shear(e, el_in, el_out, area, integrated, c_memb, thick, e_b, nu
 
     Returns (D, M_xx, M_yy, M_xy, Q_x, Q_y, w) with w = 1 when M is the plate law's.
     """
-    m_old0, m_old1, m_old2 = el_in[e, E_M], el_in[e, E_M + 1], el_in[e, E_M + 2]
-    q_old0, q_old1 = el_in[e, E_Q], el_in[e, E_Q + 1]
+    m_old = (el_in[e, E_M], el_in[e, E_M + 1], el_in[e, E_M + 2])
+    q_old = (el_in[e, E_Q], el_in[e, E_Q + 1])
+    dk = (dkx, dky, dkxy2)
+    dg = (dgxz, dgyz)
     if integrated:
         d_b = c_memb * thick * thick / 12.0  # for the hourglass stiffness only
         mxx, myy, mxy = mi_xx, mi_yy, mi_xy
         w_bend = 0.0
     else:
-        d_b = e_b * thick * thick * thick / (12.0 * (1.0 - nu_b * nu_b))
-        mxx = m_old0 + d_b * (dkx + nu_b * dky)
-        myy = m_old1 + d_b * (dky + nu_b * dkx)
-        mxy = m_old2 + d_b * 0.5 * (1.0 - nu_b) * dkxy2
+        d_b = plate_stiffness(e_b, thick, nu_b)
+        mxx, myy, mxy = plate_moments(m_old, d_b, nu_b, dk)
         w_bend = 1.0
-    qx = q_old0 + kgt * dgxz
-    qy = q_old1 + kgt * dgyz
+    qx, qy = shear_forces(q_old, kgt, dg)
     el_out[e, E_M] = mxx
     el_out[e, E_M + 1] = myy
     el_out[e, E_M + 2] = mxy
     el_out[e, E_Q] = qx
     el_out[e, E_Q + 1] = qy
-    el_out[e, E_U_BEND] = el_in[e, E_U_BEND] + area * (
-        w_bend * (0.5 * (m_old0 + mxx) * dkx + 0.5 * (m_old1 + myy) * dky
-                  + 0.5 * (m_old2 + mxy) * dkxy2)
-        + 0.5 * (q_old0 + qx) * dgxz + 0.5 * (q_old1 + qy) * dgyz
-    )
+    el_out[e, E_U_BEND] = el_in[e, E_U_BEND] + bending_work(
+        area, w_bend, m_old, (mxx, myy, mxy), q_old, (qx, qy), dk, dg)
     return d_b, mxx, myy, mxy, qx, qy, w_bend
 
 
@@ -610,15 +680,9 @@ def hourglass_resultants(e, el_in, el_out, k_m, k_w, k_t, gam_mid, vx, vy, vz, t
     """The five hourglass resultants of element e (in-plane x, y; w; θ_x, θ_y), each
     Q += k (γ_mid · rates) Δt (``hourglass_mode``), written to el_out with their
     energy; returns them."""
-    hg0, e_hg = hourglass_mode(el_in[e, E_HG], k_m, gam_mid, vx, dt)
-    hg1, de = hourglass_mode(el_in[e, E_HG + 1], k_m, gam_mid, vy, dt)
-    e_hg += de
-    hg2, de = hourglass_mode(el_in[e, E_HG + 2], k_w, gam_mid, vz, dt)
-    e_hg += de
-    hg3, de = hourglass_mode(el_in[e, E_HG + 3], k_t, gam_mid, tx, dt)
-    e_hg += de
-    hg4, de = hourglass_mode(el_in[e, E_HG + 4], k_t, gam_mid, ty, dt)
-    e_hg += de
+    (hg0, hg1, hg2, hg3, hg4), e_hg = hourglass_update(
+        (el_in[e, E_HG], el_in[e, E_HG + 1], el_in[e, E_HG + 2], el_in[e, E_HG + 3],
+         el_in[e, E_HG + 4]), k_m, k_w, k_t, gam_mid, (vx, vy, vz, tx, ty), dt)
     el_out[e, E_HG] = hg0
     el_out[e, E_HG + 1] = hg1
     el_out[e, E_HG + 2] = hg2
@@ -902,12 +966,8 @@ def shell_force(e, mesh, motion, dt, tables, blocks):
     # rates with the midpoint γ, forces with the current one
     gam, bb = hourglass_vectors(lx, ly, b1, b2)
     gam_mid = hourglass_vectors(mid[3][0], mid[3][1], mid[5][0], mid[5][1])[0]
-    r = sections[sec, C_HOURGLASS]
-    k_m = 0.0 if full else r * c_memb * area * bb  # a 2×2 membrane has no in-plane modes
-    # w mode: the bilinear w of an element is the nodal-value trace of a twist;
-    # k = 16 D Σb² is its twist energy for a square element (r = 1)
-    k_w = r * 16.0 * d_b * bb
-    k_t = r * d_b * area * bb
+    k_m, k_w, k_t = hourglass_stiffnesses(sections[sec, C_HOURGLASS], c_memb, area, bb, d_b,
+                                          full)
     hg0, hg1, hg2, hg3, hg4 = hourglass_resultants(
         e, el_in, el_out, k_m, k_w, k_t, gam_mid, vx, vy, vz, tx, ty, dt)
 

@@ -1,12 +1,15 @@
 """The element stage for fabric shells in blocks of 8, vectorised across the block (issue 13).
 
-docs/theory.md §4.6, "SIMD element pass". ``shell.shell_force`` is one element: LLVM has no
-loop over elements to vectorise. Here the fabric elements of the default model — a 2×2
+docs/theory.md §4.6 and docs/performance.md ("SIMD element pass"). ``shell.shell_force``
+is one element: LLVM has no loop over elements to vectorise. Here the fabric elements of the default model — a 2×2
 membrane (``full_membrane``), a resultant section, the tabulated crossover, the fibre
 frame, the true trellis law, the virial resultant — go through the same arithmetic as
-``shell_force`` and ``fabric.fabric_point`` (the same helpers, or the same formulas in the
-same order), written so that each value of a block of ``LANES`` elements is computed for
-all lanes at once. Per block (one iteration of the parallel loop; every table below is
+``shell_force`` and ``fabric.fabric_point``: every formula is one of their inlined helpers
+(``plate_moments``, ``hourglass_update``, ``point_gradient``, ``yarn_directions``,
+``virial_components``, ``cell_sum``, …), so the physics is written once; this module adds
+the data layout, selects in place of branches, and the scalar kernel's sums over points
+unrolled in its order, so that each value of a block of ``LANES`` elements is computed
+for all lanes at once. Per block (one iteration of the parallel loop; every table below is
 the thread's own scratch row):
 
 1. *gather* (scalar): the corners' x, v, ω and the element state the step reads; a lane
@@ -40,7 +43,7 @@ both kinds end in :func:`element_tail` (bending, hourglass, corner forces, steps
 The results are bitwise those of ``shell_force`` (tests/unit/test_shell_blocks.py), so a
 run does not depend on which elements went through the blocks, nor on the thread count.
 What LLVM needs to vectorise the three vector stages (found with
-``--pass-remarks-missed=loop-vectorize``; the prototypes in benchmarks/simd_*.py):
+``--pass-remarks-missed=loop-vectorize``):
 lane-major scratch with unsigned affine indices (:func:`at`), no gathers inside the
 loop, no calls (``vecmath.atan2_upper``), selects instead of branches, and no alias
 checks — each stage is compiled with ``forceinline=True`` so that LLVM inlines it into
@@ -63,10 +66,20 @@ from wovenimpact.kernels.fabric import (
     family_stiffness,
     shear_modulus_true,
     shear_resultant,
+    shear_step_stiffness,
     table_tensions,
     table_virial,
+    trellis_angle,
+    virial_components,
+    yarn_directions,
+    yarn_stretches,
 )
-from wovenimpact.kernels.fabric_table import hermite_basis, hermite_terms, knot_interval
+from wovenimpact.kernels.fabric_table import (
+    cell_sum,
+    hermite_basis,
+    hermite_terms,
+    knot_interval,
+)
 from wovenimpact.kernels.shell import (
     centre_gradient,
     centre_membrane_forces,
@@ -76,13 +89,20 @@ from wovenimpact.kernels.shell import (
     element_stable_step,
     family_stable_step,
     finish_element,
+    bending_work,
     first_piola,
-    hourglass_mode,
+    hourglass_stiffnesses,
+    hourglass_update,
     hourglass_vectors,
     kinematic_step,
     midpoint_frame,
     midpoint_rates,
+    plate_moments,
+    plate_stiffness,
+    point_corner_forces,
+    point_gradient,
     scalar_element,
+    shear_forces,
     through_thickness_f,
     warp_forces,
 )
@@ -115,7 +135,6 @@ from wovenimpact.kernels.shell_layout import (
     N_ELEM_STATE,
     STEP_YARN,
 )
-from wovenimpact.kernels.vecmath import atan2_upper
 
 LANES = 8  # elements per block: one AVX-512 register of doubles
 POINTS = 4 * LANES  # the block's crossover points: Gauss point g of lane l is g·LANES + l
@@ -177,10 +196,7 @@ def gauss_f(gg, bu, g, lu, lx, ly):
           gg[gb(bu, N_GG, 8 * g + 2, lu)], gg[gb(bu, N_GG, 8 * g + 3, lu)])
     q2 = (gg[gb(bu, N_GG, 8 * g + 4, lu)], gg[gb(bu, N_GG, 8 * g + 5, lu)],
           gg[gb(bu, N_GG, 8 * g + 6, lu)], gg[gb(bu, N_GG, 8 * g + 7, lu)])
-    f11 = lx[0] * q1[0] + lx[1] * q1[1] + lx[2] * q1[2] + lx[3] * q1[3]
-    f12 = lx[0] * q2[0] + lx[1] * q2[1] + lx[2] * q2[2] + lx[3] * q2[3]
-    f21 = ly[0] * q1[0] + ly[1] * q1[1] + ly[2] * q1[2] + ly[3] * q1[3]
-    f22 = ly[0] * q2[0] + ly[1] * q2[1] + ly[2] * q2[2] + ly[3] * q2[3]
+    f11, f12, f21, f22 = point_gradient(lx, ly, q1, q2)
     return f11, f12, f21, f22, q1, q2
 
 
@@ -224,8 +240,9 @@ def point_kinematics(tid, bu, lu, g, gg, lx, ly, kap, kin):
     kin[tid, atq(1, q)] = h12
     kin[tid, atq(2, q)] = h21
     kin[tid, atq(3, q)] = h22
-    kin[tid, atq(Q_LAM, q)] = math.sqrt(h11 * h11 + h21 * h21)
-    kin[tid, atq(Q_LAM + 1, q)] = math.sqrt(h12 * h12 + h22 * h22)
+    lam_w, lam_f = yarn_stretches(h11, h12, h21, h22)
+    kin[tid, atq(Q_LAM, q)] = lam_w
+    kin[tid, atq(Q_LAM + 1, q)] = lam_f
     return (not (f11 * f22 - f12 * f21 > 0.0)) | (not (h11 * h22 - h12 * h21 > 0.0))
 
 
@@ -329,30 +346,19 @@ def crossover_points(tid, kin, coef, geo, res, mc):
         # 1. kinematics (fabric.yarn_frame)
         lam_w = kin[tid, atq(Q_LAM, q)]
         lam_f = kin[tid, atq(Q_LAM + 1, q)]
-        ewx, ewy = g11 / lam_w, g21 / lam_w
-        efx, efy = g12 / lam_f, g22 / lam_f
-        cos_t = ewx * efx + ewy * efy
-        sin_t = ewx * efy - ewy * efx
+        ewx, ewy, efx, efy, cos_t, sin_t = yarn_directions(g11, g21, g12, g22, lam_w, lam_f)
         bad = not ((lam_w > 0.0) & (lam_f > 0.0) & (sin_t > 0.0) & (cos_t - cos_t == 0.0))
-        gamma = 0.5 * math.pi - atan2_upper(sin_t, cos_t)
+        gamma = trellis_angle(sin_t, cos_t)
         # 2. the table (fabric_table.crossover_from_table on the copied cell)
         x0, hx = geo[tid, atq(0, q)], geo[tid, atq(1, q)]
         y0, hy = geo[tid, atq(2, q)], geo[tid, atq(3, q)]
         ax0, ax1, bx0, bx1, dax0, dax1, dbx0, dbx1 = hermite_basis((lam_w - x0) / hx, hx)
         ay0, ay1, by0, by1, day0, day1, dby0, dby1 = hermite_basis((lam_f - y0) / hy, hy)
-        w0, gw0, gf0, hw0, hf0 = cell_corner(coef, tid, 0, q, ax0, bx0, dax0, dbx0, ay0, by0,
-                                             day0, dby0)
-        w1, gw1, gf1, hw1, hf1 = cell_corner(coef, tid, 12, q, ax0, bx0, dax0, dbx0, ay1, by1,
-                                             day1, dby1)
-        w2, gw2, gf2, hw2, hf2 = cell_corner(coef, tid, 24, q, ax1, bx1, dax1, dbx1, ay0, by0,
-                                             day0, dby0)
-        w3, gw3, gf3, hw3, hf3 = cell_corner(coef, tid, 36, q, ax1, bx1, dax1, dbx1, ay1, by1,
-                                             day1, dby1)
-        w_tab = (w0 + w1) + (w2 + w3)
-        gw_tab = (gw0 + gw1) + (gw2 + gw3)
-        gf_tab = (gf0 + gf1) + (gf2 + gf3)
-        hw_tab = (hw0 + hw1) + (hw2 + hw3)
-        hf_tab = (hf0 + hf1) + (hf2 + hf3)
+        w_tab, gw_tab, gf_tab, hw_tab, hf_tab = cell_sum(
+            cell_corner(coef, tid, 0, q, ax0, bx0, dax0, dbx0, ay0, by0, day0, dby0),
+            cell_corner(coef, tid, 12, q, ax0, bx0, dax0, dbx0, ay1, by1, day1, dby1),
+            cell_corner(coef, tid, 24, q, ax1, bx1, dax1, dbx1, ay0, by0, day0, dby0),
+            cell_corner(coef, tid, 36, q, ax1, bx1, dax1, dbx1, ay1, by1, day1, dby1))
         # fabric.tabulated_crossover
         ell_w, ell_f, h_w, h_f, l_w, l_f, t_w, t_f = table_tensions(
             lam_w, lam_f, ell0_w, ell0_f, hw_tab, hf_tab, gw_tab, gf_tab)
@@ -368,16 +374,14 @@ def crossover_points(tid, kin, coef, geo, res, mc):
         scale = 1.0
         stiff, k_w, k_f = family_stiffness(scale, yarn_w, yarn_f, t_w, t_f, den_w, den_f, l_w,
                                            l_f, lt0_w, lt0_f, lam_w, lam_f, sin_t)
-        n_xx = c_w * ewx * ewx + c_f * efx * efx
-        n_yy = c_w * ewy * ewy + c_f * efy * efy
-        n_xy = c_w * ewx * ewy + c_f * efx * efy
+        n_xx, n_yy, n_xy = virial_components(c_w, c_f, ewx, ewy, efx, efy)
         # 4b. fabric.trellis_shear, the true law
         gs, g_tan, e_dens = shear_modulus_true(abs(gamma), g1, g2, gam1, gam2)
         tau = gs * gamma
         e_shear = thick * e_dens
         n_xx, n_yy, n_xy, cs = shear_resultant(n_xx, n_yy, n_xy, thick, tau, lam_w, lam_f, ewx,
                                                ewy, efx, efy, cos_t, sin_t)
-        k_shear = 2.0 * (thick * g_tan + abs(cs))
+        k_shear = shear_step_stiffness(thick, g_tan, cs)
         stiff += thick * g_tan
         # 5. fabric.stored_energy, the table's
         point_response_into(res, tid, q, 1.0 if bad else 0.0, stiff, n_xx, n_yy, n_xy, k_shear,
@@ -472,10 +476,7 @@ def membrane_point(tid, bu, lu, g, gg, gw, res, lx, ly, out_el):
     k_f = max(0.0, res[tid, atq(R_KF, q)])
     wg = gw[gb(bu, 4, g, lu)]
     p11, p12, p21, p22 = first_piola(a, b, c12, f11, f12, f21, f22)
-    fx = (wg * (p11 * q1[0] + p12 * q2[0]), wg * (p11 * q1[1] + p12 * q2[1]),
-          wg * (p11 * q1[2] + p12 * q2[2]), wg * (p11 * q1[3] + p12 * q2[3]))
-    fy = (wg * (p21 * q1[0] + p22 * q2[0]), wg * (p21 * q1[1] + p22 * q2[1]),
-          wg * (p21 * q1[2] + p22 * q2[2]), wg * (p21 * q1[3] + p22 * q2[3]))
+    fx, fy = point_corner_forces(wg, p11, p12, p21, p22, q1, q2)
     return (res[tid, atq(R_BAD, q)], wg * w_pt, c_pt, c_s, k_w, k_f, wg * a, wg * b, wg * c12,
             fx, fy)
 
@@ -497,43 +498,28 @@ def element_tail(tid, bu, lu, old, out_el, out_blk, inert, dt, px, py, pz, vx_, 
     b1, b2 = frame[5]
     vx, vy, vz, tx, ty, dkx, dky, dkxy2, dgxz, dgyz = rates
     # 4. bending and transverse shear (shell.bending_and_shear, resultant section)
-    m_old0 = old[tid, at(V_M, lu)]
-    m_old1 = old[tid, at(V_M + 1, lu)]
-    m_old2 = old[tid, at(V_M + 2, lu)]
-    q_old0 = old[tid, at(V_Q, lu)]
-    q_old1 = old[tid, at(V_Q + 1, lu)]
-    d_b = e_b * thick * thick * thick / (12.0 * (1.0 - nu_b * nu_b))
-    mxx = m_old0 + d_b * (dkx + nu_b * dky)
-    myy = m_old1 + d_b * (dky + nu_b * dkx)
-    mxy = m_old2 + d_b * 0.5 * (1.0 - nu_b) * dkxy2
-    w_bend = 1.0
-    qx = q_old0 + kgt * dgxz
-    qy = q_old1 + kgt * dgyz
+    m_old = (old[tid, at(V_M, lu)], old[tid, at(V_M + 1, lu)], old[tid, at(V_M + 2, lu)])
+    q_old = (old[tid, at(V_Q, lu)], old[tid, at(V_Q + 1, lu)])
+    dk = (dkx, dky, dkxy2)
+    dg = (dgxz, dgyz)
+    d_b = plate_stiffness(e_b, thick, nu_b)
+    mxx, myy, mxy = plate_moments(m_old, d_b, nu_b, dk)
+    qx, qy = shear_forces(q_old, kgt, dg)
     out_el[tid, at(E_M, lu)] = mxx
     out_el[tid, at(E_M + 1, lu)] = myy
     out_el[tid, at(E_M + 2, lu)] = mxy
     out_el[tid, at(E_Q, lu)] = qx
     out_el[tid, at(E_Q + 1, lu)] = qy
-    out_el[tid, at(E_U_BEND, lu)] = old[tid, at(V_U_BEND, lu)] + area * (
-        w_bend * (0.5 * (m_old0 + mxx) * dkx + 0.5 * (m_old1 + myy) * dky
-                  + 0.5 * (m_old2 + mxy) * dkxy2)
-        + 0.5 * (q_old0 + qx) * dgxz + 0.5 * (q_old1 + qy) * dgyz
-    )
+    out_el[tid, at(E_U_BEND, lu)] = old[tid, at(V_U_BEND, lu)] + bending_work(
+        area, 1.0, m_old, (mxx, myy, mxy), q_old, (qx, qy), dk, dg)
     # 5. hourglass (shell.hourglass_resultants)
     gam, bb = hourglass_vectors(lx, ly, b1, b2)
     gam_mid = hourglass_vectors(mid[3][0], mid[3][1], mid[5][0], mid[5][1])[0]
-    k_m = 0.0 if full else r_hg * c_memb * area * bb
-    k_wm = r_hg * 16.0 * d_b * bb
-    k_t = r_hg * d_b * area * bb
-    hg0, e_hg = hourglass_mode(old[tid, at(V_HG, lu)], k_m, gam_mid, vx, dt)
-    hg1, de = hourglass_mode(old[tid, at(V_HG + 1, lu)], k_m, gam_mid, vy, dt)
-    e_hg += de
-    hg2, de = hourglass_mode(old[tid, at(V_HG + 2, lu)], k_wm, gam_mid, vz, dt)
-    e_hg += de
-    hg3, de = hourglass_mode(old[tid, at(V_HG + 3, lu)], k_t, gam_mid, tx, dt)
-    e_hg += de
-    hg4, de = hourglass_mode(old[tid, at(V_HG + 4, lu)], k_t, gam_mid, ty, dt)
-    e_hg += de
+    k_m, k_wm, k_t = hourglass_stiffnesses(r_hg, c_memb, area, bb, d_b, full)
+    (hg0, hg1, hg2, hg3, hg4), e_hg = hourglass_update(
+        (old[tid, at(V_HG, lu)], old[tid, at(V_HG + 1, lu)], old[tid, at(V_HG + 2, lu)],
+         old[tid, at(V_HG + 3, lu)], old[tid, at(V_HG + 4, lu)]), k_m, k_wm, k_t, gam_mid,
+        (vx, vy, vz, tx, ty), dt)
     out_el[tid, at(E_HG, lu)] = hg0
     out_el[tid, at(E_HG + 1, lu)] = hg1
     out_el[tid, at(E_HG + 2, lu)] = hg2

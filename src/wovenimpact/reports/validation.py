@@ -23,6 +23,7 @@ from wovenimpact.errors import InputError
 from wovenimpact.io.atomic import atomic_write_text
 from wovenimpact.io.report import write_index
 from wovenimpact.reports.mesh_validation import RING_STUDIES, ring_section
+from wovenimpact.reports.contact_validation import smith_strip_lines
 from wovenimpact.reports.metal_validation import metal_section
 from wovenimpact.reports.strip_validation import STUDY as STRIP_STUDY
 from wovenimpact.reports.strip_validation import strip_section
@@ -438,6 +439,7 @@ def run_validation(work: str | Path, report: str | Path = ROOT / "docs" / "valid
         lines.append("")
     lines += ["## Commentary", "", *commentary(cases, convergence),
               *study_commentary(study_rows)]
+    lines += smith_strip_lines(work, figures, log=log)  # the impactor's contact (§6.2)
     lines += metal_section(work, figures, log=log)  # issue 10: metal shells
     atomic_write_text(report, "\n".join(lines) + "\n")
     write_index(work, "wovenimpact validate: every run and study")  # WORK/report.html

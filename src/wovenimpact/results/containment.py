@@ -139,7 +139,7 @@ def fragment_row(model, state, watch: CasingWatch | None = None) -> dict:
     """
     w = CasingWatch(model) if watch is None else watch
     k = _path_window(model, state, w)
-    x, cm, r_nodes, v_cm = k["x"], k["cm"], k["r_nodes"], k["v_cm"]
+    cm, r_nodes, v_cm = k["cm"], k["r_nodes"], k["v_cm"]
     r_cm = math.hypot(cm[0], cm[1])
     radial = (v_cm[0] * cm[0] + v_cm[1] * cm[1]) / r_cm if r_cm > 0 else 0.0
     outside = bool(np.any(k["r_window"] > float(r_nodes.max())))

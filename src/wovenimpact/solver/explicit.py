@@ -42,7 +42,6 @@ from wovenimpact.kernels.bundles import (
     NodeModel,
     ShellMesh,
 )
-from wovenimpact.kernels.gather import gather_nodal_forces
 from wovenimpact.kernels.integrate import force_pair_power, gather_and_update, smooth_step
 from wovenimpact.kernels.mass_scaling import node_masses, scale_element_masses, scaled_node_masses
 from wovenimpact.solver.contact_stage import (
@@ -196,16 +195,6 @@ def shell_forces(model, state: State, ws: Workspace) -> None:
             f"{state.step}: {STATUS_TEXT.get(int(ws.status[e]), 'unknown failure')}"
             + (f"; {bad.size} elements in this state" if bad.size > 1 else "")
         )
-
-
-def element_forces(model, state: State, ws: Workspace) -> None:
-    """Stages 1–2: element forces at x^n and their nodal sums (into ws)."""
-    t0 = time.perf_counter()
-    shell_forces(model, state, ws)
-    t0 = ws.tick("shell forces", t0)
-    gather_nodal_forces(model.node_ptr, model.node_elem, model.node_corner, ws.blocks, ws.alive,
-                        ws.f_int, ws.live)
-    ws.tick("gather", t0)
 
 
 def scale_masses(model, state: State, ws: Workspace) -> None:

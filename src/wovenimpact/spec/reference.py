@@ -28,7 +28,7 @@ from pydantic.fields import FieldInfo
 from pydantic_core import PydanticUndefined
 
 from wovenimpact.spec import case, material
-from wovenimpact.spec.fields import Valid, _ToSI
+from wovenimpact.spec.fields import _ToSI
 from wovenimpact.units import DIMENSIONS, bounds_text
 
 HEADER = """\

@@ -9,18 +9,11 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from wovenimpact.io.atomic import atomic_path  # noqa: E402
+from wovenimpact.io.atomic import save_png  # noqa: E402
 from wovenimpact.io.history import read_csv  # noqa: E402
 
 # the history column overlaid across variants, first one present wins
 HISTORY_PREFERENCE = ("impactor_velocity_m_per_s", "structure_kinetic_energy_part_J")
-
-
-def _save(fig, path: Path) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=120, format="png")
-    plt.close(fig)
 
 
 def study_plots(info, variants, rows, out: Path) -> list[Path]:
@@ -46,7 +39,7 @@ def study_plots(info, variants, rows, out: Path) -> list[Path]:
         ax.grid(alpha=0.3)
         fig.tight_layout()
         path = out / "plots" / f"{metric}.png"
-        _save(fig, path)
+        save_png(fig, path)
         written.append(path)
     fig, ax = plt.subplots(figsize=(7, 4.2))
     column = None
@@ -66,7 +59,7 @@ def study_plots(info, variants, rows, out: Path) -> list[Path]:
         ax.legend(fontsize=7)
         fig.tight_layout()
         path = out / "plots" / f"{column}_histories.png"
-        _save(fig, path)
+        save_png(fig, path)
         written.append(path)
     else:
         plt.close(fig)

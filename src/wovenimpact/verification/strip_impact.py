@@ -25,7 +25,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 from scipy.optimize import brentq
@@ -194,45 +193,3 @@ def strip_impact(problem: StripImpact | None = None) -> dict:
                     "stray_m": np.array(stray)},
     }
 
-
-def strip_impact_figure(result: dict, path: Path, title: str = "") -> Path:
-    """Contact force and kink position against time, with Smith's theory drawn over."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from wovenimpact.io.atomic import atomic_path
-
-    h = result["history"]
-    th = result["theory"]
-    t_us = h["time_s"] * 1e6
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(10, 4))
-    a1.plot(t_us, h["contact_force_N"], lw=0.8, label="wovenimpact")
-    a1.axhline(th["force_N"], color="k", ls="--", label="Smith et al. (1958)")
-    peak = float(np.max(h["contact_force_N"]))
-    if peak > 3.0 * th["force_N"]:  # the pick-up of the struck material, one step long
-        a1.set_ylim(-0.5 * th["force_N"], 3.0 * th["force_N"])
-        a1.text(0.98, 0.95, f"first contact: {peak / 1e3:.0f} kN (off scale), the\nstruck "
-                "material picked up", transform=a1.transAxes, ha="right", va="top",
-                fontsize=8)
-    a1.set_xlabel("time (µs)")
-    a1.set_ylabel("force on the face (N)")
-    a1.legend()
-    a1.grid(alpha=0.3)
-    t0 = result["first_contact_s"] or 0.0
-    a2.plot(t_us, h["kink_position_m"] * 1e3, lw=0.8, label="wovenimpact (half deflection)")
-    tt = np.linspace(t0, h["time_s"][-1], 50)
-    a2.plot(tt * 1e6, (result["contact_half_width_m"] + 0.5 * th["kink_speed"] * (tt - t0)) * 1e3,
-            "k--", label="a + U t / 2 (theory)")
-    a2.set_xlabel("time (µs)")
-    a2.set_ylabel("position (mm)")
-    a2.legend()
-    a2.grid(alpha=0.3)
-    fig.suptitle(title or "flat face on an elastic strip")
-    fig.tight_layout()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_path(path) as tmp:
-        fig.savefig(tmp, dpi=120, format="png")
-    plt.close(fig)
-    return path

@@ -45,6 +45,29 @@ def test_a_strip_without_its_dip_fractures_everywhere_at_the_table_s_strain():
     assert r.kinetic_fraction < 0.01 and r.energy_error < 1e-4
 
 
+
+def test_a_plane_strain_strip_fractures_at_the_johnson_cook_strain_of_its_triaxiality():
+    """2024-T3, no dip, long edges held across (ε_yy = 0), 2 mm elements: every element
+    reaches the Johnson–Cook strain of plane-strain tension, η = 1/√3, ε_f = d1 + d2
+    exp(d3/√3) = 0.1847 (0.209 at η = 1/3), in one step. With σ_yy = σ_xx/2 (J2, plastic
+    incompressibility) ε̄p = (2/√3) ε_xx^p and σ_xx = 2σ_f/√3, so the end has moved L(e^ε −
+    1), ε = (√3/2) ε_f + σ_xx (1 − ν/2)/E; within 1 % (the closed form neglects the elastic
+    part of ε_yy, which is not quite σ_xx/2 at σ_f/E ≈ 0.8 %)."""
+    import numpy as np
+
+    mat = load_material(MATERIALS / "al2024t3_johnson_cook.toml")
+    r = run_coupon(Coupon(mat, reduction=0.0, plane_strain=True), 2e-3)
+    d1, d2, d3 = mat.damage.d[:3]
+    eps_f = d1 + d2 * math.exp(d3 / math.sqrt(3.0))
+    table = np.array(mat.hardening)
+    sig_f = float(np.interp(eps_f, table[:, 0], table[:, 1]))
+    strain = (math.sqrt(3.0) / 2.0 * eps_f
+              + 2.0 * sig_f / math.sqrt(3.0) * (1.0 - 0.5 * mat.poisson) / mat.modulus)
+    expected = 32e-3 * (math.exp(strain) - 1.0)
+    assert r.onset_elongation == r.elongation_at_fracture
+    assert r.elongation_at_fracture == pytest.approx(expected, rel=0.01)
+    assert r.energy_error < 1e-4
+
 def test_the_shipped_2024_t3_table_brings_two_meshes_to_one_elongation_at_fracture():
     """Without the table the 4 mm coupon fractures 3.2 % later than the 2 mm one (theory
     §7.3: +7.4 % and +4.1 % over the 0.25 mm reference): more than X = 2 %. With the

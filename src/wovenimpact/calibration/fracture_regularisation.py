@@ -83,6 +83,9 @@ class Coupon:
         speed: V, the pulled end's speed (m/s).
         points: Simpson points through the thickness.
         quasi_static_rate: drop the Johnson–Cook rate factors (module docstring).
+        plane_strain: hold the long edges across the pull (ε_yy = 0): the plane-strain
+            tension test, the stress state of a sheet stretched over a long edge
+            (stress triaxiality 1/√3 instead of 1/3).
     """
 
     material: MetalParameters
@@ -94,6 +97,7 @@ class Coupon:
     speed: float = 10.0
     points: int = 5
     quasi_static_rate: bool = True
+    plane_strain: bool = False
 
     @property
     def length_m(self) -> float:
@@ -134,7 +138,8 @@ class Coupon:
         return w
 
     def mesh(self, element_size: float):
-        """Nodes, quads and the end node sets (held, pulled) of a structured mesh."""
+        """Nodes, quads, the end node sets (held, pulled) and the long edges' nodes of a
+        structured mesh."""
         nx, ny = self.check_size(element_size)
         half_l = 0.5 * self.length_m
         xs = np.linspace(-half_l, half_l, nx + 1)
@@ -144,7 +149,8 @@ class Coupon:
         idx = np.arange(gx.size).reshape(nx + 1, ny + 1)
         quads = np.stack([idx[:-1, :-1].ravel(), idx[1:, :-1].ravel(), idx[1:, 1:].ravel(),
                           idx[:-1, 1:].ravel()], axis=1)
-        return nodes, quads, idx[0].copy(), idx[-1].copy()
+        return nodes, quads, idx[0].copy(), idx[-1].copy(), np.concatenate([idx[:, 0],
+                                                                           idx[:, -1]])
 
     def material_for(self, regularisation: FractureRegularisation | None) -> MetalParameters:
         """The coupon's material: the quasi-static rate (if asked) and ``regularisation``
@@ -160,11 +166,12 @@ class Coupon:
     def model(self, element_size: float,
               regularisation: FractureRegularisation | None = None):
         """The model, its pulled nodes and the initial velocity field."""
-        nodes, quads, held, pulled = self.mesh(element_size)
+        nodes, quads, held, pulled, edges = self.mesh(element_size)
         bc = BoundaryConditions(len(nodes))
         bc.fix(held, (0, 2, 3, 4, 5))
         bc.fix(pulled, (2, 3, 4, 5))
-        bc.fix([held[len(held) // 2], pulled[len(pulled) // 2]], (1,))
+        bc.fix(edges if self.plane_strain else [held[len(held) // 2], pulled[len(pulled) // 2]],
+               (1,))
         bc.prescribe(pulled, 0, self.speed)
         sec = Section(self.material_for(regularisation), thickness=self.thickness,
                       points=self.points)

@@ -27,7 +27,7 @@ import time
 import numba
 import numpy as np
 
-from wovenimpact.contact import ShellContact
+from wovenimpact.solver.shell_contact import ShellContact
 from wovenimpact.interfaces import empty_books, part_arrays
 from wovenimpact.jit import set_threads
 from wovenimpact.materials.metal import MetalParameters

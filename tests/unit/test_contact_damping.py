@@ -17,7 +17,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from wovenimpact.contact import ShellContact
+from wovenimpact.solver.shell_contact import ShellContact
 from wovenimpact.errors import InputError
 from wovenimpact.kernels.contact_energy import DAMPING, FRICTION, N_KINDS, SPRING
 from wovenimpact.materials.metal import MetalParameters
@@ -233,7 +233,7 @@ def test_the_serial_and_parallel_books_agree_bitwise(monkeypatch):
     are few and in parallel (then a serial sum) when they are many: the same powers
     summed in the same order, so the books are bitwise equal, for any thread count
     (three plies pressed together under a dome and sliding, friction on)."""
-    import wovenimpact.contact as contact_module
+    import wovenimpact.solver.shell_contact as contact_module
     from wovenimpact.model.mesh import plate_mesh
 
     mesh = plate_mesh(20e-3, 1e-3, plies=3, spacing=0.5e-3, quarter=True)

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import example, given, settings
 from hypothesis import strategies as st
 
-from wovenimpact.contact import ShellContact, node_plies
+from wovenimpact.solver.shell_contact import ShellContact, node_plies
 from wovenimpact.jit import set_threads
 from wovenimpact.kernels import shell_layout as SL
 from wovenimpact.kernels.bundles import (

@@ -71,7 +71,7 @@ class ContactBuffers:
         p = model.shell_contact
         n_surfaces = np.unique(model.ply).size + solid_body_count(model)
         if p.enabled and (n_surfaces > 1 or p.self_contact):
-            from wovenimpact.contact import ShellContact
+            from wovenimpact.solver.shell_contact import ShellContact
 
             shells = ShellContact(model, beta=p.beta, damping=p.damping, friction=p.friction,
                                   damping_mode=p.damping_mode, self_contact=p.self_contact)

@@ -99,3 +99,27 @@ def test_v50_of_a_containment_study_says_which_fit_it_takes(tmp_path):
     text = " ".join(result.output.split())
     assert result.exit_code == 2
     assert "a containment study" in text and "wovenimpact ballistics plies" in text
+
+
+def test_v50_of_one_mesh_of_a_study_over_meshes_and_velocities(tmp_path):
+    """A ladder run on two meshes in one results.csv: ``--where`` keeps one mesh's rows
+    ('1mm' matches the cell '1 mm'); each mesh gives its own V50 (110 and 90 m/s); an
+    unknown value is refused, naming the values the column holds."""
+    vs = np.array([80.0, 100.0, 120.0, 150.0, 200.0, 300.0])
+    lines = ["id,mesh.element_size,impactor.velocity,status,error,outcome,"
+             "residual_velocity_m_per_s"]
+    for mesh, limit in (("1 mm", 110.0), ("0.5 mm", 90.0)):
+        for i, v in enumerate(vs):
+            r = max(v**2 - limit**2, 0.0) ** 0.5
+            lines.append(f"{mesh}{i},{mesh},{v} m/s,done,,"
+                         f"{'perforated' if r > 0 else 'stopped'},{r}")
+    (tmp_path / "r.csv").write_text("\n".join(lines) + "\n")
+    for value, limit in (("1mm", 110.0), ("0.5 mm", 90.0)):
+        result = CliRunner().invoke(app, ["ballistics", "v50", str(tmp_path / "r.csv"),
+                                          "--where", f"mesh.element_size={value}", "--json"])
+        assert result.exit_code == 0, result.output
+        assert abs(json.loads(result.stdout)["v50_m_per_s"] - limit) < 0.1
+        assert json.loads(result.stdout)["runs"] == len(vs)
+    result = CliRunner().invoke(app, ["ballistics", "v50", str(tmp_path / "r.csv"),
+                                      "--where", "mesh.element_size=2 mm"])
+    assert result.exit_code != 0 and "0.5 mm" in result.output and "1 mm" in result.output

@@ -47,17 +47,39 @@ def _column(rows, key: str, results: Path) -> list[str]:
     return [r[key] for r in rows]
 
 
+def rows_where(rows: list[dict], where, results: Path) -> list[dict]:
+    """The rows that match every condition of ``where`` ("COLUMN=VALUE": the cell's text
+    as results.csv holds it, spaces ignored, so '1mm' matches '1 mm')."""
+    for cond in where:
+        column, sep, value = cond.partition("=")
+        if not sep:
+            raise InputError(f"--where {cond!r}: give COLUMN=VALUE, e.g. "
+                             "'contact.damping=0.3'")
+        cells = _column(rows, column.strip(), results)
+        kept = [r for r, c in zip(rows, cells) if c.replace(" ", "") == value.replace(" ", "")]
+        if not kept:
+            raise InputError(f"--where {cond!r}: no finished run has it; the column holds "
+                             f"{sorted(set(cells))}")
+        rows = kept
+    return rows
+
+
+WHERE_HELP = ("Keep the runs whose COLUMN has VALUE (repeatable), e.g. a study over meshes "
+              "and velocities: --where 'mesh.element_size=0.5 mm'.")
+
+
 @ballistics_app.command("v50")
 def v50(
     results: Path = typer.Argument(..., help="results.csv of a velocity sweep."),
     key: str = typer.Option("impactor.velocity", help="Parameter column of the striking velocity."),
+    where: list[str] = typer.Option([], "--where", help=WHERE_HELP),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),
 ) -> None:
     """Lambert–Jonas fit V_r = a (V_s^p − V50^p)^(1/p) of residual against striking velocity."""
     from wovenimpact.studies.ballistics import lambert_jonas_fit, require_decided
 
     try:
-        rows = _rows(results)
+        rows = rows_where(_rows(results), where, results)
         if EXIT in rows[0] and RESIDUAL not in rows[0]:
             raise InputError(
                 f"{results}: a containment study (its runs have {EXIT}, no impactor "

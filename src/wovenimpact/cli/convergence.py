@@ -26,23 +26,13 @@ def study_triples(results: Path, metrics: list[str], key: str,
     """Per metric, the triples of :func:`studies.convergence.mesh_convergence` over the
     finished rows of ``results`` that match every ``where`` ("column=value", the cell's
     text as results.csv holds it), one row per element size in column ``key``."""
-    from wovenimpact.cli.ballistics import _column, finished_rows
+    from wovenimpact.cli.ballistics import _column, finished_rows, rows_where
     from wovenimpact.studies.convergence import mesh_convergence
 
     rows = finished_rows(results)
     if not rows:
         raise InputError(f"{results}: no finished runs")
-    for cond in where:
-        column, sep, value = cond.partition("=")
-        if not sep:
-            raise InputError(f"--where {cond!r}: give COLUMN=VALUE, e.g. "
-                             "'contact.damping=0.3'")
-        cells = _column(rows, column.strip(), results)
-        kept = [r for r, c in zip(rows, cells) if c.strip() == value.strip()]
-        if not kept:
-            raise InputError(f"--where {cond!r}: no finished run has it; the column holds "
-                             f"{sorted(set(cells))}")
-        rows = kept
+    rows = rows_where(rows, where, results)
     sizes = [_size(v, key) for v in _column(rows, key, results)]
     out = {}
     for metric in metrics:

@@ -26,11 +26,29 @@ def validate(
     runs: list[Path] = typer.Option(None, "--runs", help="With --containment: tabulate these "
                                     "finished containment runs (a run's folder or a folder of "
                                     "runs; repeatable) instead of running the ladders."),
+    crossover: bool = typer.Option(False, "--crossover", help="Instead: the 3-D crossover "
+                                   "cell's virtual tests on three meshes (thesis ch. 5; minutes), "
+                                   "report docs/validation_crossover.md."),
 ) -> None:
     """Run (or resume) the example cases and thesis studies; write the validation report."""
     from wovenimpact.io.outdir import check_output_file, prepare_output_dir, write_failure
     from wovenimpact.reports.validation import ON_REQUEST, ROOT, STUDIES, run_validation
 
+    if crossover:
+        from wovenimpact.reports.crossover_validation import crossover_page
+
+        report = report or ROOT / "docs" / "validation_crossover.md"
+        try:
+            prepare_output_dir(work, "--work")
+            check_output_file(report, "--report")
+            path = crossover_page(work, report, log=lambda m: console.print(
+                f"[dim]{time.strftime('%H:%M:%S')}[/] {m}"))
+        except InputError as err:
+            fail(str(err))
+        except OSError as err:
+            fail(write_failure(err, "the crossover cell's runs or page"))
+        console.print(f"crossover validation page: {path}")
+        return
     if containment:
         _containment(work, report or ROOT / "docs" / "validation_containment.md", workers,
                      tuple(overrides or ()), tuple(runs or ()))

@@ -34,3 +34,18 @@ def test_the_v50_mesh_line_judges_the_spread_against_five_percent():
     assert "spread 15.4%" in bad and "not met" in bad
     none = v50_mesh_line({"1 mm": 75.0, "0.5 mm": None}, "0.5 mm")
     assert "75.0 / —" in none and "not every ladder brackets" in none
+
+
+def test_the_jones_figure_is_drawn_from_histories(tmp_path):
+    """jones_figure draws each mesh's deflection history over Jones's band into a PNG."""
+    import numpy as np
+
+    from wovenimpact.verification.jones_plate import jones_figure
+
+    t = np.linspace(0.0, 4e-4, 50)
+    results = [{"time_s": t, "deflection_m": 1e-3 * n / 8 * np.sin(t / 4e-4),
+                "thickness_m": 1e-3, "elements_per_half_side": n, "permanent_over_H": n / 8,
+                "lambda": 145.0, "jones_mode_over_H": 4.0, "jones_impulse_over_H": 11.0}
+               for n in (8, 16)]
+    path = jones_figure(results, tmp_path / "jones.png")
+    assert path.read_bytes()[:4] == b"\x89PNG"

@@ -249,12 +249,11 @@ def _figures(out: Path, compression, extension, biaxial, shell: dict[str, dict])
 
 def _save(fig, ax, xlabel: str, ylabel: str, path: Path) -> None:
     """Axis labels, grid and legend; written to ``path`` and closed."""
-    import matplotlib.pyplot as plt
+    from wovenimpact.io.atomic import save_png
 
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_png(fig, path, dpi=110)

@@ -11,15 +11,12 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 from wovenimpact.calibration.single_element import SHEAR_TESTS, ElementTestResult  # noqa: E402
+from wovenimpact.io.atomic import save_png  # noqa: E402
 
 
 def _save(fig, path: Path) -> Path:
     fig.tight_layout()
-    tmp = path.with_name(path.stem + ".tmp" + path.suffix)
-    fig.savefig(tmp, dpi=120)
-    plt.close(fig)
-    tmp.replace(path)
-    return path
+    return save_png(fig, path)
 
 
 def plot_element_test(result: ElementTestResult, out_dir: Path) -> list[Path]:

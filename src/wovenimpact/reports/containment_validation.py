@@ -185,7 +185,8 @@ def exit_speed_figure(rows, thesis: dict, title: str, unit: str, path: Path, reg
     the regression curve."""
     import numpy as np
 
-    from wovenimpact.io.plots import plt, _save
+    from wovenimpact.io.atomic import save_png as _save
+    from wovenimpact.io.plots import plt
 
     fig, ax = plt.subplots(figsize=(7, 4))
     done = [r for r in rows if r.get("status") == "done"

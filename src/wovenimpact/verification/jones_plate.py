@@ -161,7 +161,8 @@ def jones_study(elements=(8, 16, 32), out: str | Path | None = None, **kwargs) -
 
 def jones_figure(results: list[dict], path: str | Path) -> Path:
     """Mid-point deflection / H against time for each mesh and Jones's two limits."""
-    from wovenimpact.io.plots import _save, plt
+    from wovenimpact.io.atomic import save_png as _save
+    from wovenimpact.io.plots import plt
 
     path = Path(path)
     fig, ax = plt.subplots(figsize=(7.0, 4.2))

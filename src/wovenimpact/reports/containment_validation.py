@@ -278,10 +278,11 @@ def intro_lines() -> list[str]:
             "face-on against 129.90 with the default blade, 7 mm ring, both by the default "
             "stable step) and the hybrid "
             "casing's inner aluminium shell (ours 1 mm).", "",
-            "Mesh: the energy a casing absorbs is not yet mesh-converged (docs/theory.md "
-            "§8.8: yarn and aluminium failure have no element-size regularisation, and a "
-            "finer mesh absorbs less), so the layers a coarse ladder needs to contain are "
-            "likely too few.", ""]
+            "Mesh: the answers are not mesh-converged (docs/theory.md §8.8). They follow "
+            "the element's edge along the casing's axis, where the casing bends over a "
+            "length of about √(R t): on the 10-ply ring 3 mm instead of 7 mm along the axis "
+            "raises the exit speed 13 % (on four plies 3.4 %), and a finer mesh absorbs "
+            "less, so the layers a 7 mm ladder needs to contain are too few.", ""]
 
 
 def runs_lines(ladders: dict[str, list[dict]], unfinished: list[str]) -> list[str]:

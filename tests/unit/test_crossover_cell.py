@@ -173,3 +173,107 @@ def test_a_case_builds_the_cell_and_steps_it():
         step(model, st, ws)
     eb = energy_balance(model, st)
     assert eb["internal_work_J"] > 0.0 and eb["error_fraction"] < 1e-3
+
+
+def repeat_cell(**changes):
+    """The 2 × 2 plain-weave repeat of the thesis's geometry (Table 5-1)."""
+    d = doc(warp={"h0": "0.12495 mm", "thickness": "0.2499 mm", "width": "0.9407 mm"},
+            cell={"repeat": 2}, **changes)
+    return crossover_cell(geometry_from_dict(d))
+
+
+def test_the_repeat_has_four_yarns_of_twice_the_single_cells_volume():
+    """The 2 × 2 repeat is 4ℓ square, as thick as the single cell; each of its four yarns
+    has 2 × along elements and the volume of two single-cell yarns (4ℓ times the polygonal
+    section, to round-off), so the yarns' volume fraction is the single cell's; every
+    element has a positive volume and orthonormal right-handed axes."""
+    one = crossover_cell(geometry_from_dict(doc(
+        warp={"h0": "0.12495 mm", "thickness": "0.2499 mm", "width": "0.9407 mm"})))
+    cell = repeat_cell()
+    assert cell.repeat == 2 and cell.yarn_names == ("warp0", "warp1", "fill0", "fill1")
+    assert cell.size == pytest.approx((2 * one.size[0], 2 * one.size[1]), rel=1e-15)
+    assert cell.thickness == pytest.approx(one.thickness, rel=1e-12)
+    v, v1 = volumes(cell), volumes(one)
+    assert (v > 0.0).all()
+    single = v1[one.mesh.hex_sets["warp"]].sum()
+    for name in cell.yarn_names:
+        assert len(cell.mesh.hex_sets[name]) == 2 * 8 * 4 * 2
+        assert v[cell.mesh.hex_sets[name]].sum() == pytest.approx(2 * single, rel=1e-12)
+    f = cell.frames
+    np.testing.assert_allclose(np.einsum("nij,nkj->nik", f, f),
+                               np.broadcast_to(np.eye(3), f.shape), atol=1e-15)
+    assert (np.linalg.det(f) > 0).all()
+
+
+def test_the_repeat_is_a_periodic_plain_weave():
+    """Each yarn's x_max (y_max) end face is its x_min (y_min) face shifted by 4ℓ: the
+    repeat continues itself. Warp 0 passes over fill 0 and under fill 1, warp 1 the other
+    way (the centrelines' heights at the four crossings), and each yarn's material axis
+    follows its own centreline's slope."""
+    cell = repeat_cell()
+    nodes, sets = cell.mesh.nodes, cell.mesh.node_sets
+    L = cell.size[0]
+    for name in cell.yarn_names:
+        axis, (lo, hi) = (0, ("x_min", "x_max")) if name.startswith("warp") else (1, ("y_min", "y_max"))
+        shift = np.zeros(3)
+        shift[axis] = L
+        np.testing.assert_allclose(nodes[sets[f"{name}.{hi}"]], nodes[sets[f"{name}.{lo}"]] + shift,
+                                   atol=1e-15)
+    ell = 0.25 * L
+    mid = {n: nodes[sets[n]] for n in cell.yarn_names}
+    for j, name in enumerate(("warp0", "warp1")):
+        x = mid[name]
+        for i, xc in enumerate((-ell, ell)):
+            near = np.abs(x[:, 0] - xc) < 1e-12
+            z = x[near, 2].mean()  # the centreline's height at the crossing
+            over = (i == j)  # warp0 over fill0, warp1 over fill1
+            assert (z > 0.1e-3) if over else (z < -0.1e-3)
+    for name in cell.yarn_names:
+        idx = cell.mesh.hex_sets[name]
+        axis = 0 if name.startswith("warp") else 1
+        centre = nodes[cell.mesh.hexes[idx]].mean(axis=1)
+        # a1's slope has the sign of dz/ds of the centreline, which changes at the crossings
+        slope = cell.frames[idx, 0, 2] / cell.frames[idx, 0, axis]
+        sign = {"warp0": 1.0, "warp1": -1.0, "fill0": -1.0, "fill1": 1.0}[name]
+        expect = -sign * np.sin(0.5 * np.pi * (centre[:, axis] + ell) / ell)
+        assert (np.sign(slope) == np.sign(expect)).all()
+
+
+def test_the_repeat_yarns_meet_at_every_crossing_without_overlapping():
+    """At each of the four crossings the upper yarn's lower surface lies on the lower
+    yarn's upper surface (to round-off: the thesis's zero gap), never inside it; the
+    parallel yarns stand apart by the pitch less their trimmed width, (1 − u_t) W."""
+    cell = repeat_cell()
+    nodes, sets = cell.mesh.nodes, cell.mesh.node_sets
+    w = cell.yarns["warp"]
+    ell = w.half_length
+    ut = trimmed_extent("lenticular", 0.2)
+    worst = []
+    for j, wname in enumerate(("warp0", "warp1")):
+        for i, fname in enumerate(("fill0", "fill1")):
+            xc, yc = (2 * i - 1) * ell, (2 * j - 1) * ell
+            warp_over = i == j
+            upper, lower = (wname, fname) if warp_over else (fname, wname)
+            p = nodes[sets[f"{upper}.bottom"]]
+            # the lower yarn's upper surface at the upper yarn's bottom nodes above it
+            if lower.startswith("fill"):
+                across, along, sign = p[:, 0] - xc, p[:, 1], (-1.0 if i == 0 else 1.0)
+            else:
+                across, along, sign = p[:, 1] - yc, p[:, 0], (1.0 if j == 0 else -1.0)
+            u = across / (0.5 * w.width)
+            above = (np.abs(u) <= ut) & (np.abs(along - (xc if lower.startswith("warp") else yc)) <= ell)
+            z_low = (sign * w.amplitude * np.cos(0.5 * np.pi * (along + ell) / ell)
+                     + 0.5 * w.thickness * section_profile("lenticular", u))
+            gap = p[above, 2] - z_low[above]
+            assert above.sum() > 10
+            worst.append(gap.min())
+            assert gap.max() < 2e-8
+    assert min(worst) > -1e-15
+    y0 = nodes[sets["warp0"], 1].max()
+    y1 = nodes[sets["warp1"], 1].min()
+    assert y1 - y0 == pytest.approx((1.0 - ut) * w.width + (2 * ell - w.width), rel=1e-9)
+
+
+def test_a_repeat_other_than_one_or_two_is_refused_naming_the_key():
+    with pytest.raises(InputError, match="cell.repeat"):
+        crossover_cell(geometry_from_dict(doc(cell={"repeat": 3})))

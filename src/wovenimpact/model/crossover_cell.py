@@ -25,6 +25,24 @@ the warp's lower surface h_w cos(πx/2ℓ_w) − h_f cos(πy/2ℓ_f) is the fill
 the yarns meet over the whole cell without overlapping (zero gap). Other values are checked
 for overlap on a fine grid (:func:`yarn_clearance`) and refused when the yarns overlap.
 Each yarn has its own nodes (their contact is not a shared node).
+
+*The 2 × 2 repeat* (``[cell] repeat = 2``): the plain weave's periodic unit of two warp
+yarns and two fill yarns, [−2ℓ_w, 2ℓ_w] × [−2ℓ_f, 2ℓ_f] — what an in-plane shear test
+needs, a yarn with a parallel neighbour to jam against (calibration/cell_shear.py). Warp j
+(j = 0, 1) lies along y = (2j − 1) ℓ_f, fill i along x = (2i − 1) ℓ_w, and
+
+  z_warp j = σ_j h_w cos(π (x + ℓ_w) / 2ℓ_w),  σ_j = +1, −1,
+  z_fill i = −σ_i h_f cos(π (y + ℓ_f) / 2ℓ_f),
+
+so warp 0 passes over fill 0 and under fill 1, warp 1 under fill 0 and over fill 1, every
+yarn's end faces lie at its inflection points (z = 0, as the single cell's) and the
+repeat is periodic: a copy shifted by 4ℓ along either axis continues every centreline.
+Each quarter of the repeat is the one-crossover cell, shifted, and mirrored in z where
+the fill is on top; the clearance of the crossing yarns is therefore the single cell's
+(:func:`yarn_clearance`), and parallel yarns, each within its pitch (width + gap ≤ pitch),
+do not overlap. Each yarn has its own nodes, hexahedron set ("warp0", "warp1", "fill0",
+"fill1", besides "warp" and "fill") and end faces. ``[mesh] along`` counts the elements
+over 2ℓ (one crossing), so a yarn of the repeat has 2 × along.
 """
 
 from __future__ import annotations
@@ -40,6 +58,7 @@ from wovenimpact.materials.crimp import crimp_amplitude, crimp_of_amplitude
 from wovenimpact.model.mesh import Mesh
 
 FAMILIES = ("warp", "fill")
+REPEATS = (1, 2)  # crossings along each yarn: the single crossover, the 2 × 2 plain weave
 CLEARANCE_GRID = 201  # points per direction of the overlap check
 OVERLAP_TOLERANCE = 1e-9  # of the yarn thickness: round-off of surfaces that coincide
 
@@ -70,11 +89,16 @@ class CrossoverCell:
         mesh: nodes, hexahedra (``Mesh.hexes``; the warp's first) and sets: hexahedron
             sets "warp", "fill"; node sets "all", "warp", "fill", each yarn's end faces
             ("warp.x_min", "warp.x_max", "fill.y_min", "fill.y_max") and its upper and
-            lower surfaces ("warp.top", "warp.bottom", "fill.top", "fill.bottom").
+            lower surfaces ("warp.top", "warp.bottom", "fill.top", "fill.bottom"). In the
+            2 × 2 repeat (``repeat`` 2) the same sets name each family's union, and each
+            yarn has its own: hexahedron sets "warp0", "warp1", "fill0", "fill1" and node
+            sets "warp0", "warp0.x_min", "warp0.x_max", "warp0.top", "warp0.bottom", ….
         frames: (n_hexes, 3, 3) material axes, rows a1 (along the yarn), a2, a3 (also
             ``mesh.hex_frames``).
         yarns: {"warp": YarnShape, "fill": YarnShape}.
         shape, trim: the section's shape and trim.
+        repeat: crossings along each yarn, 1 (the single crossover) or 2 (the 2 × 2
+            plain-weave repeat).
     """
 
     mesh: Mesh
@@ -82,11 +106,21 @@ class CrossoverCell:
     yarns: dict
     shape: str
     trim: float
+    repeat: int = 1
 
     @property
     def size(self) -> tuple[float, float]:
-        """The cell's extent along x and y (m)."""
-        return 2.0 * self.yarns["warp"].half_length, 2.0 * self.yarns["fill"].half_length
+        """The cell's extent along x and y (m): 2ℓ × repeat each."""
+        return (2.0 * self.repeat * self.yarns["warp"].half_length,
+                2.0 * self.repeat * self.yarns["fill"].half_length)
+
+    @property
+    def yarn_names(self) -> tuple[str, ...]:
+        """The yarns' own set names: ("warp", "fill"), or ("warp0", "warp1", "fill0",
+        "fill1") in the 2 × 2 repeat."""
+        if self.repeat == 1:
+            return FAMILIES
+        return tuple(f"{f}{j}" for f in FAMILIES for j in range(self.repeat))
 
     @property
     def thickness(self) -> float:
@@ -154,17 +188,26 @@ def centreline(yarn: YarnShape, s, sign: float):
     return sign * yarn.amplitude * np.cos(k * s), -sign * yarn.amplitude * k * np.sin(k * s)
 
 
-def _yarn_nodes(yarn: YarnShape, shape: str, trim: float, n, sign: float, axis: int):
-    """Nodes (k slowest, then j, i fastest) of one yarn: i along it, j across (u), k up."""
+def _yarn_nodes(yarn: YarnShape, shape: str, trim: float, n, sign: float, axis: int,
+                place=None):
+    """Nodes (k slowest, then j, i fastest) of one yarn: i along it, j across (u), k up.
+    ``place`` (the 2 × 2 repeat): (half-span, phase, offset) — the yarn runs over
+    [−half-span, half-span], its centreline the cosine about s = ``phase`` and its axis at
+    ``offset`` across; None: the single cell's yarn over [−ℓ, ℓ] about 0."""
     along, across, through = n
-    s = np.linspace(-yarn.half_length, yarn.half_length, along + 1)
+    if place is None:
+        s = np.linspace(-yarn.half_length, yarn.half_length, along + 1)
+    else:
+        s = np.linspace(-place[0], place[0], along + 1)
     ut = trimmed_extent(shape, trim)
     u = np.linspace(-ut, ut, across + 1)
     zeta = np.linspace(-1.0, 1.0, through + 1)
     k3, j3, i3 = np.meshgrid(zeta, u, s, indexing="ij")
-    c, _ = centreline(yarn, i3, sign)
+    c, _ = centreline(yarn, i3 if place is None else i3 - place[1], sign)
     z = c + k3 * 0.5 * yarn.thickness * section_profile(shape, j3)
     across_coord = j3 * 0.5 * yarn.width
+    if place is not None:
+        across_coord = across_coord + (place[2] if axis == 0 else -place[2])
     if axis == 0:  # warp: along x, across +y
         xyz = (i3, across_coord, z)
     else:  # fill: along y, across −x (right-handed: the elements keep C3D8 order)
@@ -186,12 +229,16 @@ def _grid_hexes(n, offset: int) -> np.ndarray:
     return np.stack([nid(i + a, j + b, k + c) for a, b, c in corners], axis=1).astype(np.int64)
 
 
-def _frames(yarn: YarnShape, n, sign: float, axis: int) -> np.ndarray:
-    """Each element's axes: a1 the centreline's tangent at its mid-station, a2 across."""
+def _frames(yarn: YarnShape, n, sign: float, axis: int, place=None) -> np.ndarray:
+    """Each element's axes: a1 the centreline's tangent at its mid-station, a2 across
+    (``place`` as :func:`_yarn_nodes`)."""
     along, across, through = n
-    s = np.linspace(-yarn.half_length, yarn.half_length, along + 1)
+    if place is None:
+        s = np.linspace(-yarn.half_length, yarn.half_length, along + 1)
+    else:
+        s = np.linspace(-place[0], place[0], along + 1)
     mid = 0.5 * (s[1:] + s[:-1])
-    _, slope = centreline(yarn, mid, sign)
+    _, slope = centreline(yarn, mid if place is None else mid - place[1], sign)
     norm = np.sqrt(1.0 + slope**2)
     a1 = np.zeros((along, 3))
     a2 = np.zeros((along, 3))
@@ -225,7 +272,8 @@ def yarn_clearance(yarns: dict, shape: str, trim: float, points: int = CLEARANCE
 
 
 def crossover_cell(spec) -> CrossoverCell:
-    """The cell of a geometry spec (spec/crossover.py; module docstring).
+    """The cell of a geometry spec (spec/crossover.py; module docstring): one crossover,
+    or the 2 × 2 plain-weave repeat with ``[cell] repeat = 2``.
 
     Raises:
         InputError: a yarn wider than its pitch, or yarns that overlap (thicker than
@@ -245,6 +293,12 @@ def crossover_cell(spec) -> CrossoverCell:
             "yarns narrower than the pitch, a width or a gap, where the cell's corners "
             "leave it room)")
     n = (spec.mesh.along, spec.mesh.across, spec.mesh.through)
+    repeat = int(getattr(spec.cell, "repeat", 1))
+    if repeat not in REPEATS:
+        raise InputError(f"cell.repeat = {repeat!r}: valid are 1 (one crossover) and 2 (the "
+                         "2 × 2 plain-weave repeat)")
+    if repeat == 2:
+        return _repeat_cell(yarns, shape, trim, n)
     per_yarn = (n[0] + 1) * (n[1] + 1) * (n[2] + 1)
     nodes = np.vstack([_yarn_nodes(yarns["warp"], shape, trim, n, 1.0, 0),
                        _yarn_nodes(yarns["fill"], shape, trim, n, -1.0, 1)])
@@ -266,3 +320,57 @@ def crossover_cell(spec) -> CrossoverCell:
                 hex_sets={"warp": np.arange(per_hexes),
                           "fill": per_hexes + np.arange(per_hexes)}, hex_frames=frames)
     return CrossoverCell(mesh=mesh, frames=frames, yarns=yarns, shape=shape, trim=trim)
+
+
+def repeat_placement(yarns: dict):
+    """The 2 × 2 repeat's yarns (module docstring) in node order: (name, family, sign,
+    axis, place) with ``place`` = (half-span 2ℓ, phase −ℓ, offset (2j − 1) ℓ of the crossing
+    family) as :func:`_yarn_nodes` takes it."""
+    w, f = yarns["warp"], yarns["fill"]
+    out = []
+    for j, sigma in enumerate((1.0, -1.0)):
+        out.append((f"warp{j}", "warp", sigma, 0,
+                    (2.0 * w.half_length, -w.half_length, (2 * j - 1) * f.half_length)))
+    for i, sigma in enumerate((1.0, -1.0)):
+        out.append((f"fill{i}", "fill", -sigma, 1,
+                    (2.0 * f.half_length, -f.half_length, (2 * i - 1) * w.half_length)))
+    return out
+
+
+def _repeat_cell(yarns: dict, shape: str, trim: float, n) -> CrossoverCell:
+    """The 2 × 2 plain-weave repeat (module docstring): four yarns of 2 × along elements
+    each, the warps' first."""
+    m = (2 * n[0], n[1], n[2])
+    per_yarn = (m[0] + 1) * (m[1] + 1) * (m[2] + 1)
+    per_hexes = m[0] * m[1] * m[2]
+    grid = np.stack(np.meshgrid(np.arange(m[2] + 1), np.arange(m[1] + 1), np.arange(m[0] + 1),
+                                indexing="ij"), axis=-1).reshape(-1, 3)  # (k, j, i)
+    nodes, hexes, frames = [], [], []
+    node_sets: dict = {}
+    hex_sets: dict = {}
+    for y, (name, family, sign, axis, place) in enumerate(repeat_placement(yarns)):
+        yarn = yarns[family]
+        nodes.append(_yarn_nodes(yarn, shape, trim, m, sign, axis, place))
+        hexes.append(_grid_hexes(m, y * per_yarn))
+        frames.append(_frames(yarn, m, sign, axis, place))
+        base = y * per_yarn
+        lo, hi = ("x_min", "x_max") if axis == 0 else ("y_min", "y_max")
+        node_sets[name] = base + np.arange(per_yarn)
+        node_sets[f"{name}.{lo}"] = base + np.flatnonzero(grid[:, 2] == 0)
+        node_sets[f"{name}.{hi}"] = base + np.flatnonzero(grid[:, 2] == m[0])
+        node_sets[f"{name}.bottom"] = base + np.flatnonzero(grid[:, 0] == 0)
+        node_sets[f"{name}.top"] = base + np.flatnonzero(grid[:, 0] == m[2])
+        hex_sets[name] = y * per_hexes + np.arange(per_hexes)
+    for family, lo, hi in (("warp", "x_min", "x_max"), ("fill", "y_min", "y_max")):
+        for key in ("", f".{lo}", f".{hi}", ".bottom", ".top"):
+            node_sets[f"{family}{key}"] = np.concatenate(
+                [node_sets[f"{family}{j}{key}"] for j in range(2)])
+        hex_sets[family] = np.concatenate([hex_sets[f"{family}{j}"] for j in range(2)])
+    nodes = np.vstack(nodes)
+    node_sets["all"] = np.arange(len(nodes))
+    frames = np.vstack(frames)
+    mesh = Mesh(nodes=nodes, quads=np.zeros((0, 4), dtype=np.int64),
+                ply=np.zeros(0, dtype=np.int64), node_sets=node_sets, hexes=np.vstack(hexes),
+                hex_sets=hex_sets, hex_frames=frames)
+    return CrossoverCell(mesh=mesh, frames=frames, yarns=yarns, shape=shape, trim=trim,
+                         repeat=2)

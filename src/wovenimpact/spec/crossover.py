@@ -9,6 +9,7 @@ key (as for case and material files, spec/fields.py)::
 
     [cell]
     name = "thesis Table 5-1"
+    repeat = 1                   # or 2: the 2 × 2 plain-weave repeat (two yarns a family)
     [warp]                       # along x
     thread_count = "27 1/in"     # of this family: its yarns' pitch is 1 / thread_count
     crimp = 0.0421
@@ -46,10 +47,13 @@ MAX_CRIMP = 0.5  # as material files (a crimp of 50 % is no woven fabric)
 
 
 class CellInfo(BaseModel):
-    """``[cell]``: a name for the outputs."""
+    """``[cell]``: a name for the outputs, and the crossings along each yarn."""
 
     model_config = STRICT
     name: str = Field(min_length=1)
+    # 1: one crossover (thesis §5.2.1); 2: the 2 × 2 plain-weave repeat, two warp yarns
+    # over and under two fill yarns (model/crossover_cell.py) — a yarn with a neighbour
+    repeat: integer(ge=1, le=2, example=2) = 1
 
 
 class YarnGeometrySpec(BaseModel):

@@ -1,0 +1,179 @@
+"""In-plane shear of the crossover cell by a pin-jointed frame (calibration/cell_shear.py,
+docs/solid.md §6.7): the frame's kinematics, a driver that does no work on yarns that do
+not touch, the test on a coarse 2 × 2 repeat, the locking rules on curves with a known
+answer and the shell's trellis law beside it."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from wovenimpact.calibration.cell_shear import (
+    driven_ends,
+    end_motion,
+    end_motion_rate,
+    frame_gradient,
+    locking_angle,
+    meshed_width,
+    shear_cell,
+    smooth_ramp_integral,
+    stiffening_angle,
+    trellis_angles,
+    trellis_law,
+)
+from wovenimpact.calibration.crossover_cell import element_volumes
+from wovenimpact.errors import InputError
+from wovenimpact.kernels.integrate import smooth_step
+from wovenimpact.model.crossover_cell import crossover_cell
+from wovenimpact.model.model import ShellContactParams
+from wovenimpact.spec.crossover import geometry_from_dict
+from wovenimpact.spec.material import load_material
+
+ROOT = Path(__file__).resolve().parents[2]
+YARN = load_material(ROOT / "examples" / "materials" / "kevlar_yarn_solid.toml")
+FABRIC = load_material(ROOT / "examples" / "materials" / "kevlar_thesis.toml")
+
+
+def repeat_doc(along=6, across=4, through=2, repeat=2) -> dict:
+    """The thesis's geometry (Table 5-1) as the 2 × 2 repeat, coarse."""
+    return {"cell": {"name": "repeat", "repeat": repeat},
+            "warp": {"thread_count": "27 1/in", "crimp": 0.0421, "width": "0.9407 mm",
+                     "thickness": "0.2499 mm", "h0": "0.12495 mm"},
+            "mesh": {"along": along, "across": across, "through": through}}
+
+
+def test_the_frame_shears_the_net_and_turns_each_yarn_rigidly():
+    """F(γ) keeps both families' lengths and closes their angle to 90° − γ; a yarn's end
+    nodes keep their distances (a rigid motion), its axis point c goes to F c and its
+    direction turns by ±γ/2, so parallel warps end pitch × cos γ apart; ∂x/∂γ is the
+    derivative of x(γ) (central differences)."""
+    g = math.radians(25.0)
+    F = frame_gradient(g)
+    ex, ey = F @ [1.0, 0.0], F @ [0.0, 1.0]
+    assert np.linalg.norm(ex) == pytest.approx(1.0) and np.linalg.norm(ey) == pytest.approx(1.0)
+    assert math.degrees(math.acos(ex @ ey)) == pytest.approx(90.0 - 25.0, rel=1e-12)
+    cell = crossover_cell(geometry_from_dict(repeat_doc()))
+    ends = driven_ends(cell)
+    assert [e.name for e in ends] == ["warp0", "warp1", "fill0", "fill1"]
+    pitch = 0.5 * cell.size[1]
+    np.testing.assert_allclose(ends[0].centre, [0.0, -0.5 * pitch], atol=1e-15)
+    for e in ends:
+        x = end_motion(g, e.X, e.centre, e.turn)
+        d0 = np.linalg.norm(e.X[:, None] - e.X[None], axis=-1)
+        d = np.linalg.norm(x[:, None] - x[None], axis=-1)
+        np.testing.assert_allclose(d, d0, atol=1e-15)
+        np.testing.assert_allclose(end_motion(g, e.centre[None], e.centre, e.turn)[0],
+                                   F @ e.centre, atol=1e-15)
+        h = 1e-6
+        fd = (end_motion(g + h, e.X, e.centre, e.turn) - end_motion(g - h, e.X, e.centre, e.turn)) / (2 * h)
+        np.testing.assert_allclose(end_motion_rate(g, e.X, e.centre, e.turn), fd, atol=1e-12)
+    axis0 = F @ ends[0].centre
+    axis1 = F @ ends[1].centre
+    normal = np.array([-math.sin(0.5 * g), math.cos(0.5 * g)])  # across the turned warps
+    assert (axis1 - axis0) @ normal == pytest.approx(pitch * math.cos(g), rel=1e-12)
+
+
+def test_the_ramp_integral_is_the_integral_of_the_smooth_step():
+    """Its derivative (central differences) is the smooth step A(t) everywhere, and it
+    starts at 0: γ(t) = γ̇ ∫ A is the angle of a rate ramped in as the other tests' speeds."""
+    ramp = 5e-6
+    h = 1e-11
+    t = np.linspace(h, 8e-6, 801)
+    a = np.array([smooth_step(s, ramp) for s in t])
+    rate = np.array([(smooth_ramp_integral(s + h, ramp) - smooth_ramp_integral(s - h, ramp))
+                     / (2 * h) for s in t])
+    np.testing.assert_allclose(rate, a, atol=1e-6)
+    assert smooth_ramp_integral(0.0, ramp) == 0.0
+    assert smooth_ramp_integral(8e-6, ramp) == pytest.approx(0.5 * ramp + 3e-6, rel=1e-14)
+
+
+def test_yarns_that_do_not_touch_are_moved_rigidly_by_the_frame():
+    """With the contact off, the frame's end motions are rigid motions of each yarn: to
+    10° the internal work stays below 1e-3 of what the same angle would store if the
+    yarns were sheared in their plane (½ G12 γ² V, the affine frame), and the energy
+    balance closes."""
+    r = shear_cell(geometry_from_dict(repeat_doc(along=4, across=2, through=1)), YARN,
+                   angle=math.radians(10.0), rate=1e4, samples=10,
+                   contact=ShellContactParams(enabled=False))
+    assert r.stopped == "angle" and r.gamma[-1] >= math.radians(10.0)
+    cell = crossover_cell(geometry_from_dict(repeat_doc(along=4, across=2, through=1)))
+    volume = float(element_volumes(cell).sum())
+    affine = 0.5 * YARN.g12 * r.gamma[-1] ** 2 * volume
+    internal = r.work[-1]  # the frame's work: internal work plus kinetic energy
+    assert abs(internal) < 1e-3 * affine
+    assert r.energy_error < 1e-3
+
+
+@pytest.fixture(scope="module")
+def coarse_run():
+    """The coarse repeat (6 × 4 × 2 elements per crossing and yarn) to 8° at 2000 rad/s."""
+    return shear_cell(geometry_from_dict(repeat_doc()), YARN, angle=math.radians(8.0),
+                      rate=2e3, samples=16)
+
+
+def test_the_coarse_repeat_resists_shear_through_its_crossings(coarse_run):
+    """The frame's moment rises with every sample after the ramp (the crossings' yarns
+    pressed into each other as they turn: a monotonic τ(γ)), the work the frame puts in
+    is positive and the run is quasi-static: kinetic energy below 1 % of the internal
+    work over the second half, energy error below 1 %, hourglass energy below 10 %. The
+    parallel yarns, 0.12 mm apart as meshed, do not touch at 8°; the crossings carry."""
+    r = coarse_run
+    assert r.stopped == "angle" and r.repeat == 2 and r.elements == 4 * 12 * 4 * 2
+    after = r.gamma > math.radians(1.0)
+    assert (np.diff(r.stress[after]) > 0.0).all()
+    assert r.stress[-1] > 0.0 and r.work[-1] > 0.0
+    assert r.kinetic_fraction < 0.01
+    assert r.energy_error < 0.01
+    assert r.hourglass_fraction < 0.10
+    assert np.all(r.parallel_force == 0.0)
+    assert r.crossing_force[-1] > 0.0
+    # the definitions: τ = T / (A0 t), N_s = T / A0
+    np.testing.assert_allclose(r.stress * r.area * r.thickness, r.moment, rtol=1e-12)
+    np.testing.assert_allclose(r.resultant * r.area, r.moment, rtol=1e-12)
+
+
+def test_the_shear_test_refuses_bad_input_naming_it():
+    spec = geometry_from_dict(repeat_doc())
+    for kwargs, key in (({"angle": 2.0}, "angle"), ({"rate": 0.0}, "rate"),
+                        ({"samples": 2}, "samples"), ({"max_kinetic": 0.0}, "max_kinetic")):
+        with pytest.raises(InputError, match=key):
+            shear_cell(spec, YARN, **kwargs)
+
+
+def bilinear(gamma, g1, g2, lock):
+    return np.where(gamma < lock, g1 * gamma, g1 * lock + g2 * (gamma - lock))
+
+
+def test_the_locking_rules_find_the_corner_of_a_bilinear_curve():
+    """τ = G1 γ up to γL, then slope G2: the tangents' intersection is γL (both windows
+    within a branch), the tangent reaches 10 × G1 within a sample of γL; a straight
+    line (or a mild stiffening) has no locking angle."""
+    gamma = np.linspace(0.0, math.radians(40.0), 401)
+    lock = math.radians(25.0)
+    tau = bilinear(gamma, 1e6, 50e6, lock)
+    assert locking_angle(gamma, tau) == pytest.approx(lock, rel=1e-9)
+    assert stiffening_angle(gamma, tau) == pytest.approx(lock, abs=gamma[1])  # within a sample
+    assert math.isnan(locking_angle(gamma, 3e6 * gamma))
+    assert math.isnan(locking_angle(gamma, bilinear(gamma, 1e6, 2e6, lock)))
+    assert math.isnan(stiffening_angle(gamma, 3e6 * gamma))
+
+
+def test_the_trellis_law_and_its_locking_angles_are_the_shells():
+    """trellis_angles gives the shell's γ1, γ2 (materials.fabric, eqs. 3.13–3.14) for the
+    reference fabric — 0.53° and 49.46° — and 29.3° / 55.5° for the cell's meshed width
+    (the lenticular section trimmed at a fifth of its thickness is 0.872 of the pitch
+    wide); trellis_law is G1 γ below γ1 and G2 γ beyond γ2."""
+    f = FABRIC
+    pitch = 2.0 * f.fill.half_length
+    g1, g2 = trellis_angles(f.warp.width, pitch, f.shear_c_max)
+    assert (g1, g2) == pytest.approx(f.locking_angles, rel=1e-12)
+    assert (math.degrees(g1), math.degrees(g2)) == pytest.approx((0.53, 49.46), abs=0.01)
+    cell = crossover_cell(geometry_from_dict(repeat_doc()))
+    m1, m2 = trellis_angles(meshed_width(cell), 0.5 * cell.size[1], f.shear_c_max)
+    assert (math.degrees(m1), math.degrees(m2)) == pytest.approx((29.3, 55.5), abs=0.1)
+    gam = np.array([0.5 * g1, 1.2 * g2])
+    tau = trellis_law(gam, f.shear_g1, f.shear_g2, g1, g2)
+    assert tau == pytest.approx([f.shear_g1 * gam[0], f.shear_g2 * gam[1]], rel=1e-12)

@@ -12,6 +12,7 @@ import numpy as np
 import pytest
 
 from wovenimpact.calibration.cell_shear import (
+    crossing_misfit,
     driven_ends,
     end_motion,
     end_motion_rate,
@@ -177,3 +178,17 @@ def test_the_trellis_law_and_its_locking_angles_are_the_shells():
     gam = np.array([0.5 * g1, 1.2 * g2])
     tau = trellis_law(gam, f.shear_g1, f.shear_g2, g1, g2)
     assert tau == pytest.approx([f.shear_g1 * gam[0], f.shear_g2 * gam[1]], rel=1e-12)
+
+
+def test_turning_the_crossing_yarns_rigidly_makes_them_overlap():
+    """The thesis's yarns meet without overlapping (misfit 0 at γ = 0, to round-off); turned
+    rigidly by ±γ/2 they overlap by a depth that grows about in proportion to γ (the
+    surfaces' slopes, up to 23°, times the yarns' relative sliding) and reaches a quarter
+    of the yarn's thickness near 10°."""
+    cell = crossover_cell(geometry_from_dict(repeat_doc(repeat=1)))
+    t = cell.yarns["warp"].thickness
+    m = [crossing_misfit(cell, math.radians(a)) for a in (0.0, 1.0, 2.0, 10.0)]
+    assert m[0] < 1e-12
+    assert 0.015 * t < m[1] < 0.04 * t
+    assert m[2] == pytest.approx(2 * m[1], rel=0.1)
+    assert 0.2 * t < m[3] < 0.3 * t

@@ -358,3 +358,34 @@ def meshed_width(cell, family: str = "warp") -> float:
     """The width of a family's yarns as meshed: the trimmed section's u_t W (the
     lenticular section's tips are cut where it is ``trim`` of its thickness)."""
     return trimmed_extent(cell.shape, cell.trim) * cell.yarns[family].width
+
+
+def crossing_misfit(cell, gamma: float, points: int = 401) -> float:
+    """The depth (m) by which the two yarns of one crossing would overlap if the frame
+    turned them rigidly, the warp by +γ/2 and the fill by −γ/2 about the crossing: the
+    largest height of the fill's upper surface above the warp's lower surface where both
+    are, on a ``points`` × ``points`` grid over the single cell's area (the yarns'
+    undeformed sections and centrelines, model.crossover_cell). Zero at γ = 0 for the
+    thesis's yarns, which meet without overlapping; what the crossing must take up by
+    compressing or lifting the yarns as the trellis turns."""
+    from wovenimpact.model.crossover_cell import centreline, section_profile
+
+    w, f = cell.yarns["warp"], cell.yarns["fill"]
+    ut = trimmed_extent(cell.shape, cell.trim)
+    half = max(w.half_length, f.half_length, 0.5 * w.width, 0.5 * f.width)
+    g = np.linspace(-half, half, points)
+    X, Y = np.meshgrid(g, g, indexing="ij")
+    a = 0.5 * gamma
+    # each yarn's own coordinates (along, across) of a point: turn the point back
+    xw, yw = math.cos(a) * X + math.sin(a) * Y, -math.sin(a) * X + math.cos(a) * Y
+    xf, yf = math.cos(a) * X - math.sin(a) * Y, math.sin(a) * X + math.cos(a) * Y
+    uw = yw / (0.5 * w.width)
+    uf = -xf / (0.5 * f.width)
+    on_w = (np.abs(uw) <= ut) & (np.abs(xw) <= w.half_length)
+    on_f = (np.abs(uf) <= ut) & (np.abs(yf) <= f.half_length)
+    warp_low = (centreline(w, xw, 1.0)[0]
+                - 0.5 * w.thickness * section_profile(cell.shape, np.clip(uw, -1.0, 1.0)))
+    fill_up = (centreline(f, yf, -1.0)[0]
+               + 0.5 * f.thickness * section_profile(cell.shape, np.clip(uf, -1.0, 1.0)))
+    both = on_w & on_f
+    return float(max(0.0, np.max((fill_up - warp_low)[both]))) if both.any() else 0.0

@@ -30,7 +30,8 @@ from wovenimpact.state import initial_state
 
 
 def fabric_plate(per_edge: int, ultimate_tension: float | None = None, stable_step="isotropic",
-                 metal_rows: int = 0, crossover: str = "table", elastic_rows: int = 0):
+                 metal_rows: int = 0, crossover: str = "table", elastic_rows: int = 0,
+                 kinematic_fraction: float = SL.KINEMATIC_FRACTION):
     """A fabric plate (the benchmark's, 0.94 mm cells) struck by a velocity bump; its
     yarns' T_u lowered to make them break; optionally its first rows of elements J2
     metal (they stay with shell_force) and its last rows elastic steel (a resultant
@@ -54,7 +55,7 @@ def fabric_plate(per_edge: int, ultimate_tension: float | None = None, stable_st
         which[mesh.n_elems - elastic_rows * per_edge:] = len(sections) - 1
     bc = BoundaryConditions(mesh.n_nodes).fix(mesh.node_sets["edge_outer"])
     model = build_model(mesh.nodes, mesh.quads, sections, which, bcs=bc,
-                        stable_step=stable_step)
+                        stable_step=stable_step, kinematic_fraction=kinematic_fraction)
     r = np.linalg.norm(mesh.nodes[:, :2], axis=1) / (0.5 * per_edge * size)
     v0 = np.zeros((mesh.n_nodes, 3))
     v0[:, 2] = -400.0 * np.clip(1.0 - 2.0 * r, 0.0, None) ** 2
@@ -110,6 +111,21 @@ def test_breaking_yarns_bitwise(stable_step):
     assert np.any(rows[:, FL.S_DAMAGE] >= 1.0), "no yarn broke: the test would not see it"
     assert 0 < pending < 40 * model.n_elems  # both paths taken
     assert_same(a, b, wa, wb)
+
+
+def test_both_paths_read_the_kinematic_fraction():
+    """run.kinematic_fraction (η of the yarn step's kinematic bound) reaches the block
+    stage and shell_force alike: with η = 0.25 the two stay bitwise equal, and the run
+    differs from the default η's (the struck plate's corners close fast enough for the
+    bound to govern some steps, so a path that ignored η would part from the other)."""
+    runs = {}
+    for eta in (SL.KINEMATIC_FRACTION, 0.25):
+        model, st = fabric_plate(12, ultimate_tension=10.0, stable_step="yarn",
+                                 kinematic_fraction=eta)
+        a, b, wa, wb, _ = run_both(model, st, 40)
+        assert_same(a, b, wa, wb)
+        runs[eta] = a.t
+    assert runs[0.25] > runs[SL.KINEMATIC_FRACTION]  # larger steps: further in 40 steps
 
 
 def test_mixed_sections_and_exact_crossover():

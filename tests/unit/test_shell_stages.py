@@ -191,24 +191,26 @@ def test_the_kinematic_step_lets_no_corner_pair_close_or_open_more_than_its_frac
     closing or opening fastest relative to its length; corners moving across their line
     (a struck node leaving its neighbours normal to the plate) or moving as a rigid
     translation do not limit the step."""
-    from wovenimpact.kernels.shell import KINEMATIC_FRACTION
+    from wovenimpact.kernels.shell_layout import KINEMATIC_FRACTION
 
     side = 0.005
     px, py, pz = (0.0, side, side, 0.0), (0.0, 0.0, side, side), (0.0,) * 4
     still = (0.0,) * 4
     # corner 1 runs at 100 m/s towards corner 0 along their side (length 5 mm)
-    dt = kinematic_step(px, py, pz, (0.0, -100.0, 0.0, 0.0), still, still)
+    dt = kinematic_step(px, py, pz, (0.0, -100.0, 0.0, 0.0), still, still, KINEMATIC_FRACTION)
     assert dt == pytest.approx(KINEMATIC_FRACTION * side / 100.0, rel=1e-14)
     # the same pair opening (a slack yarn pulled taut within a step), alike
-    dt = kinematic_step(px, py, pz, (0.0, 100.0, 0.0, 0.0), still, still)
+    dt = kinematic_step(px, py, pz, (0.0, 100.0, 0.0, 0.0), still, still, KINEMATIC_FRACTION)
     assert dt == pytest.approx(KINEMATIC_FRACTION * side / 100.0, rel=1e-14)
     # a corner leaving normal to the plate, a rigid translation
-    assert kinematic_step(px, py, pz, still, still, (0.0, 0.0, 300.0, 0.0)) == math.inf
-    assert kinematic_step(px, py, pz, (7.0,) * 4, (-3.0,) * 4, (1.0,) * 4) == math.inf
+    assert kinematic_step(px, py, pz, still, still, (0.0, 0.0, 300.0, 0.0), 0.5) == math.inf
+    assert kinematic_step(px, py, pz, (7.0,) * 4, (-3.0,) * 4, (1.0,) * 4, 0.5) == math.inf
     # and along a diagonal: corner 2 towards corner 0, |Δx|² = 2 side²
-    dt = kinematic_step(px, py, pz, (0.0, 0.0, -50.0, 0.0), (0.0, 0.0, -50.0, 0.0), still)
+    diagonal = (0.0, 0.0, -50.0, 0.0), (0.0, 0.0, -50.0, 0.0), still
     closing = 2.0 * side * 50.0  # −Δx·Δv
-    assert dt == pytest.approx(KINEMATIC_FRACTION * 2.0 * side**2 / closing, rel=1e-14)
+    for eta in (KINEMATIC_FRACTION, 0.25, 0.5):  # run.kinematic_fraction: Δt ∝ η
+        dt = kinematic_step(px, py, pz, *diagonal, eta)
+        assert dt == pytest.approx(eta * 2.0 * side**2 / closing, rel=1e-14)
 
 
 def test_a_yarn_familys_step_is_its_reference_length_over_its_wave_speed():

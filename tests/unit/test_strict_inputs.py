@@ -271,3 +271,13 @@ def test_a_large_imported_mesh_is_refused_once_read(tmp_path, monkeypatch):
     doc["run"]["allow_large_mesh"] = True
     mesh, _ = compile_module.make_mesh(case_from_dict(doc, "case.toml"), tmp_path)
     assert mesh.n_elems == 9
+
+
+def test_a_kinematic_fraction_without_the_yarn_step_is_refused_naming_both_keys():
+    """run.kinematic_fraction is η of the yarn step's kinematic bound: given with the
+    isotropic step it would be ignored, so it is refused (and outside 0 < η ≤ 0.5 too)."""
+    text = refusal(PLATE, "run.kinematic_fraction=0.25")
+    assert "kinematic_fraction" in text and "stable_step" in text and "'isotropic'" in text
+    assert "0.5" in refusal(CASING, "run.kinematic_fraction=0.6")
+    spec, _ = load_case(CASING, ["run.kinematic_fraction=0.25"])
+    assert spec.run.stable_step == "yarn" and spec.run.kinematic_fraction == 0.25

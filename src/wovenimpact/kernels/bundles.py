@@ -47,6 +47,7 @@ class ShellMesh(NamedTuple):
     rot_inertia: np.ndarray  # (n_elems,) rotary inertia lumped on each corner (kg m²)
     mat_row: np.ndarray  # (n_elems + 1,) element e's material rows mat_row[e] … [e + 1] − 1
     step_mode: int  # shell_layout STEP_*: the fabric elements' stable step
+    kinematic_fraction: float  # η of the kinematic bound under STEP_YARN (run.kinematic_fraction)
 
 
 class Motion(NamedTuple):

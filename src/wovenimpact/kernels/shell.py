@@ -779,14 +779,12 @@ def family_stable_step(k, k_shear, mu, g):
     return step if k > 0.0 else math.inf  # libm call, which stops the vectoriser
 
 
-KINEMATIC_FRACTION = 0.05  # of its length a corner pair may close in one step
-
-
 @inline_kernel
-def kinematic_step(px, py, pz, vx, vy, vz):
+def kinematic_step(px, py, pz, vx, vy, vz, fraction):
     """The step in which no two corners of the element (sides and diagonals) close or
-    open by more than KINEMATIC_FRACTION of their distance: Δt ≤ η |Δx|²/|Δx·Δv|
-    (theory §4, "Stable step"). A wave-speed bound comes from the state at the step's
+    open by more than ``fraction`` η of their distance: Δt ≤ η |Δx|²/|Δx·Δv|
+    (theory §4, "Stable step"; η is ``run.kinematic_fraction``, default
+    shell_layout.KINEMATIC_FRACTION). A wave-speed bound comes from the state at the step's
     start, and an element crushed within a few steps (a fabric cell under a punch's
     edge, its yarns slack, from 0.3 to 0.04 of its size in 1 µs) outruns it; so does a
     slack family (left out of the wave bound) pulled taut within one step. Corners
@@ -801,7 +799,7 @@ def kinematic_step(px, py, pz, vx, vy, vz):
             change = abs(dx * (vx[j] - vx[i]) + dy * (vy[j] - vy[i]) + dz * (vz[j] - vz[i]))
             d2 = dx * dx + dy * dy + dz * dz
             rate = change / d2 if change > rate * d2 else rate  # a select: vectorises
-    return KINEMATIC_FRACTION / rate if rate > 0.0 else math.inf
+    return fraction / rate if rate > 0.0 else math.inf
 
 
 @inline_kernel
@@ -986,7 +984,7 @@ def shell_force(e, mesh, motion, dt, tables, blocks):
         dt_e = min(element_stable_step(px, py, pz, area, c_step, kgt, mu, inertia, d_b, bb),
                    family_stable_step(k_warp, c_step, mu, g1),
                    family_stable_step(k_fill, c_step, mu, g2))
-        dt_kin = kinematic_step(px, py, pz, vx_, vy_, vz_)
+        dt_kin = kinematic_step(px, py, pz, vx_, vy_, vz_, mesh.kinematic_fraction)
     else:
         dt_e = dt_iso
         dt_kin = math.inf

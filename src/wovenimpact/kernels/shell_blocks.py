@@ -487,7 +487,7 @@ def membrane_point(tid, bu, lu, g, gg, gw, res, lx, ly, out_el):
 @block_kernel
 def element_tail(tid, bu, lu, old, out_el, out_blk, inert, dt, px, py, pz, vx_, vy_, vz_,
                  frame, mid, rates, g1, g2, mf_x, mf_y, c_memb, cs_max, kw_max, kf_max,
-                 full, thick, mu, e_b, nu_b, kgt, r_hg, step_yarn):
+                 full, thick, mu, e_b, nu_b, kgt, r_hg, step_yarn, kin_frac):
     """Steps 4–7 of ``shell_force`` for lane lu, on its membrane's results: bending and
     transverse shear of a resultant section, hourglass (in-plane modes too unless
     ``full``: a 2×2 membrane has none), the corner forces into out_blk, the element
@@ -547,7 +547,7 @@ def element_tail(tid, bu, lu, old, out_el, out_blk, inert, dt, px, py, pz, vx_, 
     dt_yarn = min(element_stable_step(px, py, pz, area, cs_max, kgt, mu, inertia, d_b, bb),
                   family_stable_step(kw_max, cs_max, mu, g1),
                   family_stable_step(kf_max, cs_max, mu, g2))
-    dt_kin = kinematic_step(px, py, pz, vx_, vy_, vz_)
+    dt_kin = kinematic_step(px, py, pz, vx_, vy_, vz_, kin_frac)
     dt_e = dt_yarn if step_yarn else dt_iso
     out_el[tid, at(E_DT, lu)] = dt_e
     out_el[tid, at(E_DT_KIN, lu)] = dt_kin if step_yarn else math.inf
@@ -560,7 +560,7 @@ def element_tail(tid, bu, lu, old, out_el, out_blk, inert, dt, px, py, pz, vx_, 
 # kernels/bundles.py)
 @block_kernel
 def element_lanes(tid, bu, cn, old, res, flag, gg, gw, rg, a0s, inert, out_el, out_blk, dt,
-                  thick, mu, e_b, nu_b, kgt, r_hg, step_yarn):
+                  thick, mu, e_b, nu_b, kgt, r_hg, step_yarn, kin_frac):
     """Stage 5: the rest of ``shell_force`` for every lane of the block (see the module
     docstring), on the points' results in res: the element state's columns and the
     isotropic step into out_el, the corner forces into out_blk; a lane with a point
@@ -611,7 +611,8 @@ def element_lanes(tid, bu, cn, old, res, flag, gg, gw, rg, a0s, inert, out_el, o
         out_el[tid, at(E_U_MEMB, lu)] = u
         finite = element_tail(tid, bu, lu, old, out_el, out_blk, inert, dt, px, py, pz, vx_,
                               vy_, vz_, frame, mid, rates, g1, g2, mf_x, mf_y, c_memb, cs_max,
-                              kw_max, kf_max, True, thick, mu, e_b, nu_b, kgt, r_hg, step_yarn)
+                              kw_max, kf_max, True, thick, mu, e_b, nu_b, kgt, r_hg, step_yarn,
+                              kin_frac)
         # a count, not a conditional store (which LLVM would not vectorise): > 0 flags
         flag[tid, lu] = flag[tid, lu] + bad_points + (1.0 - finite)
 
@@ -668,7 +669,7 @@ def elastic_membrane_lanes(tid, bu, cn, old, rg, a0s, dt, res, flag, modulus, po
 # kernels/bundles.py)
 @block_kernel
 def elastic_element_lanes(tid, bu, cn, old, res, flag, rg, inert, out_el, out_blk, dt, thick,
-                          mu, e_b, nu_b, kgt, r_hg, step_yarn):
+                          mu, e_b, nu_b, kgt, r_hg, step_yarn, kin_frac):
     """Stage 5 of an elastic block: the element state's membrane columns from res, then
     :func:`element_tail` with the in-plane hourglass modes."""
     for ll in range(LANES):
@@ -690,7 +691,8 @@ def elastic_element_lanes(tid, bu, cn, old, res, flag, rg, inert, out_el, out_bl
         c_memb = res[tid, at(L_C, lu)]
         finite = element_tail(tid, bu, lu, old, out_el, out_blk, inert, dt, px, py, pz, vx_,
                               vy_, vz_, frame, mid, rates, g1, g2, mf_x, mf_y, c_memb, c_memb,
-                              0.0, 0.0, False, thick, mu, e_b, nu_b, kgt, r_hg, step_yarn)
+                              0.0, 0.0, False, thick, mu, e_b, nu_b, kgt, r_hg, step_yarn,
+                              kin_frac)
         flag[tid, lu] = flag[tid, lu] + (1.0 - finite)
 
 
@@ -710,6 +712,7 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
     mat_kind = mesh.mat_kind
     mat_params = mesh.mat_params
     step_yarn = mesh.step_mode == STEP_YARN
+    kin_frac = mesh.kinematic_fraction
     x = motion.x
     v = motion.v
     omega = motion.omega
@@ -809,7 +812,7 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
                                    mat_params[m, ELASTIC_MODULUS],
                                    mat_params[m, ELASTIC_POISSON], thick)
             elastic_element_lanes(tid, b, cn, old, res, flag, rg, inert, out_el, out_blk, dt,
-                                  thick, mu, e_b, nu_b, kgt, r_hg, step_yarn)
+                                  thick, mu, e_b, nu_b, kgt, r_hg, step_yarn, kin_frac)
         else:
             kinematics_lanes(tid, b, cn, old, gg, rg, dt, kin, flag)
             table_lookup(mat_params, m, tid, kin, coef, geo, exact)
@@ -817,7 +820,7 @@ def internal_force_blocks(mesh, motion, dt, tables, results, dt_erode, erode_inv
             exact_points(mat_params, m, tid, b, elems, mat_row, el_in, rows_in, rows_out,
                          kin, exact, flag, res)
             element_lanes(tid, b, cn, old, res, flag, gg, gw, rg, a0s, inert, out_el, out_blk,
-                          dt, thick, mu, e_b, nu_b, kgt, r_hg, step_yarn)
+                          dt, thick, mu, e_b, nu_b, kgt, r_hg, step_yarn, kin_frac)
         # 6. scatter; a flagged lane is left for the scalar kernel (the next loop)
         for ll in range(lanes[b]):
             lu = _U(ll)

@@ -76,6 +76,9 @@ MEMBRANE_FULL = 4
 STEP_ISOTROPIC = 0  # L_e / c_e with the largest membrane tangent per current length
 STEP_YARN = 1  # each taut yarn family over its reference length, plus a kinematic limit
 STABLE_STEPS = {"isotropic": STEP_ISOTROPIC, "yarn": STEP_YARN}  # run.stable_step's words
+# η of the kinematic bound (kernels.shell.kinematic_step; run.kinematic_fraction's default):
+# the fraction of its distance a corner pair may close or open in one step
+KINEMATIC_FRACTION = 0.05
 
 # material kinds and the elastic parameter vector (a row of Model.mat_params)
 MAT_ELASTIC = 0

@@ -366,6 +366,8 @@ class Model:
             model's mass stops (mass scaling is then no longer a small perturbation).
         stable_step: "isotropic" or "yarn", the fabric elements' stable step (theory
             §4, "Stable step"; the shell kernel reads it as ``STEP_*``).
+        kinematic_fraction: η of the kinematic bound under ``stable_step = "yarn"``:
+            the fraction of its distance a corner pair may close or open in one step.
         elem_mass: (n_elems,) mass of each element, μ A0 (kg).
         elem_length: (n_elems, 2) each element's lengths for the regularisation of
             failure: along warp and fill for fabric, √A0 twice otherwise
@@ -420,6 +422,7 @@ class Model:
     mass_scaling_fraction: float = 0.0
     max_added_mass_fraction: float = 0.02
     stable_step: str = "isotropic"
+    kinematic_fraction: float = SL.KINEMATIC_FRACTION
     elem_mass: np.ndarray = field(default_factory=lambda: np.zeros(0))
     # the rotary inertia each element lumps on each of its corners (kg m²; node_inertia
     # is their sum, so the digest covers it)
@@ -469,6 +472,8 @@ class Model:
                        self.mass_scaling_fraction)).encode())
         if self.stable_step != "isotropic":  # (the default leaves older digests as they were)
             h.update(self.stable_step.encode())
+        if self.kinematic_fraction != SL.KINEMATIC_FRACTION:  # (likewise)
+            h.update(repr(self.kinematic_fraction).encode())
         if self.eroded_nodes != "remove":  # (likewise)
             h.update(self.eroded_nodes.encode())
         if self.shell_contact.damping_mode != "always":  # (likewise)
@@ -708,7 +713,8 @@ def node_element_map(quads: np.ndarray, n_nodes: int):
 
 
 def check_build_arguments(x0, q, *, alpha, erode_dt_fraction, mass_scaling_fraction,
-                          max_added_mass_fraction, stable_step, eroded_nodes) -> None:
+                          max_added_mass_fraction, stable_step, eroded_nodes,
+                          kinematic_fraction=SL.KINEMATIC_FRACTION) -> None:
     """Checks :func:`build_model`'s mesh arrays (shapes, node indices) and run parameters
     (ranges, names), raising an :class:`InputError` that names the first one wrong."""
     if x0.ndim != 2 or x0.shape[1] != 3:
@@ -736,6 +742,14 @@ def check_build_arguments(x0, q, *, alpha, erode_dt_fraction, mass_scaling_fract
     if stable_step not in SL.STABLE_STEPS:
         raise InputError(
             f"stable_step = {stable_step!r}: valid {' or '.join(SL.STABLE_STEPS)}")
+    if not 0.0 < kinematic_fraction <= 0.5:
+        raise InputError(f"kinematic_fraction = {kinematic_fraction!r}: valid 0 < η ≤ 0.5 "
+                         "(a corner pair closing by more than half its distance in a step "
+                         "could pass through itself)")
+    if kinematic_fraction != SL.KINEMATIC_FRACTION and stable_step != "yarn":
+        raise InputError(f"kinematic_fraction = {kinematic_fraction!r}: the kinematic bound "
+                         f"belongs to stable_step = \"yarn\", not {stable_step!r}; set "
+                         "stable_step = \"yarn\" or leave kinematic_fraction out")
     if eroded_nodes not in ERODED_NODES:
         raise InputError(
             f"eroded_nodes = {eroded_nodes!r}: valid {' or '.join(map(repr, ERODED_NODES))}")
@@ -915,6 +929,7 @@ def build_model(
     stable_step: str = "isotropic",
     eroded_nodes: str = "remove",
     solid: SolidPart | None = None,
+    kinematic_fraction: float = SL.KINEMATIC_FRACTION,
     rigid_planes=(),
 ) -> Model:
     """Assemble a :class:`Model` from a mesh, named sections and constraints.
@@ -946,13 +961,16 @@ def build_model(
         solid: the hexahedra on the same nodes (model.solid.solid_part); default none.
             ``quads`` may then be empty.
         rigid_planes: rigid plates (model.rigid_plane.RigidPlane); default none.
+        kinematic_fraction: η of the kinematic bound under ``stable_step = "yarn"``,
+            0 < η ≤ 0.5; default ``shell_layout.KINEMATIC_FRACTION`` (theory §4).
     """
     x0 = np.ascontiguousarray(nodes, dtype=float)
     q = np.ascontiguousarray(quads, dtype=np.int64)
     check_build_arguments(x0, q, alpha=alpha, erode_dt_fraction=erode_dt_fraction,
                           mass_scaling_fraction=mass_scaling_fraction,
                           max_added_mass_fraction=max_added_mass_fraction,
-                          stable_step=stable_step, eroded_nodes=eroded_nodes)
+                          stable_step=stable_step, eroded_nodes=eroded_nodes,
+                          kinematic_fraction=kinematic_fraction)
     names, mats, sec_table, es = section_table(sections, elem_section, len(q))
     kinds, params, mat_params, states = material_table(mats)
     point_width, section_state0, mat_row = point_state_tables(sec_table, kinds, states, es)
@@ -994,5 +1012,5 @@ def build_model(
         max_added_mass_fraction=float(max_added_mass_fraction), elem_mass=m_el,
         elem_rot_inertia=elem_rot_inertia, elem_length=elem_length, elem_failure=elem_failure,
         stable_step=str(stable_step), eroded_nodes=str(eroded_nodes), solid=solid,
-        rigid_planes=tuple(rigid_planes or ()),
+        rigid_planes=tuple(rigid_planes or ()), kinematic_fraction=float(kinematic_fraction),
     )

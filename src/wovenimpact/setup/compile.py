@@ -651,6 +651,7 @@ def case_model(spec: CaseSpec, mesh: Mesh, sections: dict[str, Section], elem_se
         mass_scaling_fraction=spec.run.mass_scaling_fraction,
         max_added_mass_fraction=spec.run.max_added_mass_fraction,
         stable_step=spec.run.stable_step,
+        kinematic_fraction=spec.run.kinematic_fraction,
         eroded_nodes=spec.run.eroded_nodes,
         solid=solid,
         rigid_planes=planes,

@@ -160,7 +160,8 @@ class Workspace:
             ref_grad=model.ref_grad, gauss_grad=model.gauss_grad,
             gauss_weight=model.gauss_weight, rot_inertia=model.elem_rot_inertia,
             mat_row=model.mat_row,
-            step_mode=SL.STABLE_STEPS[model.stable_step])
+            step_mode=SL.STABLE_STEPS[model.stable_step],
+            kinematic_fraction=model.kinematic_fraction)
         ws.plan = block_plan(model)
         ws.scratch = block_scratch(ws.plan) if ws.plan is not None else None
         ws.results = ElementResults(blocks=ws.blocks, status=ws.status,

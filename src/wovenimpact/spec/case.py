@@ -99,6 +99,7 @@ from pydantic import (
 
 from wovenimpact.errors import InputWarning
 from wovenimpact.impactor import BODY_PENALTY_SCALE, SIDEWAYS_COS
+from wovenimpact.kernels.shell_layout import KINEMATIC_FRACTION
 from wovenimpact.spec.fields import (
     STRICT,
     Problem,
@@ -512,6 +513,11 @@ class RunSpec(BaseModel):
     # perforation (0.28 % with the material option erode_intact_crush = 0.1; the
     # default's up to 0.2 %); not yet the default
     stable_step: Literal["isotropic", "yarn"] = "isotropic"
+    # η of the yarn step's kinematic bound (docs/theory.md §4, "Stable step"): the
+    # fraction of its distance a corner pair of an element may close or open in one step;
+    # only with stable_step = "yarn" (refused otherwise, when not the default 0.05)
+    kinematic_fraction: quantity("dimensionless", gt=0, le=0.5,
+                                 example="0.25") = KINEMATIC_FRACTION
     # what becomes of a node that loses its last live element (docs/theory.md §5, "Eroded
     # nodes"): "keep" (the default) flies on as a free node with its mass and momentum,
     # contact-active against impactors and other plies' segments (LS-DYNA's ENMASS = 2);
@@ -541,6 +547,13 @@ class RunSpec(BaseModel):
             raise ValueError(
                 f"mass_scaling_fraction = {f:g} must be 0 (off) or above erode_dt_fraction "
                 f"= {e:g}: an element erodes before its step would reach the scaling target"
+            )
+        if self.kinematic_fraction != KINEMATIC_FRACTION and self.stable_step != "yarn":
+            raise ValueError(
+                f"kinematic_fraction = {self.kinematic_fraction:g} applies to the kinematic "
+                f"bound of stable_step = \"yarn\" only, and stable_step is "
+                f"{self.stable_step!r}: set stable_step = \"yarn\" or leave "
+                "kinematic_fraction out"
             )
         return self
 

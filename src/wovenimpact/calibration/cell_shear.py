@@ -232,6 +232,9 @@ class CellShear:
             thickness at each sample (m): how far the crossings open vertically.
         centre_z: the vertical displacement of the cell's centre of mass at each sample
             (m): zero (to round-off) when nothing outside acts along z ("free_z").
+        end_z: the mean vertical displacement of each end face (m), samples × yarns × 2
+            (the yarns in ``cell.yarn_names`` order; the face at the lower coordinate
+            first): a yarn whose two ends part vertically climbs through the cell.
         ends: the end conditions (module docstring).
     """
 
@@ -254,6 +257,7 @@ class CellShear:
     repeat: int
     thickening: np.ndarray
     centre_z: np.ndarray
+    end_z: np.ndarray
     ends: str
 
 
@@ -299,6 +303,11 @@ def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: 
     z0 = model.x0[:, 2].copy()
     height0 = float(np.ptp(z0))
     mass = np.asarray(ws.node_mass, float)
+    sets = cell.mesh.node_sets
+    faces = [[sets[f"{n}.{lo}"], sets[f"{n}.{hi}"]]
+             for n in cell.yarn_names
+             for lo, hi in [("x_min", "x_max") if n.startswith("warp") else ("y_min", "y_max")]]
+    end_rows = []
 
     def gamma_at(t: float) -> float:
         return rate * smooth_ramp_integral(t, ramp)
@@ -336,6 +345,7 @@ def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: 
                      balance["internal_work_J"], balance["hourglass_J"],
                      balance["error_fraction"], state.t, float(np.ptp(z)) - height0,
                      float(np.sum(mass * (z - z0)) / np.sum(mass))))
+        end_rows.append([[float(np.mean(z[f] - z0[f])) for f in pair] for pair in faces])
         if g >= angle:
             break
         ke, wi = balance["kinetic_J"], balance["internal_work_J"]
@@ -345,6 +355,7 @@ def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: 
             stopped = (f"kinetic energy {ke / max(wi, 1e-300):.3g} of the internal work at "
                        f"γ = {math.degrees(g):.2f}° (above max_kinetic = {max_kinetic:g})")
             rows.pop()
+            end_rows.pop()
             break
     if not rows:
         raise SimulationError(f"the shear test stopped before its first sample: {stopped}")
@@ -361,7 +372,7 @@ def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: 
         hourglass_fraction=float(hg[-1] / max(wint[-1], 1e-300)),
         energy_error=float(err[-1]), stopped=stopped, steps=int(state.step),
         elements=int(model.n_hexes), repeat=int(cell.repeat), thickening=thick,
-        centre_z=zc, ends=end_conditions)
+        centre_z=zc, end_z=np.array(end_rows), ends=end_conditions)
 
 
 def _line(x: np.ndarray, y: np.ndarray) -> tuple[float, float]:

@@ -14,14 +14,14 @@ each yarn turns rigidly with its family while the crossings follow F. The end fa
 yarn whose axis passes through c (its end faces' mean in-plane position: (0, y_j) for a
 warp, (x_i, 0) for a fill) are therefore driven as a rigid body,
 
-  x(γ) = F(γ) c + R(±γ/2) (X − c),  z held,
+  x(γ) = F(γ) c + R(±γ/2) (X − c),
 
 + for the warp, − for the fill: the yarn's end section stays square to the yarn (the yarn is
 not sheared in its plane by its clamp), its centre on the frame's homogeneous motion. For
 the single crossover (c = 0) this is a rigid rotation of each yarn about the cell's centre;
 in the 2 × 2 repeat (model.crossover_cell, ``repeat = 2``) it moves the parallel yarns toward
-each other, pitch × cos γ apart, until they jam. The end faces are held along z (the
-inflection points of the periodic weave); nothing else touches the cell, the yarns meet
+each other, pitch × cos γ apart, until they jam. Which end-face nodes are driven and what
+holds them along z are the *End conditions* below; nothing else touches the cell, the yarns meet
 through their contact (docs/solid.md §6.1), frictionless unless stated.
 
 *End conditions* (``ends``; the in-plane drive x(γ) above is the same in each):
@@ -32,7 +32,10 @@ through their contact (docs/solid.md §6.1), frictionless unless stated.
   rise or sink (each node on its own), not tilt (its nodes' in-plane positions fix its
   plane). Nothing outside acts on the cell along z, and it starts at rest, so its momentum
   along z stays zero and its centre of mass keeps its height: the rigid vertical motion is
-  removed by momentum, not by a support (``CellShear.centre_z`` reports it).
+  removed by momentum, not by a support (``CellShear.centre_z`` reports it). But a yarn's
+  two end faces can then part vertically, one up and one down (the yarn tilts and climbs
+  through the cell), which a periodic fabric forbids (they are one section, a repeat
+  apart): it shows where the crossings' misfit goes when nothing holds the yarns.
 - ``"hinged"``: only the line of each end face at mid-height across the yarn (its
   centreline's level: z = 0 at the inflection point) is driven in x, y and held in z; the
   rest of the face is free. The end section turns about that line — the yarn's slope at its

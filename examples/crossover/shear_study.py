@@ -60,7 +60,7 @@ def main(quick: bool, ends: str = "held", friction: float = 0.0) -> None:
     print(f"| mesh per crossing and yarn | elements | {head} | reached | stopped by | "
           "parallel contact from | locking (tangents / 10× tangent) | kinetic | hourglass | "
           "energy error | steps (wall) | thickening at the end (µm) | crossing force at 4° (N) |")
-    print("|" + "---|" * (14 + len(ANGLES)))
+    print("|" + "---|" * (12 + len(ANGLES)))
     contact = ShellContactParams(friction=friction) if friction else None
     cell = None
     for m in meshes:

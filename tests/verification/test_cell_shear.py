@@ -110,11 +110,11 @@ def test_yarns_that_do_not_touch_are_moved_rigidly_by_the_frame():
 
 @pytest.fixture(scope="module")
 def coarse_run():
-    """The coarse repeat (6 × 4 × 2 elements per crossing and yarn) to 4° at 1000 rad/s,
-    the yarns' end faces clamped (``ends = "held"``): as quasi-static over 2–4° as the
-    same cell at 2000 rad/s over 4–8°, for the same number of steps."""
+    """The coarse repeat (6 × 4 × 2 elements per crossing and yarn) to 4° at 1100 rad/s,
+    the yarns' end faces clamped (``ends = "held"``): slow enough to be quasi-static over
+    the run's second half (the kinetic energy over the internal work falls as 1/γ²)."""
     return shear_cell(geometry_from_dict(repeat_doc()), YARN, angle=math.radians(4.0),
-                      rate=1e3, samples=8)
+                      rate=1.1e3, samples=8)
 
 
 SHORT, FAST = math.radians(2.0), 3e3  # the end conditions' comparison: angle, rate
@@ -183,7 +183,8 @@ def test_free_z_ends_let_each_yarn_climb_through_the_cell(coarse_run):
     cannot do (a yarn's two ends are the same inflection point, one repeat apart). The
     crossings then hardly press each other and the frame's moment is far below the
     clamped cell's at the same angle."""
-    f = shear_cell(geometry_from_dict(repeat_doc()), YARN, angle=SHORT, rate=FAST, samples=4,
+    f = shear_cell(geometry_from_dict(repeat_doc()), YARN, angle=0.75 * SHORT, rate=FAST,
+                   samples=4,
                    ends="free_z")
     assert f.stopped == "angle" and f.ends == "free_z"
     t = crossover_cell(geometry_from_dict(repeat_doc())).yarns["warp"].thickness

@@ -35,7 +35,8 @@ through their contact (docs/solid.md §6.1), frictionless unless stated.
   removed by momentum, not by a support (``CellShear.centre_z`` reports it). But a yarn's
   two end faces can then part vertically, one up and one down (the yarn tilts and climbs
   through the cell), which a periodic fabric forbids (they are one section, a repeat
-  apart): it shows where the crossings' misfit goes when nothing holds the yarns.
+  apart): it shows where the crossings' misfit goes when nothing holds the yarns. (On the
+  single crossover nothing then holds the two yarns together at all.)
 - ``"hinged"``: only the line of each end face at mid-height across the yarn (its
   centreline's level: z = 0 at the inflection point) is driven in x, y and held in z; the
   rest of the face is free. The end section turns about that line — the yarn's slope at its
@@ -289,9 +290,8 @@ def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: 
         raise InputError(f"samples = {samples!r}: valid is an integer ≥ 4")
     if not max_kinetic > 0.0:
         raise InputError(f"max_kinetic = {max_kinetic!r}: valid is a fraction > 0")
-    end_conditions = ends
-    cell, model, ends = cell_in_shear(cell_spec, material, hourglass=hourglass,
-                                      contact=contact, ends=end_conditions)
+    cell, model, driven = cell_in_shear(cell_spec, material, hourglass=hourglass,
+                                        contact=contact, ends=ends)
     names = part_names(model)
     parts = n_parts(model)
     pairs = [(_part_index(names, a), _part_index(names, b))
@@ -323,7 +323,7 @@ def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: 
     while True:
         t_next = state.t + dt_cap
         g_next = gamma_at(t_next)
-        for e in ends:
+        for e in driven:
             target = end_motion(g_next, e.X, e.centre, e.turn)
             model.bc_velocity[e.nodes, :2] = (target - state.x[e.nodes, :2]) / dt_cap
         try:
@@ -336,7 +336,7 @@ def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: 
             continue
         next_sample += every
         moment = 0.0
-        for e in ends:
+        for e in driven:
             moment += float(np.sum(state.f_ext[e.nodes, :2]
                                    * end_motion_rate(g, e.X, e.centre, e.turn)))
         f = interface_forces(ws.contact, parts)
@@ -375,7 +375,7 @@ def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: 
         hourglass_fraction=float(hg[-1] / max(wint[-1], 1e-300)),
         energy_error=float(err[-1]), stopped=stopped, steps=int(state.step),
         elements=int(model.n_hexes), repeat=int(cell.repeat), thickening=thick,
-        centre_z=zc, end_z=np.array(end_rows), ends=end_conditions)
+        centre_z=zc, end_z=np.array(end_rows), ends=ends)
 
 
 def _line(x: np.ndarray, y: np.ndarray) -> tuple[float, float]:

@@ -15,7 +15,7 @@ trellis law's γ1, γ2 for the fabric's width and for the cell's meshed (trimmed
 the checks. ``--quick``: the coarse mesh only. ``--ends``: the frame's end conditions
 (calibration.cell_shear: "held", the default, clamps the end faces; "hinged" drives each end
 face along its mid-height line only, so the crossings can open; "free_z" frees the end faces
-in z, so each yarn can climb); the cell's thickening and the crossing force at 4° are printed
+in z, so each yarn can climb); the cell's thickening and the crossings' contact at 4° are printed
 too. ``--friction MU``: Coulomb friction between the yarns.
 """
 
@@ -59,7 +59,7 @@ def main(quick: bool, ends: str = "held", friction: float = 0.0) -> None:
     head = " | ".join(f"τ at {a:g}° (MPa)" for a in ANGLES)
     print(f"| mesh per crossing and yarn | elements | {head} | reached | stopped by | "
           "parallel contact from | locking (tangents / 10× tangent) | kinetic | hourglass | "
-          "energy error | steps (wall) | thickening at the end (µm) | crossing force at 4° (N) |")
+          "energy error | steps (wall) | thickening at the end (µm) | crossings' contact at 4° (N) |")
     print("|" + "---|" * (12 + len(ANGLES)))
     contact = ShellContactParams(friction=friction) if friction else None
     cell = None
@@ -84,7 +84,7 @@ def main(quick: bool, ends: str = "held", friction: float = 0.0) -> None:
               f"{deg(stiffening_angle(r.gamma, r.stress))} | {r.kinetic_fraction:.4f} | "
               f"{r.hourglass_fraction:.4f} | {r.energy_error:.1e} | {r.steps} ({wall:.0f} s) | "
               f"{r.thickening[-1] * 1e6:.1f} | "
-              + (f"{np.interp(math.radians(4.0), r.gamma, r.crossing_force):.2f} |"
+              + (f"{np.interp(math.radians(4.0), r.gamma, r.crossing_contact):.2f} |"
                  if r.gamma[-1] >= math.radians(4.0) else "— |"))
         shell = trellis_law(r.gamma, **law)
         print("|   shell's trellis law, same angles | | " + " | ".join(

@@ -223,7 +223,11 @@ class CellShear:
         resultant: N_s = T / A0 (N/m); stress: τ = N_s / t (Pa).
         parallel_force: the contact force between parallel yarns, warp 1 on warp 0 plus
             fill 1 on fill 0 (magnitudes, N; zero in the single crossover).
-        crossing_force: the magnitude of the force the warps exert on the fills (N).
+        crossing_force: the magnitude of the force the warps exert on the fills (N): their
+            net force, in which the crossings that press a fill up and those that press it
+            down cancel.
+        crossing_contact: Σ |F warp on fill| over the warp–fill pairs (N), each pair
+            meeting at one crossing of the repeat: how hard the crossings press, summed.
         work: the frame's work ∫ T dγ (J), by the trapezoid rule over the samples.
         kinetic: kinetic energy over internal work at each sample.
         area, thickness: A0 (m²) and t (m).
@@ -248,6 +252,7 @@ class CellShear:
     stress: np.ndarray
     parallel_force: np.ndarray
     crossing_force: np.ndarray
+    crossing_contact: np.ndarray
     work: np.ndarray
     kinetic: np.ndarray
     area: float
@@ -342,12 +347,13 @@ def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: 
         f = interface_forces(ws.contact, parts)
         parallel = sum(float(np.linalg.norm(f[a, b])) for a, b in pairs)
         crossing = float(np.linalg.norm(sum(f[a, b] for a in warps for b in fills)))
+        pressing = sum(float(np.linalg.norm(f[a, b])) for a in warps for b in fills)
         balance = energy_balance(model, state)
         z = state.x[:, 2]
         rows.append((g, moment, parallel, crossing, balance["kinetic_J"],
                      balance["internal_work_J"], balance["hourglass_J"],
                      balance["error_fraction"], state.t, float(np.ptp(z)) - height0,
-                     float(np.sum(mass * (z - z0)) / np.sum(mass))))
+                     float(np.sum(mass * (z - z0)) / np.sum(mass)), pressing))
         end_rows.append([[float(np.mean(z[f] - z0[f])) for f in pair] for pair in faces])
         if g >= angle:
             break
@@ -363,15 +369,15 @@ def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: 
     if not rows:
         raise SimulationError(f"the shear test stopped before its first sample: {stopped}")
     arr = np.array(rows)
-    gam, moment, parallel, crossing, ke, wint, hg, err, t, thick, zc = arr.T
+    gam, moment, parallel, crossing, ke, wint, hg, err, t, thick, zc, pressing = arr.T
     work = np.concatenate([[0.0], np.cumsum(0.5 * (moment[1:] + moment[:-1]) * np.diff(gam))])
     kin = ke / np.maximum(wint, 1e-300)
     late = gam >= 0.5 * gam[-1]
     kinetic_fraction = float(np.max(kin[late]))
     return CellShear(
         gamma=gam, moment=moment, resultant=moment / area, stress=moment / (area * thickness),
-        parallel_force=parallel, crossing_force=crossing, work=work, kinetic=kin, area=area,
-        thickness=thickness, kinetic_fraction=kinetic_fraction,
+        parallel_force=parallel, crossing_force=crossing, crossing_contact=pressing,
+        work=work, kinetic=kin, area=area, thickness=thickness, kinetic_fraction=kinetic_fraction,
         hourglass_fraction=float(hg[-1] / max(wint[-1], 1e-300)),
         energy_error=float(err[-1]), stopped=stopped, steps=int(state.step),
         elements=int(model.n_hexes), repeat=int(cell.repeat), thickening=thick,

@@ -61,7 +61,10 @@ kinematics without drift.
   per unit reference volume, the conjugate the shell's trellis law τ(γ) = G(|γ|) γ has
   (theory §1.6; its energy e(γ) = ∫ τ dγ is per unit reference volume too);
 - the contact force between parallel yarns (the magnitude of the force warp 1 exerts on
-  warp 0, and fill 1 on fill 0: the jamming force) and the crossing yarns' (warp on fill);
+  warp 0, and fill 1 on fill 0: the jamming force) and the crossing yarns' (warp on fill:
+  their net force, and the sum of the four crossings' magnitudes);
+- the cell's thickening (how far the crossings open), its centre of mass's and each end
+  face's vertical displacement;
 - the kinetic energy over the internal work (quasi-static when small), hourglass energy
   over internal work, and the energy error.
 

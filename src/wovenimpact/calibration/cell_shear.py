@@ -14,15 +14,37 @@ each yarn turns rigidly with its family while the crossings follow F. The end fa
 yarn whose axis passes through c (its end faces' mean in-plane position: (0, y_j) for a
 warp, (x_i, 0) for a fill) are therefore driven as a rigid body,
 
-  x(γ) = F(γ) c + R(±γ/2) (X − c),  z held,
+  x(γ) = F(γ) c + R(±γ/2) (X − c),
 
 + for the warp, − for the fill: the yarn's end section stays square to the yarn (the yarn is
 not sheared in its plane by its clamp), its centre on the frame's homogeneous motion. For
 the single crossover (c = 0) this is a rigid rotation of each yarn about the cell's centre;
 in the 2 × 2 repeat (model.crossover_cell, ``repeat = 2``) it moves the parallel yarns toward
-each other, pitch × cos γ apart, until they jam. The end faces are held along z (the
-inflection points of the periodic weave); nothing else touches the cell, the yarns meet
+each other, pitch × cos γ apart, until they jam. Which end-face nodes are driven and what
+holds them along z are the *End conditions* below; nothing else touches the cell, the yarns meet
 through their contact (docs/solid.md §6.1), frictionless unless stated.
+
+*End conditions* (``ends``; the in-plane drive x(γ) above is the same in each):
+
+- ``"held"`` (default): every node of both end faces driven in x, y and held in z. The end
+  section is clamped: it can neither rise nor tilt.
+- ``"free_z"``: every node of both end faces driven in x, y, free in z: the end section can
+  rise or sink (each node on its own), not tilt (its nodes' in-plane positions fix its
+  plane). Nothing outside acts on the cell along z, and it starts at rest, so its momentum
+  along z stays zero and its centre of mass keeps its height: the rigid vertical motion is
+  removed by momentum, not by a support (``CellShear.centre_z`` reports it). But a yarn's
+  two end faces can then part vertically, one up and one down (the yarn tilts and climbs
+  through the cell), which a periodic fabric forbids (they are one section, a repeat
+  apart): it shows where the crossings' misfit goes when nothing holds the yarns. (On the
+  single crossover nothing then holds the two yarns together at all.)
+- ``"hinged"``: only the line of each end face at mid-height across the yarn (its
+  centreline's level: z = 0 at the inflection point) is driven in x, y and held in z; the
+  rest of the face is free. The end section turns about that line — the yarn's slope at its
+  inflection point is free, so its crimp can grow and the crossing open, the fabric
+  thickening — while the inflection point keeps the mid-plane height that the weave's
+  symmetries give it (a glide by one pitch with z → −z and a half turn about z, both
+  kept by the frame's pure shear, make a periodic yarn's inflection points stay at z = 0).
+  It needs an even number of elements through the yarn.
 
 *The drive.* γ(t) = γ̇ ∫₀ᵗ A(s) ds, A the smooth step of thesis Fig. 8-3 over ``ramp`` (the
 rate rises smoothly to γ̇). Each step, every driven node gets the velocity that takes it
@@ -39,7 +61,10 @@ kinematics without drift.
   per unit reference volume, the conjugate the shell's trellis law τ(γ) = G(|γ|) γ has
   (theory §1.6; its energy e(γ) = ∫ τ dγ is per unit reference volume too);
 - the contact force between parallel yarns (the magnitude of the force warp 1 exerts on
-  warp 0, and fill 1 on fill 0: the jamming force) and the crossing yarns' (warp on fill);
+  warp 0, and fill 1 on fill 0: the jamming force) and the crossing yarns' (warp on fill:
+  their net force, and the sum of the four crossings' magnitudes);
+- the cell's thickening (how far the crossings open), its centre of mass's and each end
+  face's vertical displacement;
 - the kinetic energy over the internal work (quasi-static when small), hourglass energy
   over internal work, and the energy error.
 
@@ -124,37 +149,71 @@ class DrivenEnd:
     turn: float
 
 
-def driven_ends(cell) -> list[DrivenEnd]:
-    """The end faces of each yarn of the cell (the single crossover's two yarns or the
-    repeat's four), with c the mean in-plane position of the yarn's end-face nodes."""
+END_CONDITIONS = ("held", "free_z", "hinged")
+
+
+def mid_height_nodes(nodes: np.ndarray, xyz: np.ndarray) -> np.ndarray:
+    """Those of an end face's ``nodes`` (coordinates ``xyz``) at mid-height of their
+    column — the nodes sharing their in-plane position — i.e. on the yarn's centreline
+    level across the face: one line across the yarn when the face has an even number of
+    elements through the thickness, none when it is odd."""
+    key = np.round(xyz[nodes, :2] / 1e-12).astype(np.int64)
+    _, col = np.unique(key, axis=0, return_inverse=True)
+    col = col.ravel()
+    z = xyz[nodes, 2]
+    keep = np.zeros(len(nodes), dtype=bool)
+    for c in range(int(col.max()) + 1):
+        m = np.flatnonzero(col == c)
+        lo, hi = z[m].min(), z[m].max()
+        keep[m] = np.abs(z[m] - 0.5 * (lo + hi)) <= 1e-9 * max(hi - lo, 1e-300)
+    return nodes[keep]
+
+
+def driven_ends(cell, ends: str = "held") -> list[DrivenEnd]:
+    """The driven nodes of each yarn of the cell (the single crossover's two yarns or the
+    repeat's four): its two end faces (``ends`` "held" or "free_z"), or the line of each
+    end face at mid-height across the yarn ("hinged"); c is the mean in-plane position of
+    the yarn's end-face nodes in every case (the yarn's axis, the same point)."""
+    if ends not in END_CONDITIONS:
+        raise InputError(f"ends = {ends!r}: valid are {', '.join(END_CONDITIONS)}")
     out = []
     sets = cell.mesh.node_sets
     for name in cell.yarn_names:
         warp = name.startswith("warp")
         lo, hi = ("x_min", "x_max") if warp else ("y_min", "y_max")
-        nodes = np.concatenate([sets[f"{name}.{lo}"], sets[f"{name}.{hi}"]])
+        faces = [sets[f"{name}.{lo}"], sets[f"{name}.{hi}"]]
+        centre = cell.mesh.nodes[np.concatenate(faces), :2].mean(axis=0)
+        if ends == "hinged":
+            faces = [mid_height_nodes(f, cell.mesh.nodes) for f in faces]
+            if any(len(f) == 0 for f in faces):
+                raise InputError("ends = 'hinged' needs an end face's mid-height line: "
+                                 "valid is an even mesh.through (elements through a yarn)")
+        nodes = np.concatenate(faces)
         X = cell.mesh.nodes[nodes, :2].copy()
-        out.append(DrivenEnd(name=name, nodes=nodes, X=X, centre=X.mean(axis=0),
+        out.append(DrivenEnd(name=name, nodes=nodes, X=X, centre=centre,
                              turn=1.0 if warp else -1.0))
     return out
 
 
-def cell_in_shear(cell_spec, material, *, hourglass: float = 0.05, contact=None):
+def cell_in_shear(cell_spec, material, *, hourglass: float = 0.05, contact=None,
+                  ends: str = "held"):
     """(cell, model, ends): the crossover cell of a geometry spec (spec.crossover) of the
-    transversely isotropic ``material``, every yarn's end faces prescribed in x, y (their
-    velocities set each step by :func:`shear_cell`) and held in z."""
+    transversely isotropic ``material`` with the frame's end conditions ``ends`` (module
+    docstring, *End conditions*): the driven nodes prescribed in x, y (their velocities
+    set each step by :func:`shear_cell`); held in z ("held", "hinged") or free ("free_z")."""
     cell, part = cell_solid(cell_spec, material, hourglass)
     mesh = cell.mesh
-    ends = driven_ends(cell)
+    driven = driven_ends(cell, ends)
     bcs = BoundaryConditions(len(mesh.nodes), ramp_time=0.0)
-    for e in ends:
-        bcs.fix(e.nodes, (2,))
+    for e in driven:
+        if ends != "free_z":
+            bcs.fix(e.nodes, (2,))
         bcs.prescribe(e.nodes, 0, 0.0).prescribe(e.nodes, 1, 0.0)
     model = build_model(mesh.nodes, np.zeros((0, 4), dtype=np.int64), {},
                         np.zeros(0, dtype=np.int64), bcs=bcs, solid=part,
                         node_sets=mesh.node_sets,
                         shell_contact=contact or ShellContactParams())
-    return cell, model, ends
+    return cell, model, driven
 
 
 @dataclass(frozen=True)
@@ -167,7 +226,11 @@ class CellShear:
         resultant: N_s = T / A0 (N/m); stress: τ = N_s / t (Pa).
         parallel_force: the contact force between parallel yarns, warp 1 on warp 0 plus
             fill 1 on fill 0 (magnitudes, N; zero in the single crossover).
-        crossing_force: the magnitude of the force the warps exert on the fills (N).
+        crossing_force: the magnitude of the force the warps exert on the fills (N): their
+            net force, in which the crossings that press a fill up and those that press it
+            down cancel.
+        crossing_contact: Σ |F warp on fill| over the warp–fill pairs (N), each pair
+            meeting at one crossing of the repeat: how hard the crossings press, summed.
         work: the frame's work ∫ T dγ (J), by the trapezoid rule over the samples.
         kinetic: kinetic energy over internal work at each sample.
         area, thickness: A0 (m²) and t (m).
@@ -176,6 +239,14 @@ class CellShear:
         hourglass_fraction, energy_error: at the end.
         stopped: why the run ended ("angle", or the solver's message).
         steps, elements, repeat.
+        thickening: the cell's thickness (highest less lowest node) less its initial
+            thickness at each sample (m): how far the crossings open vertically.
+        centre_z: the vertical displacement of the cell's centre of mass at each sample
+            (m): zero (to round-off) when nothing outside acts along z ("free_z").
+        end_z: the mean vertical displacement of each end face (m), samples × yarns × 2
+            (the yarns in ``cell.yarn_names`` order; the face at the lower coordinate
+            first): a yarn whose two ends part vertically climbs through the cell.
+        ends: the end conditions (module docstring).
     """
 
     gamma: np.ndarray
@@ -184,6 +255,7 @@ class CellShear:
     stress: np.ndarray
     parallel_force: np.ndarray
     crossing_force: np.ndarray
+    crossing_contact: np.ndarray
     work: np.ndarray
     kinetic: np.ndarray
     area: float
@@ -195,6 +267,10 @@ class CellShear:
     steps: int
     elements: int
     repeat: int
+    thickening: np.ndarray
+    centre_z: np.ndarray
+    end_z: np.ndarray
+    ends: str
 
 
 def _part_index(names: list[str], name: str) -> int | None:
@@ -203,13 +279,15 @@ def _part_index(names: list[str], name: str) -> int | None:
 
 def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: float = 2e3,
                ramp: float = 5e-6, samples: int = 100, hourglass: float = 0.05,
-               contact=None, max_kinetic: float = 0.05) -> CellShear:
+               contact=None, max_kinetic: float = 0.05, ends: str = "held") -> CellShear:
     """Shear the cell in the pin-jointed frame (module docstring) to the shear angle
     ``angle`` (rad) at ``rate`` γ̇ (rad/s, ramped in over ``ramp`` s), sampling ``samples``
     times. The run stops early, saying why in ``stopped``, when it leaves quasi-statics —
     the kinetic energy, once it has fallen below a fifth of ``max_kinetic`` of the internal
     work after the ramp, rising above ``max_kinetic`` at a sample (dropped: something gave way and the cell
-    moves on its own; the curve ends at the last quasi-static sample) — or when its time step collapses (a crushed element)."""
+    moves on its own; the curve ends at the last quasi-static sample) — or when its time step collapses (a crushed element).
+    ``ends``: the frame's end conditions, "held" (default), "free_z" or "hinged" (module
+    docstring, *End conditions*)."""
     if not 0.0 < angle < 0.5 * math.pi:
         raise InputError(f"angle = {angle!r} rad: valid is 0 < angle < π/2")
     if not rate > 0.0:
@@ -220,8 +298,8 @@ def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: 
         raise InputError(f"samples = {samples!r}: valid is an integer ≥ 4")
     if not max_kinetic > 0.0:
         raise InputError(f"max_kinetic = {max_kinetic!r}: valid is a fraction > 0")
-    cell, model, ends = cell_in_shear(cell_spec, material, hourglass=hourglass,
-                                      contact=contact)
+    cell, model, driven = cell_in_shear(cell_spec, material, hourglass=hourglass,
+                                        contact=contact, ends=ends)
     names = part_names(model)
     parts = n_parts(model)
     pairs = [(_part_index(names, a), _part_index(names, b))
@@ -233,6 +311,14 @@ def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: 
     ws = Workspace.for_model(model, state)
     sx, sy = cell.size
     area, thickness = sx * sy, cell.thickness
+    z0 = model.x0[:, 2].copy()
+    height0 = float(np.ptp(z0))
+    mass = np.asarray(ws.node_mass, float)
+    sets = cell.mesh.node_sets
+    faces = [[sets[f"{n}.{lo}"], sets[f"{n}.{hi}"]]
+             for n in cell.yarn_names
+             for lo, hi in [("x_min", "x_max") if n.startswith("warp") else ("y_min", "y_max")]]
+    end_rows = []
 
     def gamma_at(t: float) -> float:
         return rate * smooth_ramp_integral(t, ramp)
@@ -245,7 +331,7 @@ def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: 
     while True:
         t_next = state.t + dt_cap
         g_next = gamma_at(t_next)
-        for e in ends:
+        for e in driven:
             target = end_motion(g_next, e.X, e.centre, e.turn)
             model.bc_velocity[e.nodes, :2] = (target - state.x[e.nodes, :2]) / dt_cap
         try:
@@ -258,16 +344,20 @@ def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: 
             continue
         next_sample += every
         moment = 0.0
-        for e in ends:
+        for e in driven:
             moment += float(np.sum(state.f_ext[e.nodes, :2]
                                    * end_motion_rate(g, e.X, e.centre, e.turn)))
         f = interface_forces(ws.contact, parts)
         parallel = sum(float(np.linalg.norm(f[a, b])) for a, b in pairs)
         crossing = float(np.linalg.norm(sum(f[a, b] for a in warps for b in fills)))
+        pressing = sum(float(np.linalg.norm(f[a, b])) for a in warps for b in fills)
         balance = energy_balance(model, state)
+        z = state.x[:, 2]
         rows.append((g, moment, parallel, crossing, balance["kinetic_J"],
                      balance["internal_work_J"], balance["hourglass_J"],
-                     balance["error_fraction"], state.t))
+                     balance["error_fraction"], state.t, float(np.ptp(z)) - height0,
+                     float(np.sum(mass * (z - z0)) / np.sum(mass)), pressing))
+        end_rows.append([[float(np.mean(z[f] - z0[f])) for f in pair] for pair in faces])
         if g >= angle:
             break
         ke, wi = balance["kinetic_J"], balance["internal_work_J"]
@@ -277,22 +367,24 @@ def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: 
             stopped = (f"kinetic energy {ke / max(wi, 1e-300):.3g} of the internal work at "
                        f"γ = {math.degrees(g):.2f}° (above max_kinetic = {max_kinetic:g})")
             rows.pop()
+            end_rows.pop()
             break
     if not rows:
         raise SimulationError(f"the shear test stopped before its first sample: {stopped}")
     arr = np.array(rows)
-    gam, moment, parallel, crossing, ke, wint, hg, err, t = arr.T
+    gam, moment, parallel, crossing, ke, wint, hg, err, t, thick, zc, pressing = arr.T
     work = np.concatenate([[0.0], np.cumsum(0.5 * (moment[1:] + moment[:-1]) * np.diff(gam))])
     kin = ke / np.maximum(wint, 1e-300)
     late = gam >= 0.5 * gam[-1]
     kinetic_fraction = float(np.max(kin[late]))
     return CellShear(
         gamma=gam, moment=moment, resultant=moment / area, stress=moment / (area * thickness),
-        parallel_force=parallel, crossing_force=crossing, work=work, kinetic=kin, area=area,
-        thickness=thickness, kinetic_fraction=kinetic_fraction,
+        parallel_force=parallel, crossing_force=crossing, crossing_contact=pressing,
+        work=work, kinetic=kin, area=area, thickness=thickness, kinetic_fraction=kinetic_fraction,
         hourglass_fraction=float(hg[-1] / max(wint[-1], 1e-300)),
         energy_error=float(err[-1]), stopped=stopped, steps=int(state.step),
-        elements=int(model.n_hexes), repeat=int(cell.repeat))
+        elements=int(model.n_hexes), repeat=int(cell.repeat), thickening=thick,
+        centre_z=zc, end_z=np.array(end_rows), ends=ends)
 
 
 def _line(x: np.ndarray, y: np.ndarray) -> tuple[float, float]:

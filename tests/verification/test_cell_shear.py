@@ -69,7 +69,8 @@ def test_the_frame_shears_the_net_and_turns_each_yarn_rigidly():
         np.testing.assert_allclose(end_motion(g, e.centre[None], e.centre, e.turn)[0],
                                    F @ e.centre, atol=1e-15)
         h = 1e-6
-        fd = (end_motion(g + h, e.X, e.centre, e.turn) - end_motion(g - h, e.X, e.centre, e.turn)) / (2 * h)
+        fd = (end_motion(g + h, e.X, e.centre, e.turn)
+              - end_motion(g - h, e.X, e.centre, e.turn)) / (2 * h)
         np.testing.assert_allclose(end_motion_rate(g, e.X, e.centre, e.turn), fd, atol=1e-12)
     axis0 = F @ ends[0].centre
     axis1 = F @ ends[1].centre

@@ -86,6 +86,7 @@ from wovenimpact.calibration.crossover_cell import cell_solid
 from wovenimpact.errors import InputError, SimulationError
 from wovenimpact.interfaces import n_parts, part_names
 from wovenimpact.kernels.fabric import shear_modulus_true
+from wovenimpact.materials.fabric import trellis_locking_angles
 from wovenimpact.model.crossover_cell import centreline, section_profile, trimmed_extent
 from wovenimpact.model.model import BoundaryConditions, ShellContactParams, build_model
 from wovenimpact.results.contact_forces import interface_forces
@@ -284,8 +285,9 @@ def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: 
     ``angle`` (rad) at ``rate`` γ̇ (rad/s, ramped in over ``ramp`` s), sampling ``samples``
     times. The run stops early, saying why in ``stopped``, when it leaves quasi-statics —
     the kinetic energy, once it has fallen below a fifth of ``max_kinetic`` of the internal
-    work after the ramp, rising above ``max_kinetic`` at a sample (dropped: something gave way and the cell
-    moves on its own; the curve ends at the last quasi-static sample) — or when its time step collapses (a crushed element).
+    work after the ramp, rising above ``max_kinetic`` at a sample (dropped: something gave
+    way and the cell moves on its own; the curve ends at the last quasi-static sample) — or
+    when its time step collapses (a crushed element).
     ``ends``: the frame's end conditions, "held" (default), "free_z" or "hinged" (module
     docstring, *End conditions*)."""
     if not 0.0 < angle < 0.5 * math.pi:
@@ -435,12 +437,10 @@ def trellis_law(gamma, g1: float, g2: float, gamma1: float, gamma2: float) -> np
 
 
 def trellis_angles(width: float, pitch: float, c_max: float) -> tuple[float, float]:
-    """(γ1, γ2) of eqs. 3.13–3.14 as the shell computes them (materials.fabric): parallel
-    yarns of width b, ``pitch`` apart, touch when pitch × cos γ = b and are compacted to
-    C_max b when pitch × cos γ = C_max b."""
-    r = width / pitch
-    return (0.5 * math.pi - math.asin(min(r, 1.0)),
-            0.5 * math.pi - math.asin(min(c_max * r, 1.0)))
+    """(γ1, γ2) of eqs. 3.13–3.14 as the shell computes them
+    (:func:`materials.fabric.trellis_locking_angles`) for yarns of width b ``pitch``
+    apart — the meshed width, say, which a fabric file's parameters do not give."""
+    return trellis_locking_angles(width / pitch, c_max)
 
 
 def meshed_width(cell, family: str = "warp") -> float:

@@ -30,6 +30,14 @@ from wovenimpact.materials.fabric_point import (  # noqa: F401  (the fabric's pu
 )
 
 
+def trellis_locking_angles(ratio: float, c_max: float) -> tuple[float, float]:
+    """(γ1, γ2) in rad of eqs. 3.13–3.14 for parallel yarns of width b a pitch p apart,
+    ``ratio`` = b / p: they touch when p cos γ = b, γ1 = π/2 − asin(b/p), and are
+    compacted to C_max b when p cos γ = C_max b (a ratio above 1 counts as 1: γ = 0)."""
+    return (0.5 * math.pi - math.asin(min(ratio, 1.0)),
+            0.5 * math.pi - math.asin(min(c_max * ratio, 1.0)))
+
+
 @dataclass(frozen=True)
 class FabricParameters:
     """Complete, validated parameter set of the crossover model (SI).
@@ -94,10 +102,7 @@ class FabricParameters:
             self.warp.width / (2.0 * self.fill.half_length),
             self.fill.width / (2.0 * self.warp.half_length),
         )
-        r = max(ratios)
-        gamma1 = 0.5 * math.pi - math.asin(min(r, 1.0))
-        gamma2 = 0.5 * math.pi - math.asin(min(self.shear_c_max * r, 1.0))
-        return gamma1, gamma2
+        return trellis_locking_angles(max(ratios), self.shear_c_max)
 
     @property
     def thesis_locking_angles(self) -> tuple[float, float]:

@@ -58,7 +58,6 @@ from wovenimpact.materials.crimp import crimp_amplitude, crimp_of_amplitude
 from wovenimpact.model.mesh import Mesh
 
 FAMILIES = ("warp", "fill")
-REPEATS = (1, 2)  # crossings along each yarn: the single crossover, the 2 × 2 plain weave
 CLEARANCE_GRID = 201  # points per direction of the overlap check
 OVERLAP_TOLERANCE = 1e-9  # of the yarn thickness: round-off of surfaces that coincide
 
@@ -293,11 +292,7 @@ def crossover_cell(spec) -> CrossoverCell:
             "yarns narrower than the pitch, a width or a gap, where the cell's corners "
             "leave it room)")
     n = (spec.mesh.along, spec.mesh.across, spec.mesh.through)
-    repeat = int(getattr(spec.cell, "repeat", 1))
-    if repeat not in REPEATS:
-        raise InputError(f"cell.repeat = {repeat!r}: valid are 1 (one crossover) and 2 (the "
-                         "2 × 2 plain-weave repeat)")
-    if repeat == 2:
+    if spec.cell.repeat == 2:  # (the spec allows 1 or 2)
         return _repeat_cell(yarns, shape, trim, n)
     per_yarn = (n[0] + 1) * (n[1] + 1) * (n[2] + 1)
     nodes = np.vstack([_yarn_nodes(yarns["warp"], shape, trim, n, 1.0, 0),

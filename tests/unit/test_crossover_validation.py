@@ -4,11 +4,17 @@ from __future__ import annotations
 
 import json
 
+import math
+
+import numpy as np
+
 from wovenimpact.reports.crossover_validation import (
     THESIS_A_M,
     THESIS_B_N,
     cell_runs,
     page_lines,
+    shear_lines,
+    shear_runs,
 )
 
 
@@ -43,9 +49,61 @@ def test_the_page_judges_each_acceptance_from_the_numbers(tmp_path):
     assert "(within 2%: not met)" in far
 
 
+def _shear_run(mesh, ends, top_deg, asked_deg, modulus, *, parallel=None, locking=None) -> dict:
+    """A linear τ = modulus γ up to ``top_deg`` (100 samples), as shear_row writes it."""
+    g = np.linspace(0.0, math.radians(top_deg), 101)[1:]
+    return {"mesh": list(mesh), "ends": ends, "rate": 2e3, "angle_asked": math.radians(asked_deg),
+            "elements": 64 * mesh[0] * mesh[1] * mesh[2], "reached": float(g[-1]),
+            "stopped": "angle" if top_deg >= asked_deg else "kinetic energy 0.1 of the work",
+            "parallel_from": parallel, "locking": locking, "stiffening": None,
+            "kinetic_fraction": 0.02, "hourglass_fraction": 0.1, "energy_error": 1e-7,
+            "steps": 5000, "wall_s": 30.0, "curve_gamma": list(g),
+            "curve_stress_Pa": list(modulus * g)}
+
+
+def _shear(fine_modulus: float, jam: bool = False) -> dict:
+    law = {"g1_Pa": 82.4e6, "g2_Pa": 8.24e9, "gamma1": math.radians(0.53),
+           "gamma2": math.radians(49.46), "meshed_gamma1": math.radians(29.3),
+           "meshed_gamma2": math.radians(55.5)}
+    runs = [_shear_run((6, 4, 2), "hinged", 10.5, 30.0, 20e6),
+            _shear_run((12, 8, 2), "hinged", 4.5, 30.0, 30e6,
+                       parallel=math.radians(29.0) if jam else None,
+                       locking=math.radians(28.0) if jam else None),
+            _shear_run((18, 12, 4), "hinged", 4.0, 4.0, fine_modulus,
+                       locking=math.radians(1.0))]
+    return {"runs": runs, "law": law}
+
+
+def test_the_shear_section_reads_the_curves_and_judges_the_jam(tmp_path):
+    """τ = 20 MPa × γ reads 0.35 MPa at 1° (20e6 × 0.017453); a run stopped at 4.5° has no
+    τ at 6°; the shell's law at 2° is G(2°) × 2° = 11.4 MPa (theory §1.6, G1 = 82.4 MPa
+    locking at 0.53°); nothing met while no parallel yarns meet; a locking angle on a run asked
+    only to 4° (below the 29.3° the yarns meet at) is not read (its initial window is the
+    ramp's); the fine mesh at 31 against 30 MPa is 3 % off (converged within 5 %), at 40
+    MPa 25 % (not)."""
+    (tmp_path / "crossover_shear.json").write_text(json.dumps(_shear(31e6)))
+    shear = shear_runs(tmp_path)
+    text = "\n".join(shear_lines(shear))
+    assert "| 6 × 4 × 2 | hinged | 3072 | 0.35 / 0.70 / 1.40 / 2.09 / 2.79 / 3.49 |" in text
+    assert "| 12 × 8 × 2 | hinged | 12288 | 0.52 / 1.05 / 2.09 / — / — / — | 4.5°, gave way |" in text
+    assert "| 18 × 12 × 4 | hinged | 55296 | 0.54 / 1.08 / 2.16 / — / — / — | 4.0°, the angle " \
+           "asked | none | — |" in text
+    assert "γ2 49.5°) | — | — | 2.8 / 11.4 /" in text
+    assert "compared with the trellis law): not met. The parallel yarns never meet: as " \
+           "meshed (their trimmed width) they would at 29.3°; the runs stopped early gave way " \
+           "or crushed at 10.5°, 4.5°." in text
+    assert "Neither rule finds a locking angle" in text
+    assert "differ by 3% (converged within 5%: yes)" in text
+    assert "differ by 25% (converged within 5%: no)" in "\n".join(shear_lines(_shear(40e6)))
+    jammed = "\n".join(shear_lines(_shear(31e6, jam=True)))
+    assert "trellis law): met. The parallel yarns meet in 1 of 3 runs." in jammed
+    assert "A locking angle is found on 12 × 8 × 2 hinged." in jammed
+    assert "| 29.0° | 28.0° / none |" in jammed
+
+
 def test_validate_crossover_writes_the_page_and_its_figure(tmp_path):
     """``wovenimpact validate --crossover --work W --report P`` on cached runs: the page at
-    P, the compression figure beside it in validation/."""
+    P with its shear section, the compression and shear figures beside it in validation/."""
     from typer.testing import CliRunner
 
     from wovenimpact.cli.app import app
@@ -53,10 +111,12 @@ def test_validate_crossover_writes_the_page_and_its_figure(tmp_path):
     work = tmp_path / "work"
     work.mkdir()
     (work / "crossover_cell.json").write_text(json.dumps(_runs(0.0154e-3, 1.094)))
+    (work / "crossover_shear.json").write_text(json.dumps(_shear(31e6)))
     page = tmp_path / "docs" / "page.md"
     result = CliRunner().invoke(app, ["validate", "--crossover", "--work", str(work),
                                       "--report", str(page)])
     assert result.exit_code == 0, result.output
     assert "E1 on the two finer meshes: 96.45 and 96.47 GPa" in page.read_text()
-    figure = tmp_path / "docs" / "validation" / "crossover_compression.png"
-    assert figure.read_bytes()[:4] == b"\x89PNG"
+    assert "## In-plane shear in a picture frame" in page.read_text()
+    for name in ("crossover_compression.png", "crossover_shear.png"):
+        assert (tmp_path / "docs" / "validation" / name).read_bytes()[:4] == b"\x89PNG"

@@ -27,8 +27,9 @@ def validate(
                                     "finished containment runs (a run's folder or a folder of "
                                     "runs; repeatable) instead of running the ladders."),
     crossover: bool = typer.Option(False, "--crossover", help="Instead: the 3-D crossover "
-                                   "cell's virtual tests on three meshes (thesis ch. 5; minutes), "
-                                   "report docs/validation_crossover.md."),
+                                   "cell's virtual tests on three meshes and its shear test "
+                                   "(thesis ch. 5; minutes), report "
+                                   "docs/validation_crossover.md."),
 ) -> None:
     """Run (or resume) the example cases and thesis studies; write the validation report."""
     from wovenimpact.io.outdir import check_output_file, prepare_output_dir, write_failure

@@ -91,7 +91,7 @@ def test_the_shear_section_reads_the_curves_and_judges_the_jam(tmp_path):
     assert "γ2 49.5°) | — | — | 2.8 / 11.4 /" in text
     assert "compared with the trellis law): not met. The parallel yarns never meet: as " \
            "meshed (their trimmed width) they would at 29.3°; the runs stopped early gave way " \
-           "or crushed at 10.5°, 4.5°." in text
+           "or crushed at 4.5°, 10.5°." in text
     assert "Neither rule finds a locking angle" in text
     assert "differ by 3% (converged within 5%: yes)" in text
     assert "differ by 25% (converged within 5%: no)" in "\n".join(shear_lines(_shear(40e6)))

@@ -279,7 +279,7 @@ def shear_lines(shear: dict) -> list[str]:
     jammed = [r for r in runs if r["parallel_from"] is not None]
     locked = [r for r in runs if _toward_jam(r, law)
               and (r["locking"] is not None or r["stiffening"] is not None)]
-    early = sorted(_deg(r["reached"]) for r in runs if r["stopped"] != "angle")
+    early = [_deg(g) for g in sorted(r["reached"] for r in runs if r["stopped"] != "angle")]
     if jammed:
         jam = f"The parallel yarns meet in {len(jammed)} of {len(runs)} runs."
     else:

@@ -18,6 +18,7 @@ from wovenimpact.calibration.cell_shear import (
     end_motion_rate,
     frame_gradient,
     locking_angle,
+    meshed_trellis_angles,
     meshed_width,
     shear_cell,
     smooth_ramp_integral,
@@ -258,6 +259,10 @@ def test_the_trellis_law_and_its_locking_angles_are_the_shells():
     cell = crossover_cell(geometry_from_dict(repeat_doc()))
     m1, m2 = trellis_angles(meshed_width(cell), 0.5 * cell.size[1], f.shear_c_max)
     assert (math.degrees(m1), math.degrees(m2)) == pytest.approx((29.3, 55.5), abs=0.1)
+    # the same from the spec, on the repeat and on the single crossover (pitch = side / repeat)
+    for doc in (repeat_doc(), repeat_doc(repeat=1)):
+        assert meshed_trellis_angles(geometry_from_dict(doc), f.shear_c_max) == pytest.approx(
+            (m1, m2), rel=1e-12)
     gam = np.array([0.5 * g1, 1.2 * g2])
     tau = trellis_law(gam, f.shear_g1, f.shear_g2, g1, g2)
     assert tau == pytest.approx([f.shear_g1 * gam[0], f.shear_g2 * gam[1]], rel=1e-12)

@@ -87,7 +87,12 @@ from wovenimpact.errors import InputError, SimulationError
 from wovenimpact.interfaces import n_parts, part_names
 from wovenimpact.kernels.fabric import shear_modulus_true
 from wovenimpact.materials.fabric import trellis_locking_angles
-from wovenimpact.model.crossover_cell import centreline, section_profile, trimmed_extent
+from wovenimpact.model.crossover_cell import (
+    centreline,
+    crossover_cell,
+    section_profile,
+    trimmed_extent,
+)
 from wovenimpact.model.model import BoundaryConditions, ShellContactParams, build_model
 from wovenimpact.results.contact_forces import interface_forces
 from wovenimpact.results.energy import energy_balance
@@ -441,6 +446,15 @@ def trellis_angles(width: float, pitch: float, c_max: float) -> tuple[float, flo
     (:func:`materials.fabric.trellis_locking_angles`) for yarns of width b ``pitch``
     apart — the meshed width, say, which a fabric file's parameters do not give."""
     return trellis_locking_angles(width / pitch, c_max)
+
+
+def meshed_trellis_angles(cell_spec, c_max: float) -> tuple[float, float]:
+    """(γ1, γ2) of eqs. 3.13–3.14 for the yarns of a geometry spec as meshed: the warps'
+    trimmed width (:func:`meshed_width`) over their pitch (the cell's side along y over its
+    repeat) — the angle at which the meshed parallel yarns would meet, and the one the law
+    ends at."""
+    cell = crossover_cell(cell_spec)
+    return trellis_angles(meshed_width(cell), cell.size[1] / cell.repeat, c_max)
 
 
 def meshed_width(cell, family: str = "warp") -> float:

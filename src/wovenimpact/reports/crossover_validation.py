@@ -140,16 +140,14 @@ def shear_law() -> dict:
     """The shell's trellis law of the reference fabric (``kevlar_thesis.toml``, theory
     §1.6), and the angles at which the cell's parallel yarns, as meshed (their trimmed
     width), would meet (eqs. 3.13–3.14 on that width)."""
-    from wovenimpact.calibration.cell_shear import meshed_width, trellis_angles
-    from wovenimpact.model.crossover_cell import crossover_cell
+    from wovenimpact.calibration.cell_shear import meshed_trellis_angles
     from wovenimpact.spec import load_material
     from wovenimpact.spec.crossover import load_geometry
 
     fabric = load_material(ROOT / "examples" / "materials" / "kevlar_thesis.toml")
     g1, g2 = fabric.locking_angles
-    cell = crossover_cell(_repeat(load_geometry(ROOT / "examples" / "crossover"
-                                                / "thesis_cell.toml"), MESHES[0]))
-    m1, m2 = trellis_angles(meshed_width(cell), 0.5 * cell.size[1], fabric.shear_c_max)
+    geometry = load_geometry(ROOT / "examples" / "crossover" / "thesis_cell.toml")
+    m1, m2 = meshed_trellis_angles(_repeat(geometry, MESHES[0]), fabric.shear_c_max)
     return {"g1_Pa": fabric.shear_g1, "g2_Pa": fabric.shear_g2, "gamma1": g1, "gamma2": g2,
             "meshed_gamma1": m1, "meshed_gamma2": m2}
 

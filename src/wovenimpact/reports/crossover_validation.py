@@ -32,6 +32,8 @@ from pathlib import Path
 
 import numpy as np
 
+from wovenimpact.io.atomic import atomic_write_text
+
 ROOT = Path(__file__).resolve().parents[3]
 MESHES = ((12, 8, 2), (18, 12, 3), (24, 16, 4))  # elements along × across × through a yarn
 THESIS_A_M, THESIS_B_N = 0.12389e-3, 0.98432  # thesis §5.3.2, Fig. 5-10 (eq. 5.8)
@@ -109,7 +111,7 @@ def cell_runs(work: Path, meshes=MESHES, log=_quiet) -> dict:
         e = extend_cell(_cell(geometry, mesh), yarn, strain=STRAIN)
         runs["extension"].append(extension_row(e, mesh, time.perf_counter() - t0))
     work.mkdir(parents=True, exist_ok=True)
-    cache.write_text(json.dumps(runs, indent=1))
+    atomic_write_text(cache, json.dumps(runs, indent=1))
     return runs
 
 
@@ -179,7 +181,7 @@ def shear_runs(work: Path, runs=SHEAR_RUNS, log=_quiet) -> dict:
                               wall_s=time.perf_counter() - t0))
     out = {"runs": rows, "law": shear_law()}
     work.mkdir(parents=True, exist_ok=True)
-    cache.write_text(json.dumps(out, indent=1))
+    atomic_write_text(cache, json.dumps(out, indent=1))
     return out
 
 
@@ -429,8 +431,6 @@ def page_lines(runs: dict) -> list[str]:
 def crossover_page(work: Path, report: Path = ROOT / "docs" / "validation_crossover.md",
                    log=_quiet) -> Path:
     """Run (or reuse) the cell's tests, draw the figure and write the page."""
-    from wovenimpact.io.atomic import atomic_write_text
-
     work, report = Path(work), Path(report)
     runs = dict(cell_runs(work, log=log), shear=shear_runs(work, log=log))
     compression_figure(runs["compression"], report.parent / "validation"

@@ -30,10 +30,10 @@ import numpy as np
 
 from wovenimpact.calibration.cell_shear import (
     locking_angle,
+    meshed_trellis_angles,
     meshed_width,
     shear_cell,
     stiffening_angle,
-    trellis_angles,
     trellis_law,
 )
 from wovenimpact.model.crossover_cell import crossover_cell
@@ -95,8 +95,8 @@ def main(quick: bool, ends: str = "held", friction: float = 0.0) -> None:
         late = r.gamma >= 0.5 * r.gamma[-1]
         print(f"|   cell's secant modulus τ/γ over the second half (MPa) | | "
               f"{secant[late].min() / 1e6:.1f}–{secant[late].max() / 1e6:.1f} | | | | | | | | | | | | | |")
-    pitch = 0.5 * cell.size[1]
-    m1, m2 = trellis_angles(meshed_width(cell), pitch, fabric.shear_c_max)
+    pitch = cell.size[1] / cell.repeat
+    m1, m2 = meshed_trellis_angles(spec, fabric.shear_c_max)
     print(f"\ntrellis law's γ1, γ2: fabric width {fabric.warp.width * 1e3:.4f} mm over pitch "
           f"{pitch * 1e3:.5f} mm: {deg(g1)}, {deg(g2)}; the cell's meshed width "
           f"{meshed_width(cell) * 1e3:.4f} mm: {deg(m1)}, {deg(m2)}; G1 = "

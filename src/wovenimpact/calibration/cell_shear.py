@@ -175,6 +175,14 @@ def mid_height_nodes(nodes: np.ndarray, xyz: np.ndarray) -> np.ndarray:
     return nodes[keep]
 
 
+def end_faces(cell, name: str) -> list[np.ndarray]:
+    """The node sets of a yarn's two end faces (x_min, x_max for a warp, y_min, y_max for a
+    fill), the face at the lower coordinate first."""
+    sets = cell.mesh.node_sets
+    lo, hi = ("x_min", "x_max") if name.startswith("warp") else ("y_min", "y_max")
+    return [sets[f"{name}.{lo}"], sets[f"{name}.{hi}"]]
+
+
 def driven_ends(cell, ends: str = "held") -> list[DrivenEnd]:
     """The driven nodes of each yarn of the cell (the single crossover's two yarns or the
     repeat's four): its two end faces (``ends`` "held" or "free_z"), or the line of each
@@ -183,11 +191,9 @@ def driven_ends(cell, ends: str = "held") -> list[DrivenEnd]:
     if ends not in END_CONDITIONS:
         raise InputError(f"ends = {ends!r}: valid are {', '.join(END_CONDITIONS)}")
     out = []
-    sets = cell.mesh.node_sets
     for name in cell.yarn_names:
         warp = name.startswith("warp")
-        lo, hi = ("x_min", "x_max") if warp else ("y_min", "y_max")
-        faces = [sets[f"{name}.{lo}"], sets[f"{name}.{hi}"]]
+        faces = end_faces(cell, name)
         centre = cell.mesh.nodes[np.concatenate(faces), :2].mean(axis=0)
         if ends == "hinged":
             faces = [mid_height_nodes(f, cell.mesh.nodes) for f in faces]
@@ -321,10 +327,7 @@ def shear_cell(cell_spec, material, *, angle: float = math.radians(30.0), rate: 
     z0 = model.x0[:, 2].copy()
     height0 = float(np.ptp(z0))
     mass = np.asarray(ws.node_mass, float)
-    sets = cell.mesh.node_sets
-    faces = [[sets[f"{n}.{lo}"], sets[f"{n}.{hi}"]]
-             for n in cell.yarn_names
-             for lo, hi in [("x_min", "x_max") if n.startswith("warp") else ("y_min", "y_max")]]
+    faces = [end_faces(cell, n) for n in cell.yarn_names]
     end_rows = []
 
     def gamma_at(t: float) -> float:

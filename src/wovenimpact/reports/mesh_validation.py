@@ -8,6 +8,14 @@ docs/validation.md.
   at 7 / 5 / 4 / 3 mm, three release angles per mesh (±0.1°) for a single run's scatter;
   the casing's absorbed energy within ±10 % and the exit speed within 3 % across the
   meshes.
+- V0 along the axis, ``examples/studies/mesh_ring_v0_axial.toml``: the 1 mm aluminium ring
+  alone, failure off, 7 and 5 mm around the ring and 5 / 3 / 2 / 1.5 mm along its axis —
+  the size the casing's axial bending asks for (docs/theory.md §8.8, item 1).
+
+Each section also gives, for every series of three or more sizes (the uniform meshes; or,
+with ``mesh.casing.axial_element_size`` in the study, the sizes along the axis at one size
+around), Celik et al.'s observed order, extrapolated value and GCI on its three finest
+meshes (``studies.convergence.mesh_convergence``).
 
 :func:`ring_section` runs (or reuses, from ``work/studies/<study>``) one of them and
 returns its section as Markdown lines: the case, the commands that reproduce it, one row
@@ -19,10 +27,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
+from wovenimpact.studies.convergence import mesh_convergence
+
 ROOT = Path(__file__).resolve().parents[3]
 MESH_KEY = "mesh.element_size"
+AXIAL_KEY = "mesh.casing.axial_element_size"
 ANGLE_KEY = "mesh.blade.angle"
-# study → (heading, what it is, acceptance: [(metric, tolerance, label)])
+# study → (heading, what it is, acceptance: [(metric, tolerance, label)],
+#          convergence estimates: [(metric, label)])
 RING_STUDIES = {
     "mesh_ring_v0": (
         "Containment ring, failure off (V0)",
@@ -32,14 +44,29 @@ RING_STUDIES = {
         "blade meshed at 5 mm throughout. What the fragment has lost by then is contact, "
         "bending and stretching only: if it moves with the mesh, failure is not the only "
         "cause of the mesh dependence.",
-        [("fragment_energy_loss_J", 0.02, "the fragment's kinetic-energy loss")]),
+        [("fragment_energy_loss_J", 0.02, "the fragment's kinetic-energy loss")],
+        [("fragment_energy_loss_J", "the fragment's kinetic-energy loss")]),
     "mesh_ring_hybrid4": (
         "Containment ring, 4 plies (V2)",
         "The 4-ply hybrid ring (`examples/containment/hybrid_4.toml`) as the example runs "
         "it, the blade meshed at 5 mm throughout, at three release angles per mesh "
         "(89.9 / 90 / 90.1°) to show a single run's scatter.",
         [("casing_absorbed_energy_J", 0.10, "the casing's absorbed energy"),
-         ("fragment_exit_speed_m_per_s", 0.03, "the fragment's exit speed")]),
+         ("fragment_exit_speed_m_per_s", 0.03, "the fragment's exit speed")],
+        [("fragment_exit_speed_m_per_s", "the fragment's exit speed"),
+         ("casing_absorbed_energy_J", "the casing's absorbed energy")]),
+    "mesh_ring_v0_axial": (
+        "Containment ring, failure off, sizes along the axis (V0)",
+        "The 1 mm aluminium ring alone (`examples/containment/metal_24.toml` with one 1 mm "
+        "layer), failure off (a plastic strain of 100), to 0.3 ms, the blade meshed at 5 mm; "
+        "7 and 5 mm around the ring (`mesh.element_size`) and 5 / 3 / 2 / 1.5 mm along its "
+        "axis (`mesh.casing.axial_element_size`). The ring bends along its axis within "
+        "ℓ = √(R t)/[3(1 − ν²)]^¼ ≈ 12.3 mm (docs/theory.md §8.8): if the casing's share of "
+        "the fragment's loss converges with the size along the axis, that size is what "
+        "a ring's mesh must resolve.",
+        [],
+        [("casing_absorbed_energy_J", "the casing's absorbed energy"),
+         ("fragment_energy_loss_J", "the fragment's kinetic-energy loss")]),
 }
 
 
@@ -64,6 +91,61 @@ def energy_loss(row: dict) -> float | None:
     return 0.5 * m * (v0 * v0 - v * v)
 
 
+def mesh_label(values: dict) -> str:
+    """A run's mesh as the section names it: its element size, or "around × along" when
+    the study sets the size along the casing's axis apart (``mesh.casing.axial_element_size``)."""
+    along = values.get(AXIAL_KEY)
+    return f"{values[MESH_KEY]}" if along in (None, "") else f"{values[MESH_KEY]} × {along}"
+
+
+def _mm(size: str) -> float:
+    """"7 mm" → 7.0 (the studies give their sizes in mm)."""
+    number, _, unit = str(size).partition(" ")
+    if unit != "mm":
+        raise ValueError(f"a mesh size in mm was expected, got {size!r}")
+    return float(number)
+
+
+def convergence_lines(rows: list[dict], metrics) -> list[str]:
+    """Per metric and series of meshes (one series on uniform meshes; one per size around
+    the ring when the study sets the size along the axis apart): Celik et al.'s estimate on
+    the series' three finest meshes, from the per-mesh means — the observed order, the
+    extrapolated value, the GCI and how far the series' coarsest mesh lies from it."""
+    lines = []
+    for metric, label in metrics:
+        means = mesh_means(rows, metric)
+        series: dict[str, list[tuple[float, float]]] = {}
+        for r in rows:
+            key = mesh_label(r)
+            if key not in means:
+                continue
+            around, along = str(r[MESH_KEY]), r.get(AXIAL_KEY)
+            name, size = ("", around) if along in (None, "") else (f"{around} around, ", along)
+            point = (_mm(size), means[key][0])
+            if point not in series.setdefault(name, []):
+                series[name].append(point)
+        for name, points in series.items():
+            points.sort()
+            where = f"{name}along the axis" if name else "uniform meshes"
+            sizes = " / ".join(f"{h:g}" for h, _ in points)
+            if len(points) < 3:
+                lines.append(f"- {label}, {where} ({sizes} mm): fewer than three meshes, "
+                             "no estimate.")
+                continue
+            t = mesh_convergence(*zip(*points))[0]
+            text = (f"- {label}, {where} ({sizes} mm): on {t.sizes[0]:g} / {t.sizes[1]:g} / "
+                    f"{t.sizes[2]:g} mm {t.verdict}")
+            if t.order is not None:
+                text += f", order {t.order:.2f}"
+            if t.extrapolated is not None:
+                coarse = points[-1]
+                text += (f", extrapolated {t.extrapolated:.4g}, GCI {t.gci_fine:.1%} on "
+                         f"{t.sizes[0]:g} mm; {coarse[0]:g} mm is "
+                         f"{coarse[1] / t.extrapolated - 1.0:+.1%} from it")
+            lines.append(text + ".")
+    return lines
+
+
 def mesh_means(rows: list[dict], metric: str) -> dict[str, tuple[float, float, int]]:
     """Per element size (in the study's order): (mean, scatter = largest − smallest, runs)
     of ``metric`` over its finished runs (the release angles)."""
@@ -73,7 +155,7 @@ def mesh_means(rows: list[dict], metric: str) -> dict[str, tuple[float, float, i
             continue
         v = energy_loss(r) if metric == "fragment_energy_loss_J" else _float(r.get(metric))
         if v is not None:
-            out.setdefault(str(r[MESH_KEY]), []).append(v)
+            out.setdefault(mesh_label(r), []).append(v)
     return {h: (sum(v) / len(v), max(v) - min(v), len(v)) for h, v in out.items()}
 
 
@@ -116,13 +198,13 @@ def table_lines(rows: list[dict]) -> list[str]:
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for r in rows:
         if r.get("status") != "done":
-            lines.append(f"| {r.get(MESH_KEY)} | {r.get(ANGLE_KEY, '')} | "
+            lines.append(f"| {mesh_label(r)} | {r.get(ANGLE_KEY, '')} | "
                          f"{r.get('status')}: {r.get('error', '')} | | | | | | | | |")
             continue
         speed = _float(r.get("fragment_exit_speed_m_per_s"))
         speed = _float(r.get("fragment_speed_at_end_m_per_s")) if speed is None else speed
         lines.append(
-            f"| {r[MESH_KEY]} | {r.get(ANGLE_KEY, '')} | {r.get('outcome', '')} | "
+            f"| {mesh_label(r)} | {r.get(ANGLE_KEY, '')} | {r.get('outcome', '')} | "
             f"{num(speed, '.2f')} | {num(energy_loss(r), '.1f')} | "
             f"{num(_float(r.get('casing_absorbed_energy_J')), '.1f')} | "
             f"{num(_float(r.get('contact_damping_energy_J')), '.1f')} | "
@@ -137,16 +219,19 @@ def ring_section(study: str, work: Path, workers: int = 1, log=_quiet) -> list[s
     return its section's lines."""
     from wovenimpact.studies.sweep import load_study, run_study
 
-    title, what, checks = RING_STUDIES[study]
+    title, what, checks, estimates = RING_STUDIES[study]
     path = ROOT / "examples" / "studies" / f"{study}.toml"
     _, variants, _ = load_study(path)
-    sizes = list(dict.fromkeys(str(v.values[MESH_KEY]) for v in variants))
+    sizes = list(dict.fromkeys(mesh_label(v.values) for v in variants))
     out = Path(work) / "studies" / study
     log(f"study {study} → {out}")
     rows = run_study(path, out, workers=workers)
+    accept = ["Acceptance (issue 36):", "", *acceptance_lines(rows, sizes, checks), ""] \
+        if checks else []
     return [f"## {title}", "", what, "", "Reproduce (one core, niced; hours for the finer "
             "meshes):", "", "```",
             f"nice wovenimpact sweep examples/studies/{study}.toml --out out/{study} --workers 1",
             f"wovenimpact validate --study {study}   # this section, into out/validation/validation.md",
-            "```", "", *table_lines(rows), "", "Acceptance (issue 36):", "",
-            *acceptance_lines(rows, sizes, checks), ""]
+            "```", "", *table_lines(rows), "", *accept,
+            "Convergence (Celik et al. 2008; `wovenimpact convergence`):", "",
+            *convergence_lines(rows, estimates), ""]

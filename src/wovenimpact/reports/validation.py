@@ -37,7 +37,7 @@ THESIS_RESIDUAL = {"plies1_100": "82–85", "plies2_100": "58", "plies4_100": "1
 STUDIES = ("thesis_velocity", "thesis_plies", "thesis_plate_size", "thesis_crimp",
            "thesis_compaction", "thesis_element_size", "thesis_velocity_v50",
            "thesis_velocity_v50_2plies", "hourglass", "design_175", STRIP_STUDY,
-           "mesh_ring_v0")
+           "mesh_ring_v0", "mesh_ring_v0_axial")
 # studies run only when asked for (`wovenimpact validate --study NAME`): hours of ring runs
 ON_REQUEST = ("mesh_ring_hybrid4",)
 # the design search of the README: fewest plies that stop the FSP at 175 m/s, by runs

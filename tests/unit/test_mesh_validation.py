@@ -64,7 +64,7 @@ def test_the_axial_study_sets_the_size_along_the_axis_apart_with_the_blade_fixed
     _, variants, _ = load_study(mv.ROOT / "examples" / "studies" / "mesh_ring_v0_axial.toml")
     labels = [mv.mesh_label(v.values) for v in variants]
     assert labels == [f"{a} × {b}" for a in ("7 mm", "5 mm")
-                      for b in ("5 mm", "3 mm", "2 mm", "1.5 mm")]
+                      for b in ("5 mm", "3 mm", "2 mm", "1.5 mm", "1 mm")]
     assert {v.values["mesh.blade.element_size"] for v in variants} == {"5 mm"}
     assert set(mv.RING_STUDIES) >= {"mesh_ring_v0", "mesh_ring_hybrid4", "mesh_ring_v0_axial"}
 

@@ -9,7 +9,7 @@ docs/validation.md.
   the casing's absorbed energy within ±10 % and the exit speed within 3 % across the
   meshes.
 - V0 along the axis, ``examples/studies/mesh_ring_v0_axial.toml``: the 1 mm aluminium ring
-  alone, failure off, 7 and 5 mm around the ring and 5 / 3 / 2 / 1.5 mm along its axis —
+  alone, failure off, 7 and 5 mm around the ring and 5 / 3 / 2 / 1.5 / 1 mm along its axis —
   the size the casing's axial bending asks for (docs/theory.md §8.8, item 1).
 
 Each section also gives, for every series of three or more sizes (the uniform meshes; or,
@@ -59,7 +59,7 @@ RING_STUDIES = {
         "Containment ring, failure off, sizes along the axis (V0)",
         "The 1 mm aluminium ring alone (`examples/containment/metal_24.toml` with one 1 mm "
         "layer), failure off (a plastic strain of 100), to 0.3 ms, the blade meshed at 5 mm; "
-        "7 and 5 mm around the ring (`mesh.element_size`) and 5 / 3 / 2 / 1.5 mm along its "
+        "7 and 5 mm around the ring (`mesh.element_size`) and 5 / 3 / 2 / 1.5 / 1 mm along its "
         "axis (`mesh.casing.axial_element_size`). The ring bends along its axis within "
         "ℓ = √(R t)/[3(1 − ν²)]^¼ ≈ 12.3 mm (docs/theory.md §8.8): if the casing's share of "
         "the fragment's loss converges with the size along the axis, that size is what "

@@ -28,6 +28,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from wovenimpact.studies.convergence import mesh_convergence
+from wovenimpact.units import to_si
 
 ROOT = Path(__file__).resolve().parents[3]
 MESH_KEY = "mesh.element_size"
@@ -98,12 +99,9 @@ def mesh_label(values: dict) -> str:
     return f"{values[MESH_KEY]}" if along in (None, "") else f"{values[MESH_KEY]} × {along}"
 
 
-def _mm(size: str) -> float:
-    """"7 mm" → 7.0 (the studies give their sizes in mm)."""
-    number, _, unit = str(size).partition(" ")
-    if unit != "mm":
-        raise ValueError(f"a mesh size in mm was expected, got {size!r}")
-    return float(number)
+def _mm(size: str, key: str) -> float:
+    """A study's mesh size ("7 mm", "0.007 m") in mm."""
+    return 1e3 * to_si(size, "length", key, gt=0)
 
 
 def convergence_lines(rows: list[dict], metrics) -> list[str]:
@@ -120,8 +118,9 @@ def convergence_lines(rows: list[dict], metrics) -> list[str]:
             if key not in means:
                 continue
             around, along = str(r[MESH_KEY]), r.get(AXIAL_KEY)
-            name, size = ("", around) if along in (None, "") else (f"{around} around, ", along)
-            point = (_mm(size), means[key][0])
+            name, size, which = (("", around, MESH_KEY) if along in (None, "") else
+                                 (f"{around} around, ", along, AXIAL_KEY))
+            point = (_mm(size, which), means[key][0])
             if point not in series.setdefault(name, []):
                 series[name].append(point)
         for name, points in series.items():
@@ -139,9 +138,11 @@ def convergence_lines(rows: list[dict], metrics) -> list[str]:
                 text += f", order {t.order:.2f}"
             if t.extrapolated is not None:
                 coarse = points[-1]
-                text += (f", extrapolated {t.extrapolated:.4g}, GCI {t.gci_fine:.1%} on "
-                         f"{t.sizes[0]:g} mm; {coarse[0]:g} mm is "
-                         f"{coarse[1] / t.extrapolated - 1.0:+.1%} from it")
+                gci = "—" if t.gci_fine is None else f"{t.gci_fine:.1%}"
+                text += f", extrapolated {t.extrapolated:.4g}, GCI {gci} on {t.sizes[0]:g} mm"
+                if t.extrapolated != 0.0:
+                    text += (f"; {coarse[0]:g} mm is {coarse[1] / t.extrapolated - 1.0:+.1%} "
+                             "from it")
             lines.append(text + ".")
     return lines
 

@@ -32,6 +32,31 @@ def test_search_finds_the_smallest_stopping_pack(threshold, start):
     assert len(calls) <= 12
 
 
+@given(threshold=st.integers(1, 40), start=st.integers(1, 8))
+def test_one_at_a_time_the_search_runs_no_pack_the_others_make_needless(threshold, start):
+    """batch_size 1 (one worker): one pack per round; while doubling, no pack above the
+    first that held; the same answer, bracketed, in at most 2 log2(40) + 2 rounds."""
+    calls = []
+
+    def stops(batch):
+        calls.append(list(batch))
+        return {n: n >= threshold for n in batch}
+
+    n, seen = search_plies(stops, start=start, batch_size=1)
+    assert n == threshold and all(len(c) == 1 for c in calls)
+    assert n == 1 or seen[n - 1] is False
+    first_held = start
+    while first_held < threshold:
+        first_held *= 2
+    assert max(seen) == first_held  # nothing run past the first doubling that held
+    assert len(calls) <= 2 * math.ceil(math.log2(40)) + 2
+
+
+def test_the_batch_size_is_one_or_two():
+    with pytest.raises(InputError, match="batch_size"):
+        search_plies(lambda batch: {n: True for n in batch}, batch_size=3)
+
+
 def test_search_gives_up_past_the_limit():
     with pytest.raises(InputError, match="no pack"):
         search_plies(lambda batch: {n: False for n in batch}, max_plies=16)
@@ -83,6 +108,21 @@ def test_design_runs_an_undecided_pack_again_with_twice_the_end_time(tmp_path, m
     assert result["reruns"] == {"2": "undecided → perforated with twice the end time"}
     assert (2, "plies_2_end2x", "500.0 us") in calls
     assert len(heard) == 1 and heard[0].startswith("2 plies: undecided at run.end_time = 250 us")
+
+
+def test_design_with_one_worker_runs_one_pack_a_round(tmp_path, monkeypatch):
+    """--workers 1: every batch is a single pack, and no pack above the first that held
+    is run (threshold 3 from 1 ply: 1, 2, 4, then 3 — never 8)."""
+    from wovenimpact.studies import design
+
+    run_batch, calls = _fake_runs(threshold=3, slow={})
+    sizes = []
+    monkeypatch.setattr(design, "_run_batch", lambda docs, base, dirs, workers: (
+        sizes.append(len(docs)), run_batch(docs, base, dirs, workers))[1])
+    result = design.design_plies(ROOT / "examples" / "plate_impact" / "plies1_100.toml",
+                                 tmp_path, workers=1)
+    assert result["plies_to_stop"] == 3 and set(sizes) == {1}
+    assert [n for n, _, _ in calls] == [1, 2, 4, 3]
 
 
 def test_design_stops_when_a_pack_is_undecided_even_twice_as_long(tmp_path, monkeypatch):

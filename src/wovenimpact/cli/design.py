@@ -19,7 +19,7 @@ def plies(
                                 "plies to stop it) or a containment case (a casing and a "
                                 "blade: casing layers to contain the fragment)."),
     out: Path = typer.Option(None, "--out", help="Where the runs go (default: out/design_<case>)."),
-    workers: int = typer.Option(2, "--workers", min=1, help="Runs in parallel."),
+    workers: int = typer.Option(2, "--workers", min=1, help="Runs in parallel: with 2 or more, two packs a round (N and 2N while doubling); with 1, one pack a round (2N only if N did not hold)."),
     start: int = typer.Option(None, "--start", min=1, help="First ply count to try (default: the case's)."),
     check: int = typer.Option(0, "--check", min=0, help="Also run this many packs just above the answer (a larger pack that perforates is warned of)."),
     as_json: bool = typer.Option(False, "--json", help="Print one JSON object."),

@@ -7,7 +7,8 @@ bisection between the largest pack that is perforated and the smallest that stop
 On a containment case (``mesh.kind = "containment"``) N is ``mesh.casing.layers`` (fabric
 plies of a hybrid casing, aluminium layers of an all-metal one) and the answer is the
 fewest layers that contain the fragment, with the casing's mass (inner shell counted).
-Each round runs its candidates in parallel (local processes). Only decided runs count:
+Each round runs its candidates in parallel (local processes): two packs with two workers or
+more, one with one worker. Only decided runs count:
 a pack whose run ends ``undecided`` (still in contact, or intact plies ahead of the
 impactor, at the end time) or ``no contact`` is continued from its last checkpoint to
 twice the end time (in ``plies_N_end2x``, saying so through ``log``; :func:`continue_from`);
@@ -41,18 +42,25 @@ def is_containment(doc: dict) -> bool:
 
 def search_plies(stops: Callable[[list[int]], dict[int, bool]], start: int = 1,
                  max_plies: int = MAX_PLIES, unit: str = "plies",
-                 goal: str = "stops the impactor") -> tuple[int, dict[int, bool]]:
+                 goal: str = "stops the impactor", batch_size: int = 2,
+                 ) -> tuple[int, dict[int, bool]]:
     """Smallest N ≥ 1 with stops(N), assuming more plies never do worse.
 
     ``stops`` evaluates a batch of ply counts (in parallel) and returns N → stopped.
+    With ``batch_size`` 2 a round runs two packs (N and 2N while doubling, the two
+    thirds of the bracket while bisecting); with 1, one pack (N, then 2N only if N did
+    not hold; the bracket's middle), so that a single worker never runs a pack — often
+    the largest and slowest — that the other's outcome makes needless.
     Returns (N, every evaluation made). ``unit`` and ``goal`` word the error when no N
     up to ``max_plies`` holds ("layers", "contains the fragment" for a casing).
     """
+    if batch_size not in (1, 2):
+        raise InputError(f"batch_size = {batch_size!r}; valid: 1 or 2")
     seen: dict[int, bool] = {}
     lo, hi = 0, None  # lo: largest known perforated (0: none), hi: smallest known stopped
     n = max(1, start)
     while hi is None:
-        batch = [k for k in (n, 2 * n) if k <= max_plies and k not in seen]
+        batch = [k for k in (n, 2 * n)[:batch_size] if k <= max_plies and k not in seen]
         if not batch:
             raise InputError(f"no pack of up to {max_plies} {unit} {goal} (searched from "
                              f"{max(1, start)}: {sorted(seen) or 'none run'})")
@@ -62,11 +70,11 @@ def search_plies(stops: Callable[[list[int]], dict[int, bool]], start: int = 1,
                 hi = k
             if not seen[k]:
                 lo = max(lo, k)
-        n *= 4
+        n *= 2 * batch_size
     while hi - lo > 1:
         third = max(1, (hi - lo) // 3)
         batch = sorted({k for k in (lo + third, hi - third) if lo < k < hi and k not in seen})
-        if not batch:
+        if not batch or batch_size == 1:
             batch = [(lo + hi) // 2]
         seen.update(stops(batch))
         for k in batch:
@@ -244,7 +252,8 @@ def design_plies(case_path: str | Path, out_dir: str | Path, workers: int = 2,
     else:
         unit, goal = "plies", "stops the impactor"
         n0 = getattr(given.mesh, "plies", 1)
-    plies, seen = search_plies(stops, start=start or n0, unit=unit, goal=goal)
+    plies, seen = search_plies(stops, start=start or n0, unit=unit, goal=goal,
+                               batch_size=min(workers, 2))
     extra = [k for k in range(plies + 1, plies + 1 + check) if k not in seen]
     if extra:
         seen.update(stops(extra))

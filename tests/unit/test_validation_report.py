@@ -169,3 +169,28 @@ def test_a_failed_design_search_is_reported_not_fatal(tmp_path, monkeypatch):
     text = "\n".join(validation.design_lines("design_175", tmp_path, workers=1))
     assert "## design_175: plies to stop the impactor, by runs" in text
     assert "**No answer: the search stopped.** 8 plies: the run failed" in text
+
+
+def test_a_report_of_some_studies_runs_only_those(tmp_path, monkeypatch):
+    """validate --study: the report holds the asked studies' sections alone; no example
+    case, convergence run or metal section is run (each would raise here)."""
+    import wovenimpact.runs
+    from wovenimpact.reports import validation
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("a run outside the asked studies")
+
+    monkeypatch.setattr(wovenimpact.runs, "reused_or_run", refuse)
+    monkeypatch.setattr(validation, "convergence_runs", refuse)
+    monkeypatch.setattr(validation, "metal_section", refuse)
+    monkeypatch.setattr(validation, "smith_strip_lines", refuse)
+    asked = []
+    monkeypatch.setattr(validation, "study_sections", lambda studies, work, figures, workers,
+                        log: (asked.extend(studies) or [f"## {s}" for s in studies], {}))
+    report = validation.run_validation(tmp_path / "w", tmp_path / "w" / "validation.md",
+                                       studies=("mesh_ring_v0",), workers=1,
+                                       studies_only=True)
+    text = report.read_text()
+    assert asked == ["mesh_ring_v0"]
+    assert text.startswith("# Validation: selected studies") and "## mesh_ring_v0" in text
+    assert "## Example cases" not in text and "## Commentary" not in text

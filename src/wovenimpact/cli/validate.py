@@ -15,7 +15,7 @@ from wovenimpact.errors import InputError
 def validate(
     work: Path = typer.Option(Path("out/validation"), "--work", help="Where the runs go (resumed)."),
     report: Path = typer.Option(None, "--report", help="Report path (default: docs/validation.md; with --study, WORK/validation.md, so that a partial report never replaces the full one)."),
-    study: list[str] = typer.Option(None, "--study", help="Only these studies (repeatable)."),
+    study: list[str] = typer.Option(None, "--study", help="Only these studies' sections (repeatable), into WORK/validation.md: no example cases, convergence runs or metal section."),
     workers: int = typer.Option(2, "--workers", min=1, help="Runs in parallel."),
     containment: bool = typer.Option(False, "--containment", help="Instead: the fan-blade "
                                      "containment ladders and mass table (thesis ch. 8; hours "
@@ -68,6 +68,7 @@ def validate(
         check_output_file(report, "--report")
         path = run_validation(work, report,
                               studies=tuple(study) if study else STUDIES, workers=workers,
+                              studies_only=bool(study),
                               log=lambda m: console.print(f"[dim]{time.strftime('%H:%M:%S')}[/] {m}"))
     except InputError as err:
         fail(str(err))

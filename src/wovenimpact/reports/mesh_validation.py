@@ -109,20 +109,18 @@ def convergence_lines(rows: list[dict], metrics) -> list[str]:
     the ring when the study sets the size along the axis apart): Celik et al.'s estimate on
     the series' three finest meshes, from the per-mesh means — the observed order, the
     extrapolated value, the GCI and how far the series' coarsest mesh lies from it."""
+    # each mesh's series name and its size in that series (mm), once per mesh
+    place: dict[str, tuple[str, float]] = {}
+    for r in rows:
+        around, along = str(r[MESH_KEY]), r.get(AXIAL_KEY)
+        place[mesh_label(r)] = (("", _mm(around, MESH_KEY)) if along in (None, "") else
+                                (f"{around} around, ", _mm(along, AXIAL_KEY)))
     lines = []
     for metric, label in metrics:
-        means = mesh_means(rows, metric)
         series: dict[str, list[tuple[float, float]]] = {}
-        for r in rows:
-            key = mesh_label(r)
-            if key not in means:
-                continue
-            around, along = str(r[MESH_KEY]), r.get(AXIAL_KEY)
-            name, size, which = (("", around, MESH_KEY) if along in (None, "") else
-                                 (f"{around} around, ", along, AXIAL_KEY))
-            point = (_mm(size, which), means[key][0])
-            if point not in series.setdefault(name, []):
-                series[name].append(point)
+        for key, (mean, _, _) in mesh_means(rows, metric).items():
+            name, size = place[key]
+            series.setdefault(name, []).append((size, mean))
         for name, points in series.items():
             points.sort()
             where = f"{name}along the axis" if name else "uniform meshes"
@@ -148,8 +146,8 @@ def convergence_lines(rows: list[dict], metrics) -> list[str]:
 
 
 def mesh_means(rows: list[dict], metric: str) -> dict[str, tuple[float, float, int]]:
-    """Per element size (in the study's order): (mean, scatter = largest − smallest, runs)
-    of ``metric`` over its finished runs (the release angles)."""
+    """Per mesh (its ``mesh_label``, in the study's order): (mean, scatter = largest −
+    smallest, runs) of ``metric`` over its finished runs (the release angles)."""
     out: dict[str, list[float]] = {}
     for r in rows:
         if r.get("status") != "done":

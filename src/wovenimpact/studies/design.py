@@ -73,8 +73,9 @@ def search_plies(stops: Callable[[list[int]], dict[int, bool]], start: int = 1,
         n *= 2 * batch_size
     while hi - lo > 1:
         third = max(1, (hi - lo) // 3)
-        batch = sorted({k for k in (lo + third, hi - third) if lo < k < hi and k not in seen})
-        if not batch or batch_size == 1:
+        batch = [] if batch_size == 1 else sorted(
+            {k for k in (lo + third, hi - third) if lo < k < hi and k not in seen})
+        if not batch:
             batch = [(lo + hi) // 2]
         seen.update(stops(batch))
         for k in batch:
